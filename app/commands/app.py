@@ -1,0 +1,32 @@
+"""``partlab app``: start the Streamlit labelling app, headless (no browser opened)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+PAGE = Path(__file__).resolve().parent.parent / "streamlit_app.py"
+
+
+def add_arguments(p) -> None:
+    p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
+    p.add_argument("--port", type=int, default=8501, help="port to listen on (default 8501)")
+
+
+def streamlit_command(host: str, port: int) -> list[str]:
+    """The command line that serves the app; also used by the browser tests."""
+    return [
+        sys.executable, "-m", "streamlit", "run", str(PAGE),
+        "--server.headless", "true",
+        "--server.address", host,
+        "--server.port", str(port),
+        "--browser.gatherUsageStats", "false",
+        "--server.fileWatcherType", "none",
+    ]
+
+
+def run(args) -> int:
+    print(f"partlab app: serving on http://{args.host}:{args.port} (Ctrl+C to stop)", flush=True)
+    return subprocess.call(streamlit_command(args.host, args.port), env=os.environ.copy())

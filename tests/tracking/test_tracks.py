@@ -1,0 +1,59 @@
+import io
+
+import pandas as pd
+import pytest
+
+from tracking.box import Box
+from tracking.tracks import (COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
+                             records_to_frame, write_tracks_csv)
+
+HEADER = "frame,track_id,part,x,y,w,h"
+
+
+def _read(text):
+    return read_tracks_csv(io.StringIO(text), name="t.csv")
+
+
+def test_round_trip(tmp_path):
+    recs = [TrackRecord(3, 1, "head", Box(10.5, 20, 8, 9), score=0.75, failure=True, occluded=0.25,
+                        state="normal", source="human"),
+            TrackRecord(0, 2, "torso", Box(1, 2, 3, 4))]
+    path = tmp_path / "tracks.csv"
+    write_tracks_csv(records_to_frame(recs), path)
+    first = path.read_text().splitlines()[0]
+    assert first == ",".join(COLUMNS)
+    back = frame_to_records(read_tracks_csv(path))
+    assert back[0].frame == 0 and back[1] == recs[0]
+
+
+def test_optional_columns_and_unknown_columns():
+    df = _read(HEADER + ",colour,failure\n0,1,head,1,2,3,4,red,1\n")
+    assert list(df.columns) == list(COLUMNS)
+    assert bool(df.failure[0]) is True
+    assert df.source[0] == "tracker"
+
+
+@pytest.mark.parametrize("text,message", [
+    ("frame,track_id,part,x,y,w\n", "missing column(s) 'h'"),
+    ("track_id,frame,part,x,y,w,h\n", "in that order"),
+    (HEADER + "\n0,1,elbow,1,2,3,4\n", "line 2, column 'part': unknown part 'elbow'"),
+    (HEADER + "\n0,1,head,1,2,3,4\n1,1,head,1,2,-3,4\n", "line 3, column 'w': negative size -3"),
+    (HEADER + "\n0,1,head,1,abc,3,4\n", "line 2, column 'y': 'abc' is not a number"),
+    (HEADER + "\nx,1,head,1,2,3,4\n", "line 2, column 'frame': 'x' is not an integer"),
+    (HEADER + "\n0,1,head\n", "line 2: 3 cells"),
+    ("", "empty"),
+])
+def test_malformed_csv_names_line_and_column(text, message):
+    with pytest.raises(TracksCSVError) as err:
+        _read(text)
+    assert message in str(err.value)
+    assert str(err.value).startswith("t.csv")
+
+
+def test_write_sorts_by_frame_track_part():
+    df = pd.DataFrame({"frame": [1, 0, 0], "track_id": [1, 2, 1], "part": ["head", "head", "torso"],
+                       "x": [0, 0, 0], "y": [0, 0, 0], "w": [1, 1, 1], "h": [1, 1, 1]})
+    buf = io.StringIO()
+    write_tracks_csv(df, buf)
+    rows = buf.getvalue().splitlines()[1:]
+    assert [r.split(",")[:3] for r in rows] == [["0", "1", "torso"], ["0", "2", "head"], ["1", "1", "head"]]
