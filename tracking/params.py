@@ -1,0 +1,117 @@
+"""Every tunable number of the trackers, in one place.
+
+These objects are what retraining fits (``models/``) and what a model bundle
+stores (as JSON through :func:`dataclasses.asdict`). Trackers read numbers only
+from here: no magic constants in the tracking code. Defaults are documented with
+why they are what they are.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+
+
+@dataclass(frozen=True)
+class PartNoise:
+    """Process-noise standard deviations of the constant-velocity state
+    ``[X, Y, W, H, dX, dY]`` of one part, in pixels (per frame), and the sharpness
+    ``lam`` of the colour likelihood ``exp(-lam * d^2)`` (Nummiaro et al.: weights
+    from the Bhattacharyya distance ``d``). Fitted from corrected trajectories."""
+
+    x: float = 4.0
+    y: float = 3.0
+    w: float = 1.0
+    h: float = 1.0
+    vx: float = 1.0
+    vy: float = 0.5
+    lam: float = 20.0
+
+
+def _default_part_noise() -> dict[str, PartNoise]:
+    # The head moves least relative to its size; the hip-leg swings most sideways.
+    return {
+        "head": PartNoise(x=3.0, y=2.0, w=0.5, h=0.5, vx=1.0, vy=0.5, lam=20.0),
+        "torso": PartNoise(x=4.0, y=3.0, w=1.0, h=1.0, vx=1.0, vy=0.5, lam=20.0),
+        "hipleg": PartNoise(x=5.0, y=3.0, w=1.0, h=1.0, vx=1.5, vy=0.5, lam=20.0),
+        "person": PartNoise(x=5.0, y=4.0, w=1.5, h=1.5, vx=1.5, vy=0.5, lam=20.0),
+    }
+
+
+@dataclass(frozen=True)
+class BodyParams:
+    """Parameters of the three-part body tracker (seed 002)."""
+
+    # seed 002 sec. 3.1: 8 bins per YCbCr channel, model update H_t = 0.9 H_{t-1} + 0.1 Q_t.
+    bins_per_channel: int = 8
+    model_update: float = 0.1
+    # seed 002 sec. 3.2, eq. (2): entropy-adaptive particle count, C = 1.2, bounded to 200..1000.
+    particles_initial: int = 500
+    particles_min: int = 200
+    particles_max: int = 1000
+    particles_c: float = 1.2
+    # seed 002 sec. 4.1: the paper gives no height ratios; head : torso : hip-leg of an adult
+    # standing figure is about 1 : 2.5 : 4 (head ~ 1/7.5 of the height, crotch at ~ 1/2).
+    height_ratios: tuple[float, float, float] = (0.15, 0.33, 0.52)
+    # seed 002 sec. 4.1: how far a separation line may move (fraction of person height).
+    separation_search: float = 0.06
+    # Foreground blobs smaller than this are not people (seed 002 sec. 5: people > 100 x 30 px;
+    # smaller here so that distant walkers in 720x480 scenes still count).
+    min_person_height: float = 40.0
+    min_person_width: float = 12.0
+    part_noise: dict[str, PartNoise] = field(default_factory=_default_part_noise)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "BodyParams":
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise ValueError(f"unknown body parameter(s): {', '.join(sorted(unknown))}")
+        data = dict(data)
+        if "part_noise" in data:
+            data["part_noise"] = {k: PartNoise(**v) for k, v in data["part_noise"].items()}
+        if "height_ratios" in data:
+            data["height_ratios"] = tuple(data["height_ratios"])
+        return cls(**data)
+
+
+@dataclass(frozen=True)
+class LimbParams:
+    """Parameters of the head-and-hands tracker (seed 000 sec. 3-5, seed 003 sec. 3).
+
+    The paper gives no state-machine thresholds; they are parameters here. The
+    ``sigma_*`` terms are the 2D variances of the candidate priors (seed 000 eq. 25-27),
+    fitted from training video by ``models/``.
+    """
+
+    particles: int = 300
+    hue_bins: int = 16
+    model_update: float = 0.1
+    # one camera: silhouette term and its 2D analogues of seed 000 eq. 25-27 (pixels).
+    sigma_v: float = 12.0
+    sigma_d: float = 20.0
+    sigma_s: float = 8.0
+    noise_xy: float = 6.0
+    lam: float = 20.0
+    # state machine thresholds (seed 000 sec. 5.2)
+    combine_distance: float = 20.0
+    split_distance: float = 30.0
+    lost_likelihood: float = 0.15
+    lost_frames: int = 5
+    start_frames: int = 3
+    # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2), drop tiny ones
+    blob_alpha: float = 1.0
+    min_blob_area: float = 30.0
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "LimbParams":
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise ValueError(f"unknown limb parameter(s): {', '.join(sorted(unknown))}")
+        return cls(**data)
