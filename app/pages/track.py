@@ -1,0 +1,74 @@
+"""Track: run a tracker over a clip in the background, or import boxes from a tracks CSV."""
+
+import io
+
+import pandas as pd
+import streamlit as st
+
+from app import jobs, state
+from app.pages.common import pick_clip, require_project
+from app.runs import TRACKERS, missing, start_tracking
+from tracking.tracks import read_tracks_csv
+
+s = state.store()
+st.title("Track")
+project = require_project(s)
+clip = pick_clip(s, project.id)
+
+bundles = s.bundles(project.id)
+choices = [None] + [b.id for b in bundles]
+names = {None: "built-in parameters", **{b.id: b.name + (" (default)" if b.id == project.default_bundle_id else "")
+                                          for b in bundles}}
+default = choices.index(project.default_bundle_id) if project.default_bundle_id in choices else 0
+
+lacking = missing("app.pipeline")
+with st.form("track"):
+    c1, c2, c3 = st.columns(3)
+    tracker = c1.radio("Tracker", TRACKERS, horizontal=True,
+                       help="body: head/torso/hip-leg; limbs: head and hands; all: both")
+    bundle_id = c2.selectbox("Model bundle", choices, index=default, format_func=names.get)
+    seed = c3.number_input("Seed", min_value=0, value=0, step=1)
+    go = st.form_submit_button("Track the whole clip", disabled=bool(lacking), type="primary")
+if lacking:
+    st.warning("Tracking is not available yet: the tracker pipeline (app.pipeline) has not landed. "
+               "You can import boxes from a tracks CSV below meanwhile.")
+if go:
+    path = next((b.path for b in bundles if b.id == bundle_id), None)
+    try:
+        job = start_tracking(s, clip, tracker=tracker, bundle_path=path, seed=int(seed))
+        st.success(f"Started: {job.label}. It keeps running while you use other pages.")
+    except (RuntimeError, ValueError) as exc:
+        st.error(str(exc))
+
+
+@st.fragment(run_every=1)
+def progress():
+    """Refreshes itself every second, so progress shows while the job runs."""
+    for job in jobs.jobs("track", clip_id=clip.id)[:5]:
+        if job.active:
+            st.progress(job.fraction, text=f"{job.label}: frame {job.done} of {job.total or '?'}")
+        elif job.status == "done":
+            st.success(f"{job.label}: done, {job.result['boxes']} boxes stored (run {job.result['run_id']}).")
+        else:
+            st.error(f"{job.label}: failed: {job.error}")
+
+
+progress()
+
+with st.expander("Import boxes from a tracks CSV (e.g. another tool's output or init.csv)"):
+    csv = st.file_uploader("Tracks CSV", type=["csv"], key=f"import_csv:{clip.id}")
+    if csv is not None and st.button("Store these boxes as a tracker run"):
+        try:
+            df = read_tracks_csv(io.StringIO(csv.getvalue().decode("utf-8", "replace")), name=csv.name)
+            df = df[df.frame < clip.frame_count]
+            run_id = s.save_tracker_run(clip.id, df, tracker="import", bundle=csv.name)
+            st.success(f"Stored {len(df)} boxes as run {run_id}; human corrections were kept.")
+        except ValueError as exc:
+            st.error(f"Not imported: {exc}")
+
+runs = s.runs(clip.id)
+if len(runs):
+    st.subheader("Runs of this clip")
+    st.dataframe(runs, hide_index=True)
+    counts = s.tracks(clip.id).groupby(["source"]).size().rename("boxes").reset_index()
+    st.dataframe(pd.DataFrame(counts), hide_index=True)

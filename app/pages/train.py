@@ -1,0 +1,96 @@
+"""Train: a new model bundle (failure SVMs + variance parameters) from corrected clips."""
+
+import pandas as pd
+import plotly.graph_objects as go
+import streamlit as st
+
+from app import jobs, state
+from app.pages.common import require_project
+from app.runs import missing, start_training
+from labelling.store import StoreError
+
+s = state.store()
+st.title("Train")
+project = require_project(s)
+
+lacking = missing("models.training", "models.bundle")
+if lacking:
+    st.warning(f"Training is not available yet: {', '.join(lacking)} has not landed.")
+
+clips = s.clips(project.id)
+corrected = {c.id: c for c in clips if s.progress(c.id)["corrected_frames"] > 0}
+with st.form("train"):
+    picked = st.multiselect("Corrected clips", list(corrected),
+                            format_func=lambda i: f"{corrected[i].name} ({s.progress(i)['corrected_frames']} frames)",
+                            default=list(corrected))
+    c1, c2, c3 = st.columns(3)
+    name = c1.text_input("Bundle name", value=f"bundle-{len(s.bundles(project.id)) + 1}")
+    seed = c2.number_input("Seed", min_value=0, value=0, step=1)
+    make_default = c3.checkbox("Make it the project's default", value=True)
+    go_train = st.form_submit_button("Train", type="primary", disabled=bool(lacking) or not corrected)
+if not corrected:
+    st.info("No clip has corrected frames yet: correct some boxes on the Correct page first.")
+if go_train:
+    try:
+        job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default)
+        st.success(f"Started: {job.label}")
+    except (RuntimeError, ValueError) as exc:
+        st.error(str(exc))
+
+
+@st.fragment(run_every=1)
+def progress():
+    for job in jobs.jobs("train", project_id=project.id)[:3]:
+        if job.active:
+            st.progress(job.fraction, text=f"{job.label}: {job.done}/{job.total or '?'}")
+        elif job.status == "failed":
+            st.error(f"{job.label} failed: {job.error}")
+        else:
+            st.success(f"{job.label}: done.")
+
+
+progress()
+
+
+def show_summary(summary: dict) -> None:
+    """Cross-validated rates and a confusion matrix per SVM, fitted variances against defaults."""
+    svms = summary.get("svms") or {}
+    if svms:
+        rows = [dict(svm=k, **{m: v.get(m) for m in ("cv_tnr", "cv_tpr", "kernel", "n_samples") if m in v})
+                for k, v in svms.items()]
+        st.dataframe(pd.DataFrame(rows), hide_index=True)
+        cols = st.columns(max(1, len(svms)))
+        for col, (k, v) in zip(cols, svms.items()):
+            cm = v.get("confusion")
+            if cm:
+                fig = go.Figure(go.Heatmap(z=cm, x=["pred. tracked", "pred. failed"], y=["tracked", "failed"],
+                                           text=cm, texttemplate="%{text}", colorscale="Blues", showscale=False))
+                fig.update_layout(title=k, height=260, margin=dict(l=10, r=10, t=40, b=10))
+                col.plotly_chart(fig, key=f"cm:{k}:{id(summary)}")
+    variances = summary.get("variances") or {}
+    if variances:
+        names = list(variances)
+        fig = go.Figure([go.Bar(name="default", x=names, y=[variances[n].get("default") for n in names]),
+                         go.Bar(name="fitted", x=names, y=[variances[n].get("fitted") for n in names])])
+        fig.update_layout(barmode="group", title="Variance parameters: fitted vs default", height=320)
+        st.plotly_chart(fig, key=f"var:{id(summary)}")
+    if not svms and not variances:
+        st.json(summary, expanded=False)
+
+
+bundles = s.bundles(project.id)
+if bundles:
+    st.subheader("Bundles")
+    ids = [None] + [b.id for b in bundles]
+    labels = {None: "built-in parameters", **{b.id: b.name for b in bundles}}
+    chosen = st.selectbox("Project default", ids, index=ids.index(project.default_bundle_id)
+                          if project.default_bundle_id in ids else 0, format_func=labels.get)
+    if chosen != project.default_bundle_id:
+        try:
+            s.set_default_bundle(project.id, chosen)
+            st.success(f"Default bundle: {labels[chosen]}")
+        except StoreError as exc:
+            st.error(str(exc))
+    for b in reversed(bundles):
+        with st.expander(f"{b.name} · {b.created:%Y-%m-%d %H:%M} · {b.path}", expanded=b is bundles[-1]):
+            show_summary(b.summary)
