@@ -51,12 +51,15 @@ def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
 
 
 def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path: str | Path | None = None,
-                   seed: int = 0, start: int = 0, retrack: bool = False) -> jobs.Job:
+                   seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False
+                   ) -> jobs.Job:
     """Track a clip in the background and store the result as a tracker run.
 
     With ``retrack``, the tracker starts from the effective boxes at frame ``start``
     (the user's fix) and runs to the next human-corrected frame or the end; tracker
-    boxes of other frames and every human edit stay as they are.
+    boxes of other frames and every human edit stay as they are. With
+    ``init_from_boxes``, a whole-clip run starts from the stored boxes of frame
+    ``start`` instead of detecting people.
     """
     pipeline = optional("app.pipeline")
     if pipeline is None:
@@ -65,11 +68,12 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
     init = None
     stop = None
-    if retrack:
+    if retrack or init_from_boxes:
         init = store.frame_boxes(clip.id, start)
         if not len(init):
             raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
         init = init.drop(columns=["revision"], errors="ignore")
+    if retrack:
         stop = next_human_frame(store, clip.id, start)
     occluders = tuple(store.occluders(clip.id))
 

@@ -28,6 +28,10 @@ with st.form("track"):
                        help="body: head/torso/hip-leg; limbs: head and hands; all: both")
     bundle_id = c2.selectbox("Model bundle", choices, index=default, format_func=names.get)
     seed = c3.number_input("Seed", min_value=0, value=0, step=1)
+    first = int(s.tracks(clip.id).frame.min()) if len(s.tracks(clip.id)) else None
+    starts = ["detect people automatically"] + ([f"the stored boxes of frame {first}"] if first is not None else [])
+    start_from = st.radio("Start from", starts, horizontal=True,
+                          help="imported or drawn boxes make the tracker follow exactly those people")
     go = st.form_submit_button("Track the whole clip", disabled=bool(lacking), type="primary")
 if lacking:
     st.warning("Tracking is not available yet: the tracker pipeline (app.pipeline) has not landed. "
@@ -35,7 +39,9 @@ if lacking:
 if go:
     path = next((b.path for b in bundles if b.id == bundle_id), None)
     try:
-        job = start_tracking(s, clip, tracker=tracker, bundle_path=path, seed=int(seed))
+        from_boxes = start_from != starts[0]
+        job = start_tracking(s, clip, tracker=tracker, bundle_path=path, seed=int(seed),
+                             start=first if from_boxes else 0, init_from_boxes=from_boxes)
         st.success(f"Started: {job.label}. It keeps running while you use other pages.")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))
