@@ -54,30 +54,41 @@ def _wave(t: np.ndarray, start: float, end: float, n_frames: int, fps: float) ->
     return bump(t, start, end), 2 * np.pi * 2.2 * frames / fps
 
 
+def _glances(rng: np.random.Generator, n_frames: int, fps: float, amount: float = 0.35) -> np.ndarray:
+    """Head yaw of a walker looking around now and then: a slow smooth random signal (radians)."""
+    frames = np.arange(n_frames) / fps
+    f1, f2 = rng.uniform(0.15, 0.35, 2)
+    p1, p2 = rng.uniform(0, 2 * np.pi, 2)
+    return amount * (0.6 * np.sin(2 * np.pi * f1 * frames + p1) + 0.4 * np.sin(2 * np.pi * f2 * frames + p2))
+
+
 def _single(rng, camera, n_frames, fps) -> Script:
     (app,) = sample_appearances(rng, 1)
-    z1, z2, z3 = 8.0 + _j(rng, 0.5), 6.6 + _j(rng, 0.3), 9.6 + _j(rng, 0.4)
-    m = walk(camera, n_frames, [(0.0, -0.82, z1), (0.52, 0.70, z2), (0.68, 0.70, z2), (1.0, -0.2, z3)],
+    z1, z2, z3 = 8.0 + _j(rng, 0.4), 6.6 + _j(rng, 0.3), 8.4 + _j(rng, 0.3)
+    # about 1.4 m/s across the room, a stop to turn back (waving at the camera), then back and away
+    m = walk(camera, n_frames, [(0.0, -0.8, z1), (0.63, 0.6, z2), (0.76, 0.6, z2), (1.0, 0.05, z3)],
              app.height_m)
     t = clip_time(n_frames)
-    wave, wphase = _wave(t, 0.57, 0.64, n_frames, fps)
-    return Script([Actor(app, with_changes(m, wave=wave, head_yaw=wave * 0.0))])
+    wave, _ = _wave(t, 0.68, 0.73, n_frames, fps)
+    return Script([Actor(app, with_changes(m, wave=wave, head_yaw=_glances(rng, n_frames, fps)))])
 
 
 def _pair_cross(rng, camera, n_frames, fps) -> Script:
     a, b = sample_appearances(rng, 2)
     za = 7.0 + _j(rng, 0.2)
-    zb = za + 0.9 + _j(rng, 0.1)  # close behind: at the crossing only the far head shows
+    zb = za + 0.75 + _j(rng, 0.1)  # close behind: at the crossing little more than the far head shows
     xa = 0.85 + _j(rng, 0.05)
     ma = walk(camera, n_frames, [(0.0, -xa, za), (1.0, xa, za)], a.height_m)
     mb = walk(camera, n_frames, [(0.0, xa, zb), (1.0, -xa, zb)], b.height_m)
+    ma = with_changes(ma, head_yaw=_glances(rng, n_frames, fps))
+    mb = with_changes(mb, head_yaw=_glances(rng, n_frames, fps))
     return Script([Actor(a, ma), Actor(b, mb)])
 
 
 def _pillar(rng, camera, n_frames, fps) -> Script:
     (app,) = sample_appearances(rng, 1)
-    m = walk(camera, n_frames, [(0.0, -0.85, 8.6 + _j(rng, 0.3)), (1.0, 0.85, 8.3 + _j(rng, 0.3))], app.height_m)
-    w = 0.10 * camera.width
+    m = walk(camera, n_frames, [(0.0, -0.85, 9.2 + _j(rng, 0.3)), (1.0, 0.85, 8.9 + _j(rng, 0.3))], app.height_m)
+    w = 0.12 * camera.width  # a column 0.75 m wide, 5.8 m from the camera: hides the walker for a while
     x = camera.cx - w / 2 + _j(rng, 0.03 * camera.width)
     _, bottom = camera.floor_point(0.0, 5.8)
     grey = int(rng.integers(150, 175))
@@ -107,7 +118,7 @@ def _distractors(rng, camera, n_frames, fps) -> Script:
         x = float(camera.x_from_fraction(xr + _j(rng, 0.05), WALL_DEPTH))
         fx, _ = camera.floor_point(x, WALL_DEPTH)
         w, h = 0.9 * s_wall, 1.3 * s_wall
-        box = (float(fx) - w / 2, float(wall_y) - 2.1 * s_wall, w, h)
+        box = (float(fx) - w / 2, float(wall_y) - 1.6 * s_wall, w, h)  # at head height behind the path
         if kind == "poster_person":
             props.append(Prop(kind, box, ((200, 200, 196), near(app.shirt), near(app.skin))))
         else:
@@ -133,13 +144,14 @@ def _crowd(rng, camera, n_frames, fps) -> Script:
               apps[3].height_m)
     wave, _ = _wave(t, 0.4, 0.55, n_frames, fps)
     md = with_changes(md, wave=wave)
-    return Script([Actor(a, m) for a, m in zip(apps, (ma, mb, mc, md))])
+    motions = [with_changes(m, head_yaw=_glances(rng, n_frames, fps)) for m in (ma, mb, mc, md)]
+    return Script([Actor(a, m) for a, m in zip(apps, motions)])
 
 
 def _bend(rng, camera, n_frames, fps) -> Script:
     (app,) = sample_appearances(rng, 1)
     z = 7.4 + _j(rng, 0.3)
-    m = walk(camera, n_frames, [(0.0, -0.85, z), (0.35, -0.05, z), (0.72, -0.05, z), (1.0, 0.8, z + 0.2)],
+    m = walk(camera, n_frames, [(0.0, -0.85, z), (0.35, -0.05, z), (0.72, -0.05, z), (1.0, 0.65, z + 0.2)],
              app.height_m)
     t = clip_time(n_frames)
     bend = 1.25 * bump(t, 0.45, 0.6, ramp=0.08)

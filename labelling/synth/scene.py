@@ -86,6 +86,21 @@ def _pillar_texture(rng: np.random.Generator, box: Box, colour) -> np.ndarray:
     return np.clip(tex, 0, 255).astype(np.uint8)
 
 
+def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: float) -> None:
+    """Darken the floor under a person's feet (a soft contact shadow; never part of the truth)."""
+    cx, cy = camera.floor_point(x, z)
+    s = float(camera.scale(z))
+    ax, ay = 0.28 * height_m * s, 0.28 * height_m * s * camera.cam_height / z
+    x1, x2 = int(max(cx - ax - 2, 0)), int(min(cx + ax + 2, frame.shape[1]))
+    y1, y2 = int(max(cy - ay - 2, 0)), int(min(cy + ay + 2, frame.shape[0]))
+    if x1 >= x2 or y1 >= y2:
+        return
+    yy, xx = np.mgrid[y1:y2, x1:x2]
+    r2 = ((xx - cx) / ax) ** 2 + ((yy - cy) / ay) ** 2
+    gain = 1.0 - 0.35 * np.clip(1.0 - r2, 0.0, 1.0)
+    frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
+
+
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
                *, clean: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
@@ -93,7 +108,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     ``clean`` leaves out flicker and sensor noise (for tests that check drawn colours).
     """
     _check(name, n_frames, width, height)
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.for_frame(width, height)
     script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
     background = draw_props(room(rng, camera), script.props, rng)
@@ -106,6 +121,9 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     for i in tqdm(range(n_frames), desc=f"synth {name}", unit="frame", disable=not progress):
         frame = background.copy()
         owner[:] = 0
+        for actor in script.actors:
+            if actor.view is None:
+                _shadow(frame, camera, float(actor.motion.x[i]), float(actor.motion.z[i]), actor.appearance.height_m)
         order = sorted(range(len(script.actors)), key=lambda a: -script.actors[a].motion.z[i])
         drawn = []
         for a in order:

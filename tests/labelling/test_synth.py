@@ -43,7 +43,7 @@ def test_head_and_hipleg_boxes_are_tight_on_the_drawn_colours(clean_single):
     T = len(scene.frames)
     errs_head, errs_leg = [], []
     for i in range(0, T, 3):
-        if 0.5 * T < i < 0.72 * T:  # standing, turning and waving: the hand may be up by the head
+        if 0.6 * T < i < 0.8 * T:  # standing, turning and waving: the hand may be up by the head
             continue
         person = _row(scene.truth, i, 1, "person")
         torso = _row(scene.truth, i, 1, "torso")
@@ -65,7 +65,7 @@ def test_head_and_hipleg_boxes_are_tight_on_the_drawn_colours(clean_single):
 def test_part_boxes_nest_in_the_person_and_stack_head_torso_hipleg(clean_single):
     t = clean_single.truth
     T = t.frame.max() + 1
-    t = t[(t.frame < 0.5 * T) | (t.frame > 0.72 * T)]  # not while waving (the hand is above the head)
+    t = t[(t.frame < 0.6 * T) | (t.frame > 0.8 * T)]  # not while waving (the hand is above the head)
     wide = t.pivot_table(index="frame", columns="part", values=["x", "y", "w", "h"])
     for part in ("head", "torso", "hipleg", "left_hand", "right_hand"):
         assert (wide["x"][part] >= wide["x"]["person"]).all()
@@ -90,7 +90,7 @@ def test_hidden_walker_at_the_middle_of_the_crossing():
     assert mid.max() > 0.5 and mid.min() == 0.0
     far = int(mid.idxmax())
     # the far walker's torso and hip-leg are mostly hidden; at the start nobody is
-    assert _row(t, n // 2, far, "torso").occluded > 0.8
+    assert _row(t, n // 2, far, "torso").occluded > 0.6 and _row(t, n // 2, far, "hipleg").occluded > 0.5
     assert t[t.frame == 0]["occluded"].max() == 0.0
 
 
