@@ -10,12 +10,24 @@ from __future__ import annotations
 
 import importlib
 import threading
+from pathlib import Path
 
 from labelling.config import data_dir
 
 DEMO_PROJECT = "demo"
 DEMO_SCENES: tuple[str, ...] = ("single", "pair_cross")
+#: small enough to render in a few seconds on a shared machine, big enough to label
+DEMO_SIZE = dict(n_frames=100, width=480, height=320)
 _LOCK = threading.Lock()
+
+
+def demo_files(clip_name: str) -> dict[str, Path]:
+    """The synthetic truth/init CSVs of a demo clip (empty for other clips)."""
+    scene = Path(clip_name).stem
+    folder = data_dir() / "demo" / scene
+    if scene not in DEMO_SCENES or not folder.is_dir():
+        return {}
+    return {k: folder / f"{k}.csv" for k in ("truth", "init") if (folder / f"{k}.csv").exists()}
 
 
 def ensure_demo(store=None) -> bool:
@@ -42,8 +54,15 @@ def ensure_demo(store=None) -> bool:
             target = data_dir() / "demo" / scene
             if not (target / "clip.mp4").exists():
                 print(f"partlab: rendering the demo scene {scene!r} into {target}", flush=True)
-                synth.render_scenario(scene, target, seed=0)
-            store.add_clip(project.id, target / "clip.mp4", name=name)
+                synth.render_scenario(scene, target, seed=0, **DEMO_SIZE)
+            clip = store.add_clip(project.id, target / "clip.mp4", name=name)
+            if (target / "occluders.csv").exists():
+                import pandas as pd
+
+                from tracking.box import Box
+
+                regions = pd.read_csv(target / "occluders.csv")
+                store.set_occluders(clip.id, [Box(r.x, r.y, r.w, r.h) for r in regions.itertuples()])
     return True
 
 

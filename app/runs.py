@@ -51,22 +51,22 @@ def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
 
 
 def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path: str | Path | None = None,
-                   seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False
-                   ) -> jobs.Job:
+                   seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False,
+                   init: pd.DataFrame | None = None) -> jobs.Job:
     """Track a clip in the background and store the result as a tracker run.
 
     With ``retrack``, the tracker starts from the effective boxes at frame ``start``
     (the user's fix) and runs to the next human-corrected frame or the end; tracker
     boxes of other frames and every human edit stay as they are. With
     ``init_from_boxes``, a whole-clip run starts from the stored boxes of frame
-    ``start`` instead of detecting people.
+    ``start`` instead of detecting people; ``init`` gives such boxes directly (e.g. a
+    synthetic scene's init.csv).
     """
     pipeline = optional("app.pipeline")
     if pipeline is None:
         raise RuntimeError("tracking is not available yet (app.pipeline has not landed)")
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
-    init = None
     stop = None
     if retrack or init_from_boxes:
         init = store.frame_boxes(clip.id, start)

@@ -21,6 +21,8 @@ function el(name, attrs) {
 
 function keyOf(b) { return b.track_id + ":" + b.part; }
 
+const SHORT = { hipleg: "hip-leg", left_hand: "L hand", right_hand: "R hand" };
+
 class Editor {
   constructor(root) {
     this.root = root.querySelector(".pl-editor");
@@ -99,7 +101,7 @@ class Editor {
     this.layout();
     const svg = this.svg;
     while (svg.firstChild) svg.removeChild(svg.firstChild);
-    const font = 12 * this.scale(); // 12 screen pixels, whatever the zoom
+    const font = 11 * this.scale(); // 11 screen pixels, whatever the zoom
     const occl = this.data.mode === "occluders";
     for (const b of this.boxes) {
       const sel = keyOf(b) === this.selected;
@@ -117,7 +119,7 @@ class Editor {
         const label = el("text", { x: b.x + font * 0.2, y: ly, class: "pl-label", "font-size": font,
           "stroke-width": font * 0.18 });
         label.textContent = above ? `#${b.track_id} person${b.failure ? " FAIL" : ""}${b.occluded ? " occl" : ""}`
-          : `${b.part}${b.failure ? " FAIL" : ""}${b.occluded ? " occl" : ""}`;
+          : `${SHORT[b.part] || b.part}${b.failure ? " FAIL" : ""}${b.occluded ? " occl" : ""}`;
         svg.appendChild(label);
       }
       if (sel) this.drawHandles(b);

@@ -34,7 +34,7 @@ def step(delta: int) -> None:
     st.session_state[fkey] = min(max(st.session_state[fkey] + delta, 0), last)
 
 
-c1, c2, c3, c4, c5 = st.columns([6, 1, 1, 1, 2], vertical_alignment="bottom")
+c1, c2, c3, c4, c5 = st.columns([5, 1, 1, 1.4, 2.6], vertical_alignment="bottom")
 with c1:
     bound_widget(st.slider, fkey, f"frame_slider:{clip.id}", "Frame", 0, max(last, 1), disabled=last == 0)
 c2.button("◀", on_click=step, args=(-1,), help="previous frame", width="stretch")

@@ -8,6 +8,7 @@ import streamlit as st
 
 from app import jobs, state
 from app.box_editor import track_colour
+from app.demo import demo_files
 from app.pages.common import pick_clip, require_project
 from app.runs import missing, optional, start_comparison_run, training_truth
 from tracking.tracks import read_tracks_csv
@@ -25,6 +26,10 @@ if evaluation is None:
 truth_file = st.file_uploader("Truth CSV for this clip (optional; else the corrected frames are the truth)",
                               type=["csv"], key=f"truth:{clip.id}")
 truth = None
+synthetic = demo_files(clip.name).get("truth")
+if truth_file is None and synthetic is not None:
+    truth = read_tracks_csv(synthetic)
+    st.caption("Truth: the synthetic scene's exact boxes.")
 if truth_file is not None:
     try:
         truth = read_tracks_csv(io.StringIO(truth_file.getvalue().decode("utf-8", "replace")), name=truth_file.name)

@@ -7,6 +7,7 @@ import streamlit as st
 
 from app import jobs, state
 from app.pages.common import pick_clip, require_project
+from app.demo import demo_files
 from app.runs import TRACKERS, missing, start_tracking
 from tracking.tracks import read_tracks_csv
 
@@ -29,7 +30,9 @@ with st.form("track"):
     bundle_id = c2.selectbox("Model bundle", choices, index=default, format_func=names.get)
     seed = c3.number_input("Seed", min_value=0, value=0, step=1)
     first = int(s.tracks(clip.id).frame.min()) if len(s.tracks(clip.id)) else None
-    starts = ["detect people automatically"] + ([f"the stored boxes of frame {first}"] if first is not None else [])
+    demo_init = demo_files(clip.name).get("init")
+    starts = ["detect people automatically"] + ([f"the stored boxes of frame {first}"] if first is not None else []) \
+        + (["the synthetic scene's init boxes"] if demo_init else [])
     start_from = st.radio("Start from", starts, horizontal=True,
                           help="imported or drawn boxes make the tracker follow exactly those people")
     go = st.form_submit_button("Track the whole clip", disabled=bool(lacking), type="primary")
@@ -39,9 +42,10 @@ if lacking:
 if go:
     path = next((b.path for b in bundles if b.id == bundle_id), None)
     try:
-        from_boxes = start_from != starts[0]
+        from_boxes = start_from == starts[1] if len(starts) > 1 and first is not None else False
+        init = read_tracks_csv(demo_init) if start_from == "the synthetic scene's init boxes" else None
         job = start_tracking(s, clip, tracker=tracker, bundle_path=path, seed=int(seed),
-                             start=first if from_boxes else 0, init_from_boxes=from_boxes)
+                             start=first if from_boxes else 0, init_from_boxes=from_boxes, init=init)
         st.success(f"Started: {job.label}. It keeps running while you use other pages.")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))

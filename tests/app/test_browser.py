@@ -76,7 +76,21 @@ def _wait_for(predicate, timeout=30.0, what="condition"):
     raise AssertionError(f"timed out waiting for {what}")
 
 
-def test_upload_track_drag_and_flag_in_the_browser(server, store, clip_file, boxes, tmp_path):
+@pytest.fixture
+def scene(tmp_path):
+    """A short synthetic clip (one walker) with its exact boxes."""
+    from labelling.synth import render_scenario
+    from tracking.tracks import read_tracks_csv
+
+    out = render_scenario("single", tmp_path / "scene", seed=1, n_frames=12, width=320, height=240)
+    clip = out / "walker.mp4"
+    (out / "clip.mp4").rename(clip)
+    return clip, read_tracks_csv(out / "truth.csv")
+
+
+def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_path):
+    clip_file, boxes = scene
+    boxes = boxes.drop(columns=["source"])
     with playwright.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
         page = browser.new_page(viewport={"width": 1280, "height": 1000})
@@ -117,7 +131,7 @@ def test_upload_track_drag_and_flag_in_the_browser(server, store, clip_file, box
         head.wait_for()
         page.wait_for_timeout(500)
         bb = head.bounding_box()
-        scale = 96 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
+        scale = 320 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
         cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
         page.mouse.move(cx, cy)
         page.mouse.down()
