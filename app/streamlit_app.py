@@ -33,7 +33,7 @@ with st.sidebar:
     st.session_state.setdefault(state.AUTHOR, "")
     bound_widget(st.text_input, state.AUTHOR, "author_input", "Your name (saved with your edits)")
 
-    @st.fragment(run_every=2)
+    @st.fragment(run_every=2 if jobs.active() else None)
     def _job_list():
         running = jobs.active()
         recent = [j for j in jobs.jobs() if not j.active][:3]

@@ -39,3 +39,43 @@ def pick_clip(s: Store, project_id: int, label: str = "Clip") -> Clip:
     names = {c.id: f"{c.name} (#{c.id})" for c in clips}
     bound_widget(st.selectbox, state.CLIP, "clip_select", label, ids, format_func=names.get)
     return s.clip(st.session_state[state.CLIP])
+
+
+def job_panel(kind: str, limit: int = 5, **meta) -> None:
+    """Progress of this kind of background job, refreshed every second while one runs;
+    when a job this session watched ends, the whole page reruns to show its result."""
+    from app import jobs
+
+    watched = st.session_state.setdefault("watched_jobs", set())
+    for job in jobs.active(kind, **meta):
+        watched.add(job.id)
+
+    @st.fragment(run_every=1 if jobs.active(kind, **meta) else None)
+    def panel():
+        ended = False
+        for job in jobs.jobs(kind, **meta)[:limit]:
+            if job.active:
+                st.progress(job.fraction, text=f"{job.label}: {job.done} of {job.total or '?'}")
+                continue
+            if job.id in watched:
+                watched.discard(job.id)
+                ended = True
+            if job.status == "done":
+                st.success(f"{job.label}: done" + (f" ({describe(job.result)})" if describe(job.result) else "."))
+            else:
+                st.error(f"{job.label}: failed: {job.error}")
+        if ended:
+            st.rerun()
+
+    panel()
+
+
+def describe(result) -> str:
+    """A one-line account of a job's result dict."""
+    if not isinstance(result, dict):
+        return ""
+    if "run_id" in result:
+        return f"{result['boxes']} boxes stored as run {result['run_id']}"
+    if "bundle_id" in result:
+        return f"bundle saved in {result['path']}"
+    return ""

@@ -8,10 +8,10 @@ import time
 
 import streamlit as st
 
-from app import jobs, state
+from app import state
 from app.box_editor import box_editor
 from app.editing import apply_events
-from app.pages.common import bound_widget, pick_clip, require_project
+from app.pages.common import bound_widget, job_panel, pick_clip, require_project
 from app.runs import missing, next_human_frame, start_tracking
 from labelling.video import VideoClip, VideoError
 from tracking.parts import PART_NAMES
@@ -92,8 +92,7 @@ with st.expander("Re-track from this frame", expanded=False):
             st.error(str(exc))
     if lacking:
         st.caption("Not available yet: the tracker pipeline has not landed.")
-    for job in jobs.active("track", clip_id=clip.id):
-        st.progress(job.fraction, text=job.label)
+    job_panel("track", limit=1, clip_id=clip.id)
 
 with st.expander("Keyboard shortcuts"):
     st.markdown("Click the frame first. **←/→** or **A/D**: previous/next frame · **N** or **Tab**: next track · "

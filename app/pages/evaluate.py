@@ -54,7 +54,7 @@ if lacking:
     st.caption("Comparison runs need the tracker pipeline, which has not landed yet.")
 
 
-@st.fragment(run_every=2)
+@st.fragment(run_every=1 if jobs.active("compare", clip_id=clip.id) else None)
 def comparison():
     cols = st.columns(2)
     for col, name in zip(cols, (a, b)):
@@ -92,6 +92,11 @@ else:
         fig.add_trace(go.Scatter(x=g.x + g.w / 2, y=g.y + g.h / 2, mode="lines+markers", name=f"#{tid}",
                                  marker=dict(size=3), line=dict(color=track_colour(int(tid))),
                                  text=g.frame, hovertemplate="frame %{text}: (%{x:.0f}, %{y:.0f})"))
+    if len(truth):
+        t = truth[truth.part == part]
+        for tid, g in t.groupby("track_id"):
+            fig.add_trace(go.Scatter(x=g.x + g.w / 2, y=g.y + g.h / 2, mode="lines", name=f"truth #{tid}",
+                                     line=dict(color="gray", dash="dot")))
     fig.update_yaxes(autorange="reversed", scaleanchor="x", range=[clip.height, 0])
     fig.update_xaxes(range=[0, clip.width])
     fig.update_layout(height=420, title=f"{part} centre per track (image coordinates)",

@@ -5,8 +5,8 @@ import io
 import pandas as pd
 import streamlit as st
 
-from app import jobs, state
-from app.pages.common import pick_clip, require_project
+from app import state
+from app.pages.common import job_panel, pick_clip, require_project
 from app.demo import demo_files
 from app.runs import TRACKERS, missing, start_tracking
 from tracking.tracks import read_tracks_csv
@@ -51,19 +51,7 @@ if go:
         st.error(str(exc))
 
 
-@st.fragment(run_every=1)
-def progress():
-    """Refreshes itself every second, so progress shows while the job runs."""
-    for job in jobs.jobs("track", clip_id=clip.id)[:5]:
-        if job.active:
-            st.progress(job.fraction, text=f"{job.label}: frame {job.done} of {job.total or '?'}")
-        elif job.status == "done":
-            st.success(f"{job.label}: done, {job.result['boxes']} boxes stored (run {job.result['run_id']}).")
-        else:
-            st.error(f"{job.label}: failed: {job.error}")
-
-
-progress()
+job_panel("track", clip_id=clip.id)
 
 with st.expander("Import boxes from a tracks CSV (e.g. another tool's output or init.csv)"):
     csv = st.file_uploader("Tracks CSV", type=["csv"], key=f"import_csv:{clip.id}")

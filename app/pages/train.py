@@ -4,8 +4,8 @@ import pandas as pd
 import plotly.graph_objects as go
 import streamlit as st
 
-from app import jobs, state
-from app.pages.common import require_project
+from app import state
+from app.pages.common import job_panel, require_project
 from app.runs import missing, start_training
 from labelling.store import StoreError
 
@@ -38,18 +38,7 @@ if go_train:
         st.error(str(exc))
 
 
-@st.fragment(run_every=1)
-def progress():
-    for job in jobs.jobs("train", project_id=project.id)[:3]:
-        if job.active:
-            st.progress(job.fraction, text=f"{job.label}: {job.done}/{job.total or '?'}")
-        elif job.status == "failed":
-            st.error(f"{job.label} failed: {job.error}")
-        else:
-            st.success(f"{job.label}: done.")
-
-
-progress()
+job_panel("train", limit=3, project_id=project.id)
 
 
 def show_summary(summary: dict) -> None:

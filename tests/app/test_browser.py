@@ -56,7 +56,7 @@ def server(tmp_path):
                 raise RuntimeError(f"the app exited: {(tmp_path / 'server.log').read_text()}")
         else:
             raise RuntimeError("the app did not answer within 30 s")
-        yield url
+        yield url, proc
     finally:
         proc.terminate()
         try:
@@ -89,13 +89,14 @@ def scene(tmp_path):
 
 
 def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_path):
+    url, proc = server
     clip_file, boxes = scene
     boxes = boxes.drop(columns=["source"])
     with playwright.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
         page = browser.new_page(viewport={"width": 1280, "height": 1000})
         page.set_default_timeout(30_000)
-        page.goto(server)
+        page.goto(url)
 
         # a project and the clip (the demo project may be there already; make our own)
         page.get_by_text("New project").first.wait_for()
@@ -158,3 +159,9 @@ def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_pat
         page.screenshot(path=str(shot), full_page=True)
         assert shot.stat().st_size > 10_000
         browser.close()
+
+    # killing the app mid-session loses no saved edit
+    proc.kill()
+    proc.wait(10)
+    [again] = _wait_for(saved, timeout=1, what="the edit after the app was killed")
+    assert (again.x, again.y, int(again.revision)) == (head1.x, head1.y, 2)
