@@ -110,10 +110,9 @@ def safe_name(name: str) -> str:
 
 
 def frames_factory(path: Path):
-    """A callable giving a fresh iterator over a clip's BGR frames (decode order)."""
+    """A callable giving a fresh iterator of ``(index, BGR frame)`` over a clip (decode order)."""
     def frames():
-        for _, frame in VideoClip(path).frames():
-            yield frame
+        return VideoClip(path).frames()
     return frames
 
 
@@ -144,12 +143,23 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
             raise ValueError(f"clip {clip.name!r} has no corrected frames yet")
         clips.append((frames_factory(clip.path), clip.fps, truth))
     out = data_dir() / "bundles" / str(project_id) / folder
+    if out.exists():
+        raise ValueError(f"{out} exists already; choose another bundle name")
+    runner_mod = optional("models.runner")  # the tracker's own failures are the paper's training samples
+    runner = getattr(runner_mod, "body_tracker_runner", None)
+    names = [store.clip(cid).name for cid in clip_ids]
 
     def work(progress):
-        bundle = training.train_bundle(clips=clips, seed=seed, progress=progress)
+        total = training.training_steps(len(clips), with_tracker=runner is not None)
+        steps = iter(range(1, 10**6))
+
+        def step(_message: str) -> None:  # train_bundle reports named steps; the bar counts them
+            progress(next(steps), total)
+
+        progress(0, total)
+        bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names)
         bundle_mod.save_bundle(bundle, out)
-        summary = getattr(bundle, "summary", None) or getattr(bundle_mod.load_bundle(out), "summary", {}) or {}
-        record = store.add_bundle(project_id, name, out, summary=summary)
+        record = store.add_bundle(project_id, name, out, summary=bundle.summary)
         if make_default:
             store.set_default_bundle(project_id, record.id)
         return dict(bundle_id=record.id, path=str(out))

@@ -286,8 +286,10 @@ class Editor {
     const b = d.box, o = d.orig;
     const moved = Math.abs(b.x - o.x) + Math.abs(b.y - o.y) + Math.abs(b.w - o.w) + Math.abs(b.h - o.h) > 0.5;
     if (!moved) { this.render(); return; }
-    b.x = Math.round(b.x * 10) / 10; b.y = Math.round(b.y * 10) / 10;
-    b.w = Math.round(b.w * 10) / 10; b.h = Math.round(b.h * 10) / 10;
+    // a tenth of a pixel is plenty; a move keeps the box's size exactly
+    for (const k of d.handle ? ["x", "y", "w", "h"] : ["x", "y"]) {
+      if (b[k] !== o[k]) b[k] = Math.round(b[k] * 10) / 10;
+    }
     if (d.isNew && (b.w < MIN_SIZE || b.h < MIN_SIZE)) {
       this.boxes = this.boxes.filter((x) => x !== b);
       this.render();

@@ -60,9 +60,12 @@ with st.expander("Import boxes from a tracks CSV (e.g. another tool's output or 
             df = read_tracks_csv(io.StringIO(csv.getvalue().decode("utf-8", "replace")), name=csv.name)
             df = df[df.frame < clip.frame_count]
             run_id = s.save_tracker_run(clip.id, df, tracker="import", bundle=csv.name)
-            st.success(f"Stored {len(df)} boxes as run {run_id}; human corrections were kept.")
+            st.session_state["track_flash"] = f"Stored {len(df)} boxes as run {run_id}; human corrections were kept."
+            st.rerun()  # the form above offers to start from these boxes now
         except ValueError as exc:
             st.error(f"Not imported: {exc}")
+if "track_flash" in st.session_state:
+    st.success(st.session_state.pop("track_flash"))
 
 runs = s.runs(clip.id)
 if len(runs):

@@ -41,29 +41,38 @@ if go_train:
 job_panel("train", limit=3, project_id=project.id)
 
 
-def show_summary(summary: dict) -> None:
+def show_summary(summary: dict, key: str) -> None:
     """Cross-validated rates and a confusion matrix per SVM, fitted variances against defaults."""
+    samples = summary.get("samples") or {}
+    if samples:
+        st.caption("Training samples: " + ", ".join(f"{k} {v}" for k, v in samples.items()))
     svms = summary.get("svms") or {}
     if svms:
-        rows = [dict(svm=k, **{m: v.get(m) for m in ("cv_tnr", "cv_tpr", "kernel", "n_samples") if m in v})
-                for k, v in svms.items()]
-        st.dataframe(pd.DataFrame(rows), hide_index=True)
-        cols = st.columns(max(1, len(svms)))
+        table = pd.DataFrame([dict(svm=k, trained=v.get("trained"), kernel=v.get("kernel"), C=v.get("C"),
+                                   **{"CV TNR": v.get("tnr"), "CV TPR": v.get("tpr")},
+                                   positives=v.get("n_positive"), negatives=v.get("n_negative"), note=v.get("note"))
+                              for k, v in svms.items()])
+        st.dataframe(table, hide_index=True)
+        cols = st.columns(len(svms))
         for col, (k, v) in zip(cols, svms.items()):
-            cm = v.get("confusion")
-            if cm:
-                fig = go.Figure(go.Heatmap(z=cm, x=["pred. tracked", "pred. failed"], y=["tracked", "failed"],
-                                           text=cm, texttemplate="%{text}", colorscale="Blues", showscale=False))
-                fig.update_layout(title=k, height=260, margin=dict(l=10, r=10, t=40, b=10))
-                col.plotly_chart(fig, key=f"cm:{k}:{id(summary)}")
-    variances = summary.get("variances") or {}
-    if variances:
-        names = list(variances)
-        fig = go.Figure([go.Bar(name="default", x=names, y=[variances[n].get("default") for n in names]),
-                         go.Bar(name="fitted", x=names, y=[variances[n].get("fitted") for n in names])])
-        fig.update_layout(barmode="group", title="Variance parameters: fitted vs default", height=320)
-        st.plotly_chart(fig, key=f"var:{id(summary)}")
-    if not svms and not variances:
+            cm = v.get("confusion") or [[0, 0], [0, 0]]
+            fig = go.Figure(go.Heatmap(z=cm, x=["pred. failed", "pred. tracked"], y=["failed", "tracked"], text=cm,
+                                       texttemplate="%{text}", colorscale="Blues", showscale=False))
+            fig.update_layout(title=k, height=230, margin=dict(l=10, r=10, t=40, b=10))
+            fig.update_yaxes(autorange="reversed")
+            col.plotly_chart(fig, key=f"cm:{key}:{k}")
+    variances = pd.DataFrame(summary.get("variances") or [])
+    if len(variances):
+        v = variances.dropna(subset=["fitted"])
+        labels = v.tracker + " " + v.part + " " + v.parameter
+        fig = go.Figure([go.Bar(name="default", x=labels, y=v["default"]),
+                         go.Bar(name="fitted", x=labels, y=v["fitted"])])
+        fig.update_layout(barmode="group", title="Variance parameters: fitted vs default", height=340,
+                          margin=dict(l=10, r=10, t=40, b=10))
+        st.plotly_chart(fig, key=f"var:{key}")
+    for note in summary.get("notes") or []:
+        st.caption(note)
+    if not svms and not len(variances):
         st.json(summary, expanded=False)
 
 
@@ -82,4 +91,4 @@ if bundles:
             st.error(str(exc))
     for b in reversed(bundles):
         with st.expander(f"{b.name} · {b.created:%Y-%m-%d %H:%M} · {b.path}", expanded=b is bundles[-1]):
-            show_summary(b.summary)
+            show_summary(b.summary, key=str(b.id))

@@ -9,6 +9,7 @@ Correct page (``docs/correct.png`` with ``PARTLAB_SCREENSHOT=1``, else in tmp).
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -122,8 +123,9 @@ def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_pat
         if not missing("app.pipeline"):
             page.get_by_text("the stored boxes of frame 0").click()
             page.get_by_role("button", name="Track the whole clip").click()
-            page.get_by_text("done,").first.wait_for(timeout=120_000)
+            page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)
             assert store.runs(clip.id).tracker.tolist() == ["import", "body"]
+            assert store.tracks(clip.id).frame.max() == 11  # the tracker followed the walker to the end
         head0 = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
 
         # correct: drag the head box of frame 0 right and down, then press F
