@@ -167,17 +167,25 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     return jobs.submit("train", f"train bundle {name}", work, project_id=project_id)
 
 
+def first_boxes(truth: pd.DataFrame) -> pd.DataFrame:
+    """Every truth track's boxes at its first frame: where a fair comparison starts
+    (seed 002 sec. 5.3 counts frames after each person's initialisation)."""
+    first = truth.groupby("track_id")["frame"].transform("min")
+    return truth[truth["frame"] == first].reset_index(drop=True)
+
+
 def start_comparison_run(clip: Clip, tracker: str, bundle_name: str, bundle_path: str | Path | None,
-                         seed: int = 0) -> jobs.Job:
-    """Track a clip with one bundle without storing the result (Evaluate page); the
-    job's result is the tracks DataFrame."""
+                         seed: int = 0, init: pd.DataFrame | None = None) -> jobs.Job:
+    """Track a clip with one bundle without storing the result (Evaluate page), from
+    ``init`` boxes when given; the job's result is the tracks DataFrame."""
     pipeline = optional("app.pipeline")
     if pipeline is None:
         raise RuntimeError("tracking is not available yet (app.pipeline has not landed)")
 
     def work(progress):
-        return pipeline.track_video(str(clip.path), tracker=tracker, model=_load_model(bundle_path),
-                                    seed=seed, progress=progress)
+        start = int(init.frame.min()) if init is not None and len(init) else 0
+        return pipeline.track_video(str(clip.path), tracker=tracker, model=_load_model(bundle_path), init=init,
+                                    seed=seed, progress=progress, start=start)
 
     return jobs.submit("compare", f"{clip.name} with {bundle_name}", work, clip_id=clip.id, bundle=bundle_name,
                        tracker=tracker, seed=seed)

@@ -34,6 +34,7 @@ class Editor {
     this.addPart = root.querySelector(".pl-add-part");
     this.addTrack = root.querySelector(".pl-add-track");
     this.data = null;
+    this.viewFrame = 0;
     this.boxes = [];
     this.selected = null;   // "track:part" of the selected box
     this.pending = [];      // events not yet applied by Python
@@ -50,6 +51,9 @@ class Editor {
     const applied = Number(this.data.applied_seq || 0);
     this.seq = Math.max(this.seq, applied);
     this.pending = this.pending.filter((e) => e.seq > applied);
+    // the frame being asked for: the newest frame request Python has not answered yet, else Python's frame
+    const asked = this.pending.filter((e) => e.kind === "frame");
+    this.viewFrame = asked.length ? asked[asked.length - 1].target : this.data.frame;
     if (this.img.getAttribute("src") !== this.data.image) this.img.setAttribute("src", this.data.image || "");
     this.svg.setAttribute("viewBox", `0 0 ${this.data.width || 1} ${this.data.height || 1}`);
     this.boxes = (this.data.boxes || []).map((b) => ({ ...b }));
@@ -63,7 +67,7 @@ class Editor {
     for (const act of ["track", "failure", "occluded", "undo", "redo"]) {
       this.root.querySelector(`[data-act="${act}"]`).style.display = occl ? "none" : "";
     }
-    this.frameLabel.textContent = `frame ${this.data.frame} / ${Math.max(0, (this.data.frame_count || 1) - 1)}`;
+    this.showFrameLabel();
     if (first) this.setStatus(occl ? "draw occluder regions; drag to move, Delete removes" :
       "click a box to select it; drag to move, corners to resize, empty area to draw a new box");
     this.render();
@@ -144,6 +148,12 @@ class Editor {
 
   setStatus(text) { this.status.textContent = text; }
 
+  showFrameLabel() {
+    const last = Math.max(0, (this.data.frame_count || 1) - 1);
+    const wait = this.viewFrame !== this.data.frame ? ` (loading ${this.viewFrame})` : "";
+    this.frameLabel.textContent = `frame ${this.data.frame} / ${last}${wait}`;
+  }
+
   // ------------------------------------------------------------ events out
   emit(event) {
     event.seq = ++this.seq;
@@ -169,8 +179,13 @@ class Editor {
     const occl = this.data.mode === "occluders";
     const b = this.selectedBox();
     if (name === "prev" || name === "next") {
-      const f = this.data.frame + (name === "next" ? 1 : -1);
-      if (f >= 0 && f < (this.data.frame_count || 0)) this.emit({ kind: "frame", target: f });
+      // repeated presses step on from the frame asked for last, not the one still shown
+      const f = this.viewFrame + (name === "next" ? 1 : -1);
+      if (f >= 0 && f < (this.data.frame_count || 0)) {
+        this.viewFrame = f;
+        this.emit({ kind: "frame", target: f });
+        this.showFrameLabel();
+      }
     } else if (name === "track") {
       this.nextTrack();
     } else if (name === "undo" || name === "redo") {

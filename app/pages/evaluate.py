@@ -10,7 +10,7 @@ from app import jobs, state
 from app.box_editor import track_colour
 from app.demo import demo_files
 from app.pages.common import pick_clip, require_project
-from app.runs import missing, optional, start_comparison_run, training_truth
+from app.runs import first_boxes, missing, optional, start_comparison_run, training_truth
 from tracking.tracks import read_tracks_csv
 
 s = state.store()
@@ -48,8 +48,9 @@ b = c2.selectbox("Bundle B", list(options), index=min(1, len(options) - 1))
 tracker = c3.radio("Tracker", ("body", "limbs", "all"), horizontal=True, key="eval_tracker")
 lacking = missing("app.pipeline")
 if st.button("Track with both and compare", disabled=bool(lacking) or evaluation is None, type="primary"):
+    init = first_boxes(truth) if len(truth) else None  # both start from the truth's first boxes
     for name in dict.fromkeys((a, b)):
-        start_comparison_run(clip, tracker, name, options[name])
+        start_comparison_run(clip, tracker, name, options[name], init=init)
 if lacking:
     st.caption("Comparison runs need the tracker pipeline, which has not landed yet.")
 
@@ -57,7 +58,7 @@ if lacking:
 @st.fragment(run_every=1 if jobs.active("compare", clip_id=clip.id) else None)
 def comparison():
     cols = st.columns(2)
-    for col, name in zip(cols, (a, b)):
+    for side, (col, name) in enumerate(zip(cols, (a, b))):
         with col:
             st.markdown(f"**{name}**")
             runs = jobs.jobs("compare", clip_id=clip.id, bundle=name, tracker=tracker)
@@ -71,10 +72,10 @@ def comparison():
                 st.error(job.error)
             elif evaluation is not None and len(truth):
                 report = evaluation.evaluate(truth, job.result, at=105)
-                st.plotly_chart(evaluation.rate_curve_figure(report), key=f"rates:{name}")
-                summary = getattr(report, "summary", None)
-                if summary is not None:
-                    st.dataframe(summary() if callable(summary) else summary)
+                st.plotly_chart(evaluation.rate_curve_figure(report), key=f"rates:{side}:{name}")
+                if report.note:
+                    st.caption(report.note)
+                st.dataframe(report.summary, key=f"summary:{side}")
 
 
 comparison()
