@@ -23,9 +23,12 @@ with st.expander("New project", expanded=not s.projects()):
             try:
                 project = s.create_project(name)
                 st.session_state[state.PROJECT] = project.id
-                st.success(f"Created project {project.name!r}.")
+                st.session_state["projects_flash"] = f"Created project {project.name!r}."
+                st.rerun()  # the sidebar's project picker shows the new project
             except StoreError as exc:
                 st.error(str(exc))
+if "projects_flash" in st.session_state:
+    st.success(st.session_state.pop("projects_flash"))
 
 project = require_project(s)
 st.subheader(f"Project: {project.name}")

@@ -107,6 +107,7 @@ def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_pat
         page.get_by_label("Project name").fill("browser")
         page.get_by_role("button", name="Create project").click()
         page.get_by_text("Created project 'browser'.").wait_for()
+        page.get_by_text("Project: browser").wait_for()
         page.locator("input[type=file]").first.set_input_files(str(clip_file))
         page.get_by_text("Added walker.mp4: 12 frames").wait_for()
         project = store.project_by_name("browser")
