@@ -29,7 +29,7 @@ from tqdm import tqdm
 from labelling.synth.appearance import Appearance
 from labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from labelling.synth.camera import Camera
-from labelling.synth.figure import FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
+from labelling.synth.figure import FACE, FOREARM, HAND_LEFT, HAND_RIGHT, FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
 from labelling.synth.scenarios import BUILDERS, Script
 from tracking.box import Box
 from tracking.tracks import normalise_tracks
@@ -37,6 +37,7 @@ from tracking.tracks import normalise_tracks
 SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
 FPS = 25.0
 OCCLUDER_ID = 255
+SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM)
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,7 +106,8 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
                *, clean: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
 
-    ``clean`` leaves out flicker and sensor noise (for tests that check drawn colours).
+    ``clean`` leaves out every photometric effect (cloth shading, flicker, sensor noise)
+    so that each pixel has its label's exact colour (for tests that check drawn colours).
     """
     _check(name, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
@@ -115,6 +117,9 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
     luts = [colour_table(a.appearance) for a in script.actors]
+    # cloth folds and lighting: a gain field per person that moves with them (none when clean)
+    folds = [None if clean else 0.045 * smooth_noise(rng, height + 64, width + 64, max(3, height // 40))
+             for _ in script.actors]
     frames = np.empty((n_frames, height, width, 3), np.uint8)
     owner = np.zeros((height, width), np.uint8)
     rows: list[tuple] = []
@@ -139,7 +144,16 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             crop = (slice(cy1 - y0, cy2 - y0), slice(cx1 - x0, cx2 - x0))
             lab = fig.labels[crop]
             on = lab > 0
-            frame[cy1:cy2, cx1:cx2][on] = luts[a][lab[on]]
+            colours = luts[a][lab[on]]
+            if folds[a] is not None:  # lit from above: brighter shoulders, darker feet, plus folds
+                ry = (np.arange(cy1 - y0, cy2 - y0, dtype=np.float32) / max(fh, 1))[:, None]
+                fold = folds[a]
+                if fold.shape[0] < fh or fold.shape[1] < fw:  # a figure larger than the frame
+                    fold = np.pad(fold, ((0, max(0, fh - fold.shape[0])), (0, max(0, fw - fold.shape[1]))), "wrap")
+                cloth = ~np.isin(lab, SKIN_LABELS)  # folds in clothes and hair, smooth skin
+                gain = (1.06 - 0.14 * ry) * (1.0 + fold[: fh, : fw][crop] * cloth)
+                colours = np.clip(colours * gain[on][:, None], 0, 255).astype(np.uint8)
+            frame[cy1:cy2, cx1:cx2][on] = colours
             owner[cy1:cy2, cx1:cx2][on] = a + 1
             drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
         for o, tex in zip(script.occluders, occ_tex):
@@ -194,6 +208,9 @@ def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: 
         occ.unlink()
     meta = {"name": name, "seed": seed, "fps": scene.fps, "width": width, "height": height,
             "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
-            "occluders": [list(b.as_tuple()) for b in scene.occluders]}
+            "occluders": [list(b.as_tuple()) for b in scene.occluders],
+            "people": [{"track_id": k + 1, "shirt": list(p.shirt), "trousers": list(p.trousers), "skin": list(p.skin),
+                        "hair": list(p.hair), "height_m": round(p.height_m, 3)}
+                       for k, p in enumerate(scene.appearances)]}
     (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
     return out
