@@ -64,6 +64,7 @@ class Appearance:
     shoes: tuple[int, int, int]
     height_m: float = 1.75
     short_sleeves: bool = False
+    long_hair: bool = False
 
 
 def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int, int]:
@@ -87,5 +88,6 @@ def sample_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
             shoes=_jitter(rng, SHOES[rng.integers(len(SHOES))], 5),
             height_m=float(rng.uniform(1.62, 1.86)),
             short_sleeves=bool(rng.random() < 0.4),
+            long_hair=bool(rng.random() < 0.35),
         ))
     return out

@@ -29,7 +29,7 @@ from tqdm import tqdm
 from labelling.synth.appearance import Appearance
 from labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from labelling.synth.camera import Camera
-from labelling.synth.figure import FACE, FOREARM, HAND_LEFT, HAND_RIGHT, FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
+from labelling.synth.figure import FACE, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
 from labelling.synth.scenarios import BUILDERS, Script
 from tracking.box import Box
 from tracking.tracks import normalise_tracks
@@ -37,7 +37,7 @@ from tracking.tracks import normalise_tracks
 SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
 FPS = 25.0
 OCCLUDER_ID = 255
-SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM)
+SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
 
 
 @dataclass(frozen=True, eq=False)

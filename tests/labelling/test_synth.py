@@ -74,7 +74,8 @@ def test_part_boxes_nest_in_the_person_and_stack_head_torso_hipleg(clean_single)
     assert (wide["y"]["head"] < wide["y"]["torso"]).all() and (wide["y"]["torso"] < wide["y"]["hipleg"]).all()
     assert (wide["y"]["hipleg"] + wide["h"]["hipleg"] == wide["y"]["person"] + wide["h"]["person"]).all()
     ratio = wide["h"]["head"] / wide["h"]["person"]
-    assert ratio.between(0.09, 0.16).all()  # a head is about 1/7.5 of the body
+    top = 0.22 if clean_single.appearances[0].long_hair else 0.16  # long hair falls to the shoulders
+    assert ratio.between(0.09, top).all()  # a head is about 1/7.5 of the body
 
 
 def test_lone_walker_is_never_occluded(clean_single):
@@ -212,3 +213,22 @@ def test_cli_writes_the_files(tmp_path, capsys):
     assert "parade" in err and "pillar" in err and "desk" in err
     assert main(["synth", str(tmp_path / "x"), "--size", "big"]) == 2
     assert not (tmp_path / "x").exists()
+
+
+def test_decoded_clip_frames_match_the_truth_frames(tmp_path):
+    import cv2
+
+    from labelling.video import open_video
+
+    n = 10
+    out = render_scenario("single", tmp_path, seed=2, n_frames=n, width=240, height=160)
+    scene = make_scene("single", seed=2, n_frames=n, width=240, height=160)
+    clip = open_video(out / "clip.mp4")
+    def smooth(f):  # average the sensor noise away; the codec keeps the picture
+        return cv2.blur(f, (5, 5)).astype(int)
+
+    for i in (0, 5, 9):
+        decoded = smooth(clip.read(i))
+        same = np.abs(decoded - smooth(scene.frames[i])).mean()
+        other = np.abs(decoded - smooth(scene.frames[(i + 4) % n])).mean()
+        assert same < 2.5 and same < 0.8 * other, (i, same, other)
