@@ -59,9 +59,11 @@ class Scene:
     appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
 
 
-def _check(name: str, n_frames: int, width: int, height: int) -> None:
+def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario {name!r}; expected one of {', '.join(SCENARIOS)}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     if n_frames < 1:
         raise ValueError(f"n_frames must be at least 1, got {n_frames}")
     if width < 64 or height < 48:
@@ -109,7 +111,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     ``clean`` leaves out every photometric effect (cloth shading, flicker, sensor noise)
     so that each pixel has its label's exact colour (for tests that check drawn colours).
     """
-    _check(name, n_frames, width, height)
+    _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.for_frame(width, height)
     script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
