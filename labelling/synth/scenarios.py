@@ -136,7 +136,7 @@ def _distractors(rng, camera, n_frames, fps) -> Script:
 def _crowd(rng, camera, n_frames, fps) -> Script:
     apps = sample_appearances(rng, 4)
     t = clip_time(n_frames)
-    ma = walk(camera, n_frames, [(0.0, -0.9, 6.6 + _j(rng, 0.2)), (1.0, 0.8, 6.9)], apps[0].height_m)
+    ma = walk(camera, n_frames, [(0.0, -0.84, 6.6 + _j(rng, 0.2)), (1.0, 0.8, 6.9)], apps[0].height_m)
     mb = walk(camera, n_frames, [(0.0, 0.9, 8.4 + _j(rng, 0.2)), (1.0, -0.85, 8.0)], apps[1].height_m)
     mc = walk(camera, n_frames, [(0.0, -0.55, 9.6), (0.6, 0.45, 9.0 + _j(rng, 0.3)), (1.0, 0.85, 9.4)],
               apps[2].height_m)
@@ -162,7 +162,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
     (app,) = sample_appearances(rng, 1)
     H = app.height_m
     W, Hi = camera.width, camera.height
-    s = 0.66 * Hi  # pixels per metre: head and torso about 180 px tall at 480 rows
+    s = 0.62 * Hi  # pixels per metre: head, torso and arms about 200-230 px tall at 480 rows
     k = 0.3
     head_top = (1.0 - 0.24) * H
     y0 = 0.2 * Hi + s * head_top
