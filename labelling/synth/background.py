@@ -113,9 +113,9 @@ def draw_props(img: np.ndarray, props: list[Prop], rng: np.random.Generator) -> 
 class CameraEffects:
     """Per-frame brightness gain ``gains: (T,)`` and a bank of noise fields to crop from.
 
-    The defaults give a decoded 720x480 clip a frame-to-frame brightness spread of about
-    1 % and a temporal pixel noise of 2-3 grey levels, a little more than PETS09-S2L1
-    (0.4 and 1.6 measured on its first 60 frames): harder than that camera, not unlike it.
+    The defaults give a decoded 720x480 clip a frame-to-frame brightness spread of
+    0.7-1 % and a median temporal pixel std of about 2 grey levels, a little more than
+    PETS09-S2L1 (0.37 % and 1.6 on its first 60 frames; ``benchmarks/synth_realism.py``).
     """
 
     gains: np.ndarray
