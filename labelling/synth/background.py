@@ -79,7 +79,7 @@ def room(rng: np.random.Generator, camera: Camera) -> np.ndarray:
     return np.clip(img, 0, 255).astype(np.uint8)
 
 
-def draw_props(img: np.ndarray, props: list[Prop], rng: np.random.Generator) -> np.ndarray:
+def draw_props(img: np.ndarray, props: list[Prop]) -> np.ndarray:
     """Draw ``props`` into ``img`` (in place) and return it."""
     for p in props:
         x, y, w, h = (int(round(v)) for v in p.box)

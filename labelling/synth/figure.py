@@ -176,7 +176,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         swing = pose.gait * LEG_SWING * np.sin(pose.phase)
         for side, sign in ((1, 1.0), (-1, -1.0)):  # left leg swings with +sin(phase)
             a = sign * swing
-            flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))  # knee bends while the leg swings forward
+            # the knee bends most while the leg swings forward
+            flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))
             hip = np.array([side * HIP_L * H, 0.0, HIP_U * H])
             knee = hip + THIGH * H * np.array([0.0, np.sin(a), -np.cos(a)])
             ankle = knee + SHIN * H * np.array([0.0, np.sin(a - flex), -np.cos(a - flex)])
@@ -201,7 +202,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         pelvis = _box_corners(PELVIS_TOP_U * H - drop, PELVIS_HALF_W * H, PELVIS_HALF_D * H,
                               PELVIS_BOTTOM_U * H - drop, PELVIS_HALF_W * H * 0.95, PELVIS_HALF_D * H)
         solids.append(_Solid("poly", project(pelvis), TROUSERS, "hipleg", depth(pelvis) + 0.035))
-        leg_depths = [depth(leg[1]) for leg in legs]
+        leg_depths = [depth(np.stack(leg[1:])) for leg in legs]  # the leg stepping towards the camera is in front
         far = int(np.argmax(leg_depths)) if abs(leg_depths[0] - leg_depths[1]) > 0.02 else -1
         for i, (side, hip, knee, ankle) in enumerate(legs):
             hip, knee, ankle = (p - np.array([0.0, 0.0, drop]) for p in (hip, knee, ankle))

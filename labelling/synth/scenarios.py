@@ -49,11 +49,6 @@ def _j(rng: np.random.Generator, scale: float) -> float:
     return float(rng.uniform(-scale, scale))
 
 
-def _wave(t: np.ndarray, start: float, end: float, n_frames: int, fps: float) -> tuple[np.ndarray, np.ndarray]:
-    frames = np.arange(len(t))
-    return bump(t, start, end), 2 * np.pi * 2.2 * frames / fps
-
-
 def _glances(rng: np.random.Generator, n_frames: int, fps: float, amount: float = 0.35) -> np.ndarray:
     """Head yaw of a walker looking around now and then: a slow smooth random signal (radians)."""
     frames = np.arange(n_frames) / fps
@@ -69,7 +64,7 @@ def _single(rng, camera, n_frames, fps) -> Script:
     m = walk(camera, n_frames, [(0.0, -0.8, z1), (0.63, 0.6, z2), (0.76, 0.6, z2), (1.0, 0.05, z3)],
              app.height_m)
     t = clip_time(n_frames)
-    wave, _ = _wave(t, 0.68, 0.73, n_frames, fps)
+    wave = bump(t, 0.68, 0.73)  # the right hand waves (about 2 Hz) while facing the camera
     return Script([Actor(app, with_changes(m, wave=wave, head_yaw=_glances(rng, n_frames, fps)))])
 
 
@@ -142,7 +137,7 @@ def _crowd(rng, camera, n_frames, fps) -> Script:
               apps[2].height_m)
     md = walk(camera, n_frames, [(0.0, 0.55, 9.6), (0.35, 0.3, 9.4), (0.6, 0.3, 9.4), (1.0, -0.55, 8.8)],
               apps[3].height_m)
-    wave, _ = _wave(t, 0.4, 0.55, n_frames, fps)
+    wave = bump(t, 0.4, 0.55)
     md = with_changes(md, wave=wave)
     motions = [with_changes(m, head_yaw=_glances(rng, n_frames, fps)) for m in (ma, mb, mc, md)]
     return Script([Actor(a, m) for a, m in zip(apps, motions)])

@@ -32,6 +32,7 @@ from labelling.synth.camera import Camera
 from labelling.synth.figure import FACE, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
 from labelling.synth.scenarios import BUILDERS, Script
 from tracking.box import Box
+from tracking.parts import PART_NAMES
 from tracking.tracks import normalise_tracks
 
 SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
@@ -115,7 +116,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.for_frame(width, height)
     script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
-    background = draw_props(room(rng, camera), script.props, rng)
+    background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
     luts = [colour_table(a.appearance) for a in script.actors]
@@ -183,7 +184,9 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
         frames[i] = frame if effects is None else effects.apply(frame, i)
     truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded"])
     truth["source"] = "truth"
-    truth = normalise_tracks(truth)
+    order = {p: k for k, p in enumerate(PART_NAMES)}
+    truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
+    truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
     init = truth[truth["frame"] == first].reset_index(drop=True)
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
