@@ -8,7 +8,7 @@ differently. Depths 5.5 .. 12 m give people 220 .. 100 px tall in a 720x480 fram
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -70,8 +70,11 @@ def _single(rng, camera, n_frames, fps) -> Script:
 
 def _pair_cross(rng, camera, n_frames, fps) -> Script:
     a, b = sample_appearances(rng, 2)
+    # a tall near walker and a short far one: seen from 3.1 m up, the far head then stays behind the near one
+    a = replace(a, height_m=float(rng.uniform(1.80, 1.86)))
+    b = replace(b, height_m=float(rng.uniform(1.60, 1.64)))
     za = 7.0 + _j(rng, 0.2)
-    zb = za + 0.75 + _j(rng, 0.1)  # close behind: at the crossing little more than the far head shows
+    zb = za + 0.55 + _j(rng, 0.05)  # close behind: at the crossing little more than the far head shows
     xa = 0.85 + _j(rng, 0.05)
     ma = walk(camera, n_frames, [(0.0, -xa, za), (1.0, xa, za)], a.height_m)
     mb = walk(camera, n_frames, [(0.0, xa, zb), (1.0, -xa, zb)], b.height_m)
