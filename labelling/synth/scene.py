@@ -49,7 +49,9 @@ class Scene:
     (``source = "truth"``) with rows for every person and part at every frame;
     ``init``: the rows of each track's first frame; ``occluders``: fixed occluder boxes
     (the pillar), else empty; ``fps``: frame rate; ``appearances``: each track's
-    colours (track ``k`` is ``appearances[k - 1]``).
+    colours (track ``k`` is ``appearances[k - 1]``); ``background``: the empty room;
+    ``owners``: per-pixel visibility maps (only with ``make_scene(..., owners=True)``),
+    e.g. the true foreground for testing a background model is ``owners[t] % 255 > 0``.
     """
 
     frames: np.ndarray
@@ -58,6 +60,8 @@ class Scene:
     occluders: list[Box]
     fps: float
     appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
+    background: np.ndarray | None = None  # (H, W, 3) uint8: the empty room (no shadows, flicker or noise)
+    owners: np.ndarray | None = None  # (T, H, W) uint8 who is seen where: 0 room, k track k, 255 occluder
 
 
 def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
@@ -106,11 +110,12 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
 
 
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
-               *, clean: bool = False, progress: bool = False) -> Scene:
+               *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
 
     ``clean`` leaves out every photometric effect (cloth shading, flicker, sensor noise)
-    so that each pixel has its label's exact colour (for tests that check drawn colours).
+    so that each pixel has its label's exact colour (for tests that check drawn colours);
+    ``owners`` keeps every frame's visibility map in :attr:`Scene.owners`.
     """
     _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
@@ -125,6 +130,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
              for _ in script.actors]
     frames = np.empty((n_frames, height, width, 3), np.uint8)
     owner = np.zeros((height, width), np.uint8)
+    owner_maps = np.zeros((n_frames, height, width), np.uint8) if owners else None
     rows: list[tuple] = []
     for i in tqdm(range(n_frames), desc=f"synth {name}", unit="frame", disable=not progress):
         frame = background.copy()
@@ -182,6 +188,8 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
                 rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
                              rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
         frames[i] = frame if effects is None else effects.apply(frame, i)
+        if owner_maps is not None:
+            owner_maps[i] = owner
     truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded"])
     truth["source"] = "truth"
     order = {p: k for k, p in enumerate(PART_NAMES)}
@@ -190,7 +198,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     first = truth.groupby("track_id")["frame"].transform("min")
     init = truth[truth["frame"] == first].reset_index(drop=True)
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
-                 tuple(a.appearance for a in script.actors))
+                 tuple(a.appearance for a in script.actors), background, owner_maps)
 
 
 def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,

@@ -237,3 +237,22 @@ def test_decoded_clip_frames_match_the_truth_frames(tmp_path):
         decoded = clip.read(i)[y1:y2, x1:x2].astype(int)
         diffs = [np.abs(decoded - scene.frames[j][y1:y2, x1:x2]).mean() for j in (i - 1, i, i + 1)]
         assert int(np.argmin(diffs)) == 1 and diffs[1] < 0.7 * min(diffs[0], diffs[2]), (i, diffs)
+
+
+def test_owner_maps_agree_with_the_truth_and_the_background():
+    scene = make_scene("pillar", seed=0, n_frames=30, width=240, height=160, owners=True)
+    assert scene.owners.shape == (30, 160, 240) and scene.background.shape == (160, 240, 3)
+    (pillar,) = scene.occluders
+    x, y, w, h = (int(v) for v in pillar.as_tuple())
+    assert (scene.owners[:, y:y + h, x:x + w] == 255).all()
+    person = scene.truth[scene.truth.part == "person"].set_index("frame")
+    for t in range(0, 30, 5):
+        ys, xs = np.nonzero(scene.owners[t] == 1)
+        r = person.loc[t]
+        if r.occluded == 1.0:
+            assert len(ys) == 0
+            continue
+        # every visible pixel of the walker is inside its box, and it is a sizeable share of the box
+        assert xs.min() >= r.x and xs.max() < r.x + r.w and ys.min() >= r.y and ys.max() < r.y + r.h
+        assert len(ys) / (r.w * r.h) * 1.0 > 0.25 * (1 - r.occluded)
+    assert make_scene("single", n_frames=2, width=96, height=64).owners is None
