@@ -256,3 +256,42 @@ def test_owner_maps_agree_with_the_truth_and_the_background():
         assert xs.min() >= r.x and xs.max() < r.x + r.w and ys.min() >= r.y and ys.max() < r.y + r.h
         assert len(ys) / (r.w * r.h) * 1.0 > 0.25 * (1 - r.occluded)
     assert make_scene("single", n_frames=2, width=96, height=64).owners is None
+
+
+def test_single_walker_turns_back_through_facing_the_camera_and_waves(clean_single):
+    from labelling.synth.camera import Camera
+    from labelling.synth.motion import walk
+
+    camera = Camera.for_frame(480, 320)
+    m = walk(camera, 100, [(0.0, -0.8, 8.0), (0.6, 0.6, 7.0), (0.8, 0.6, 7.0), (1.0, 0.0, 8.5)])
+    assert np.cos(m.facing[10]) > 0.95  # walking right (and a little towards the camera), side-on
+    assert (np.sin(m.facing[62:74]) < -0.45).all() and np.sin(m.facing[62:74]).min() < -0.98  # turns facing the camera
+    assert np.cos(m.facing[95]) < -0.5  # walking back left
+    assert m.gait[70] == 0 and m.gait[10] == 1  # standing while turning
+    t = clean_single.truth
+    T = t.frame.max() + 1
+    hand = t[t.part == "right_hand"].set_index("frame")
+    head = t[t.part == "head"].set_index("frame")
+    left = t[t.part == "left_hand"].set_index("frame")
+    waving = [f for f in range(T) if 0.69 * T <= f <= 0.72 * T]
+    assert waving and all(hand.y[f] < head.y[f] + head.h[f] for f in waving)  # the right hand is up by the head
+    assert all(left.y[f] > head.y[f] + head.h[f] for f in waving)  # the left one is not
+    assert all(hand.y[f] > head.y[f] + head.h[f] for f in range(0, int(0.5 * T)))  # walking: hands down
+
+
+def test_left_hand_is_the_persons_own_left():
+    from labelling.synth.appearance import Appearance
+    from labelling.synth.camera import LocalView
+    from labelling.synth.figure import FigurePose, draw_figure
+
+    app = Appearance((0, 0, 200), (100, 50, 0), (150, 180, 220), (20, 20, 20), (30, 30, 30))
+    view = LocalView(200.0, 300.0, 100.0, 0.4)
+
+    def hand_x(facing):
+        fig = draw_figure(FigurePose(facing=facing), app, view)
+        return [fig.origin[0] + np.nonzero(fig.masks[p].any(axis=0))[0].mean() for p in ("left_hand", "right_hand")]
+
+    left, right = hand_x(-np.pi / 2)  # facing the camera: the own left hand is on the image right
+    assert left - right > 30
+    left, right = hand_x(np.pi / 2)  # facing away: on the image left
+    assert right - left > 30
