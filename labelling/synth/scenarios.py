@@ -15,7 +15,7 @@ import numpy as np
 from labelling.synth.appearance import Appearance, sample_appearances
 from labelling.synth.background import WALL_DEPTH, Prop
 from labelling.synth.camera import Camera, LocalView
-from labelling.synth.figure import HAND_R
+from labelling.synth.figure import HAND_R, WAIST_HALF_D
 from labelling.synth.motion import Motion, bump, clip_time, walk, with_changes
 from tracking.box import Box
 
@@ -167,7 +167,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
     x0 = W / 2 + _j(rng, 0.05 * W)
     view = LocalView(x0, y0, s, k)
     desk_h, desk_far, desk_near = 0.75, 0.25, 0.95  # metres: height, near/far edge in front of the person
-    seat_cut = desk_h - k * (desk_far - 0.06 * H)
+    seat_cut = desk_h - k * (desk_far - WAIST_HALF_D * H)  # the torso's front ends at the desk's far edge
     # the desk seen from the camera: far edge row, near edge row
     far_y = y0 - s * desk_h + s * k * desk_far
     near_y = y0 - s * desk_h + s * k * desk_near
@@ -194,7 +194,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
             hands[:, i, d] += amp * 0.5 * (np.sin(2 * np.pi * fr[0] * frames / fps + ph[0])
                                            + np.sin(2 * np.pi * fr[1] * frames / fps + ph[1]))
     # clap around frames 40-60 of 150: hands meet in front of the chest three times
-    t0, t1 = 40 / 150, 60 / 150
+    t0, t1 = 40 / 149, 60 / 149  # clip time of frames 40 and 60 of a 150-frame clip
     c = bump(t, t0, t1, ramp=0.04)
     u = np.clip((t - t0) / (t1 - t0), 0, 1)
     sep = hr * 1.05 + 0.11 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))
@@ -202,7 +202,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
                      np.stack([-sep, np.full(n, 0.3), np.full(n, 0.98)], 1)], 1)
     hands = hands * (1 - c)[:, None, None] + clap * c[:, None, None]
     # reach around frames 80-110: the right hand goes to the cup and back
-    r = bump(t, 85 / 150, 105 / 150, ramp=0.035)
+    r = bump(t, 85 / 149, 105 / 149, ramp=0.035)
     target = obj + np.array([0.0, 0.0, 0.06])
     hands[:, 1] = hands[:, 1] * (1 - r)[:, None] + target[None] * r[:, None]
     yaw = 0.3 * np.sin(2 * np.pi * frames / (fps * 3.5) + rng.uniform(0, 6.3)) * (1 - r) - 0.55 * r
