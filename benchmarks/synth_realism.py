@@ -50,8 +50,8 @@ def main() -> None:
             truth = read_tracks_csv(out / "truth.csv")
             person = truth[(truth.part == "person") & (truth.occluded < 0.01)]
             flicker, noise = camera_stats(out / "clip.mp4")
-        print(f"{name:12s} {dt:8.2f} {person.h.min():4.0f}-{person.h.max():<5.0f} {person.w.min():3.0f}-{person.w.max():<5.0f}"
-              f" {100 * flicker:7.2f}% {noise:6.2f}")
+        print(f"{name:12s} {dt:8.2f} {person.h.min():4.0f}-{person.h.max():<5.0f} "
+              f"{person.w.min():3.0f}-{person.w.max():<5.0f} {100 * flicker:7.2f}% {noise:6.2f}")
     if args.real:
         flicker, noise = camera_stats(args.real)
         print(f"{args.real.name:12s} {'':8s} {'':10s} {'':9s} {100 * flicker:7.2f}% {noise:6.2f}")

@@ -41,7 +41,8 @@ ONE = 1 << SHIFT
 FIGURE_PARTS: tuple[str, ...] = ("head", "torso", "hipleg", "left_hand", "right_hand")
 
 # Label values of the label image (colour index); 0 = nothing drawn.
-HAIR, FACE, SHIRT, SLEEVE, SLEEVE_FAR, TROUSERS, TROUSERS_FAR, SHOES, HAND_LEFT, HAND_RIGHT, FOREARM, NECK = range(1, 13)
+(HAIR, FACE, SHIRT, SLEEVE, SLEEVE_FAR, TROUSERS, TROUSERS_FAR, SHOES, HAND_LEFT, HAND_RIGHT, FOREARM,
+ NECK) = range(1, 13)
 N_LABELS = 13
 #: The labels each part is drawn with (its pixels the person's own other parts leave visible).
 PART_LABELS: dict[str, tuple[int, ...]] = {
@@ -272,8 +273,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         r = view.s * H * np.array([ARM_R * 1.15, ARM_R, WRIST_R])
         hand_px = project(hand)[0]
         solids.append(_Solid("arm", (pts, r, short_sleeves), SLEEVE, None, d))
-        solids.append(_Solid("circle", (hand_px, view.s * H * HAND_R), HAND_LEFT if side == 1 else HAND_RIGHT, hand_part,
-                             d - 0.001))
+        hand_label = HAND_LEFT if side == 1 else HAND_RIGHT
+        solids.append(_Solid("circle", (hand_px, view.s * H * HAND_R), hand_label, hand_part, d - 0.001))
     if abs(arm_depths[0] - arm_depths[1]) > 0.03:
         for s in solids:
             if s.kind == "arm" and s.depth == max(arm_depths):

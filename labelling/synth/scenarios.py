@@ -112,7 +112,8 @@ def _distractors(rng, camera, n_frames, fps) -> Script:
     props = []
     s_wall = float(camera.scale(WALL_DEPTH))
     _, wall_y = camera.floor_point(0.0, WALL_DEPTH)
-    for xr, kind in ((-0.28, "poster_person"), (0.02, "rect"), (0.32, "poster_person"), (0.62, "rect")):  # clear of the door
+    # posters on the back wall, clear of the door
+    for xr, kind in ((-0.28, "poster_person"), (0.02, "rect"), (0.32, "poster_person"), (0.62, "rect")):
         x = float(camera.x_from_fraction(xr + _j(rng, 0.05), WALL_DEPTH))
         fx, _ = camera.floor_point(x, WALL_DEPTH)
         w, h = 0.9 * s_wall, 1.3 * s_wall

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
@@ -29,7 +28,8 @@ from tqdm import tqdm
 from labelling.synth.appearance import Appearance
 from labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from labelling.synth.camera import Camera
-from labelling.synth.figure import FACE, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
+from labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
+                                    colour_table, draw_figure)
 from labelling.synth.scenarios import BUILDERS, Script
 from tracking.box import Box
 from tracking.parts import PART_NAMES
@@ -219,8 +219,8 @@ def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: 
             occ, index=False, lineterminator="\n")
     elif occ.exists():
         occ.unlink()
-    meta = {"name": name, "seed": seed, "fps": scene.fps, "width": width, "height": height,
-            "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
+    meta = {"name": name, "seed": seed, "fps": scene.fps, "size": f"{width}x{height}", "width": width,
+            "height": height, "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
             "occluders": [list(b.as_tuple()) for b in scene.occluders],
             "people": [{"track_id": k + 1, "shirt": list(p.shirt), "trousers": list(p.trousers), "skin": list(p.skin),
                         "hair": list(p.hair), "height_m": round(p.height_m, 3)}
