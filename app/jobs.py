@@ -108,3 +108,12 @@ def wait(job_id: str, timeout: float = 60.0) -> Job:
             raise TimeoutError(f"job {job.label!r} still {job.status} after {timeout} s")
         time.sleep(0.05)
     return job
+
+
+def clear_finished() -> int:
+    """Forget the jobs that have ended (the job list's "clear" button); returns how many."""
+    with _LOCK:
+        done = [k for k, j in _JOBS.items() if not j.active]
+        for k in done:
+            del _JOBS[k]
+    return len(done)

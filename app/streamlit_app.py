@@ -44,6 +44,8 @@ with st.sidebar:
         for j in recent:
             st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
                        (f" ({j.error})" if j.error else ""))
+        if recent:
+            st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
 
     _job_list()
     st.caption(f"Data: {data_dir()}")

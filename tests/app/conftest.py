@@ -32,6 +32,17 @@ def walker_boxes(n: int = N_FRAMES) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+@pytest.fixture(autouse=True)
+def _no_old_jobs():
+    """Each test sees only its own background jobs (the registry is process-wide)."""
+    from app import jobs
+
+    yield
+    for job in jobs.active():
+        jobs.wait(job.id, 120)
+    jobs.clear_finished()
+
+
 @pytest.fixture
 def boxes():
     """The walker's true boxes (tracks CSV columns)."""

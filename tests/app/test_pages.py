@@ -131,3 +131,43 @@ def test_export_page_builds_an_archive_and_marks_clips_exported(store, tracked_c
     go.click().run()
     assert any("Exported 1 clip(s) as mot" in t for t in texts(at, "success")), texts(at, "error")
     assert store.clip(clip.id).exported
+
+
+@pytest.mark.skipif(bool(missing("app.pipeline")), reason="app.pipeline (the tracker pipeline) has not landed yet")
+def test_retrack_from_a_fix_stops_at_the_next_corrected_frame(store, tracked_clip, boxes):
+    project, clip = tracked_clip
+    head = boxes[(boxes.frame == 3) & (boxes.part == "head")].iloc[0]
+    store.edit_box(clip.id, 3, 1, "head", Box(head.x + 1, head.y, head.w, head.h), expected_revision=0)
+    store.edit_box(clip.id, 8, 1, "head", Box(70, 20, 8, 10), expected_revision=0)
+    before = store.tracks(clip.id)
+    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 3})
+    assert any("to frame 8 (the next corrected frame)" in m for m in texts(at, "markdown"))
+    [go] = [b for b in at.button if b.label == "Re-track from here"]
+    go.click().run()
+    [job] = jobs.jobs("track", clip_id=clip.id)
+    jobs.wait(job.id, 120)
+    assert job.status == "done", job.error
+    assert (job.result["start"], job.result["stop"]) == (3, 8)
+    after = store.tracks(clip.id)
+    keep = lambda df: df[(df.frame < 3) | (df.frame >= 8)].reset_index(drop=True)  # noqa: E731
+    assert keep(after)[["frame", "part", "x", "y", "source"]].equals(keep(before)[["frame", "part", "x", "y", "source"]])
+    fixed = after[(after.frame == 3) & (after.part == "head")].iloc[0]
+    assert (fixed.source, fixed.x) == ("human", head.x + 1)  # the fix itself is never overwritten
+    assert set(after[(after.frame > 3) & (after.frame < 8)].source) == {"tracker"}
+    assert store.runs(clip.id).start_frame.tolist() == [0, 3]
+
+
+@pytest.mark.skipif(bool(missing("app.pipeline", "labelling.evaluation")),
+                    reason="app.pipeline / labelling.evaluation have not landed yet")
+def test_evaluate_page_compares_two_runs_against_the_truth(store, tracked_clip, boxes, tmp_path):
+    project, clip = tracked_clip
+    at = page("evaluate", project_id=project.id, clip_id=clip.id)
+    at.file_uploader[0].upload("truth.csv", boxes.to_csv(index=False).encode(), "text/csv").run()
+    [go] = [b for b in at.button if b.label == "Track with both and compare"]
+    go.click().run()
+    [job] = jobs.jobs("compare", clip_id=clip.id)  # A and B are the same (built-in): one run
+    jobs.wait(job.id, 120)
+    assert job.status == "done", job.error
+    at.run()
+    assert not at.exception
+    assert len(at.get("plotly_chart")) == 3  # two rate curves and the trajectories
