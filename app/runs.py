@@ -92,13 +92,13 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
 
 def clip_state(store: Store, clip: Clip, runs: pd.DataFrame | None = None) -> str:
     """untracked, tracked, corrected n%, exported (the clip list's state column)."""
-    if clip.exported:
-        return "exported"
     progress = store.progress(clip.id)
     if progress["corrected_frames"]:
-        return f"corrected {100 * progress['fraction']:.0f}%"
-    runs = store.runs(clip.id) if runs is None else runs
-    return "tracked" if len(runs) else "untracked"
+        state = f"corrected {100 * progress['fraction']:.0f}%"
+    else:
+        runs = store.runs(clip.id) if runs is None else runs
+        state = "tracked" if len(runs) else "untracked"
+    return f"exported ({state})" if clip.exported else state
 
 
 def safe_name(name: str) -> str:

@@ -21,6 +21,9 @@ function el(name, attrs) {
 
 function keyOf(b) { return b.track_id + ":" + b.part; }
 
+// the store keeps the occluded fraction (trackers estimate it); the flag is "at least half hidden"
+function isOccluded(b) { return Number(b.occluded || 0) >= 0.5; }
+
 const SHORT = { hipleg: "hip-leg", left_hand: "L hand", right_hand: "R hand" };
 
 class Editor {
@@ -109,7 +112,7 @@ class Editor {
     const occl = this.data.mode === "occluders";
     for (const b of this.boxes) {
       const sel = keyOf(b) === this.selected;
-      const cls = occl ? "pl-occluder" : ["pl-box", b.failure ? "pl-failure" : "", b.occluded ? "pl-occluded" : "",
+      const cls = occl ? "pl-occluder" : ["pl-box", b.failure ? "pl-failure" : "", isOccluded(b) ? "pl-occluded" : "",
         sel ? "pl-selected" : ""].join(" ");
       const rect = el("rect", { x: b.x, y: b.y, width: b.w, height: b.h, class: cls,
         "data-track": b.track_id, "data-part": b.part });
@@ -122,8 +125,8 @@ class Editor {
         const ly = above ? Math.max(font, b.y - font * 0.3) : b.y + font;
         const label = el("text", { x: b.x + font * 0.2, y: ly, class: "pl-label", "font-size": font,
           "stroke-width": font * 0.18 });
-        label.textContent = above ? `#${b.track_id} person${b.failure ? " FAIL" : ""}${b.occluded ? " occl" : ""}`
-          : `${SHORT[b.part] || b.part}${b.failure ? " FAIL" : ""}${b.occluded ? " occl" : ""}`;
+        const flags = `${b.failure ? " FAIL" : ""}${isOccluded(b) ? " occl" : ""}`;
+        label.textContent = above ? `#${b.track_id} person${flags}` : `${SHORT[b.part] || b.part}${flags}`;
         svg.appendChild(label);
       }
       if (sel) this.drawHandles(b);
@@ -164,7 +167,7 @@ class Editor {
 
   emitBox(b, extra) {
     this.emit({ kind: "edit", track_id: b.track_id, part: b.part, box: [b.x, b.y, b.w, b.h],
-      failure: !!b.failure, occluded: b.occluded ? 1 : 0, revision: b.revision ?? null, ...extra });
+      failure: !!b.failure, occluded: Number(b.occluded || 0), revision: b.revision ?? null, ...extra });
     b.revision = (b.revision ?? 0) + 1; // optimistic: the next edit of this box expects our revision
   }
 
@@ -200,9 +203,11 @@ class Editor {
       this.render();
     } else if ((name === "failure" || name === "occluded") && !occl) {
       if (!b) return this.setStatus("select a box first");
-      b[name] = name === "failure" ? !b.failure : (b.occluded ? 0 : 1);
+      if (name === "failure") b.failure = !b.failure;
+      else b.occluded = isOccluded(b) ? 0 : 1;
       this.emitBox(b);
-      this.setStatus(`#${b.track_id} ${b.part}: ${name} ${b[name] ? "on" : "off"}`);
+      const on = name === "failure" ? b.failure : isOccluded(b);
+      this.setStatus(`#${b.track_id} ${b.part}: ${name} ${on ? "on" : "off"}`);
       this.render();
     }
   }
