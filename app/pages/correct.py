@@ -13,6 +13,7 @@ from app.box_editor import box_editor
 from app.editing import apply_events
 from app.pages.common import bound_widget, job_panel, pick_clip, require_project
 from app.runs import missing, next_human_frame, start_tracking
+from labelling.store import Store
 from labelling.video import VideoClip, VideoError
 from tracking.parts import PART_NAMES
 
@@ -28,6 +29,13 @@ st.session_state[fkey] = state.frame(clip.id, clip.frame_count)
 @st.cache_resource(max_entries=8)
 def video(path: str) -> VideoClip:
     return VideoClip(path)
+
+
+@st.cache_data(max_entries=32, show_spinner=False)
+def track_ids(url: str, clip_id: int, n_runs: int, next_id: int) -> list[int]:
+    """The clip's track ids; reading every box takes a while on long clips, so this is
+    cached until a tracker run or a new track changes it (the arguments after the clip)."""
+    return sorted(set(Store(url).tracks(clip_id).track_id.astype(int).tolist()))
 
 
 def step(delta: int) -> None:
@@ -57,9 +65,10 @@ if occluder_mode:
                         frame_count=clip.frame_count, mode="occluders")
 else:
     boxes = s.frame_boxes(clip.id, frame)
-    tracks = sorted(set(s.tracks(clip.id).track_id.astype(int).tolist()))
+    next_id = s.next_track_id(clip.id)
+    tracks = track_ids(s.url, clip.id, len(s.runs(clip.id)), next_id)
     events = box_editor(image, boxes, key=state.editor_key(clip.id), frame=frame, frame_count=clip.frame_count,
-                        tracks=tracks, next_track_id=s.next_track_id(clip.id), parts=PART_NAMES)
+                        tracks=tracks, next_track_id=next_id, parts=PART_NAMES)
 
 if events:
     result = apply_events(s, clip.id, events, history, author=state.author())

@@ -89,82 +89,107 @@ def scene(tmp_path):
     return clip, read_tracks_csv(out / "truth.csv")
 
 
-def test_upload_track_drag_and_flag_in_the_browser(server, store, scene, tmp_path):
-    url, proc = server
-    clip_file, boxes = scene
-    boxes = boxes.drop(columns=["source"])
+@pytest.fixture
+def page(tmp_path):
+    """A chromium page; its last view is kept as tmp_path/last.png (next to the app's
+    server.log) to see where a failed run stopped."""
     with playwright.sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
         page = browser.new_page(viewport={"width": 1280, "height": 1000})
         page.set_default_timeout(30_000)
-        page.goto(url)
+        try:
+            yield page
+        finally:
+            try:
+                page.screenshot(path=str(tmp_path / "last.png"), full_page=True)
+            except playwright.Error:
+                pass
+            browser.close()
 
-        # a project and the clip (the demo project may be there already; make our own)
-        page.get_by_text("New project").first.wait_for()
-        page.wait_for_timeout(500)
-        if not page.get_by_label("Project name").is_visible():  # expanded when there is no project yet
-            page.get_by_text("New project").first.click()
-        page.get_by_label("Project name").fill("browser")
-        page.get_by_role("button", name="Create project").click()
-        page.get_by_text("Created project 'browser'.").wait_for()
-        page.get_by_text("Project: browser").wait_for()
-        page.locator("input[type=file]").first.set_input_files(str(clip_file))
-        page.get_by_text("Added walker.mp4: 12 frames").wait_for()
-        project = store.project_by_name("browser")
-        [clip] = store.clips(project.id)
 
-        # track: start from the init boxes of frame 0 (or, until the tracker lands, import all boxes)
-        page.get_by_role("link", name="Track").click()
-        page.get_by_test_id("stExpander").get_by_text("Import boxes from a tracks CSV").click()
-        init = boxes if missing("app.pipeline") else boxes[boxes.frame == 0]
-        init.to_csv(tmp_path / "init.csv", index=False)
-        page.locator("input[type=file]").last.set_input_files(str(tmp_path / "init.csv"))
-        page.get_by_role("button", name="Store these boxes as a tracker run").click()
-        page.get_by_text(f"Stored {len(init)} boxes as run").wait_for()
-        if not missing("app.pipeline"):
-            page.get_by_text("the stored boxes of frame 0").click()
-            page.get_by_role("button", name="Track the whole clip").click()
-            page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)
-            assert store.runs(clip.id).tracker.tolist() == ["import", "body"]
-            assert store.tracks(clip.id).frame.max() == 11  # the tracker followed the walker to the end
-        head0 = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
+def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, tmp_path):
+    url, proc = server
+    clip_file, boxes = scene
+    boxes = boxes.drop(columns=["source"])
+    page.goto(url)
 
-        # correct: drag the head box of frame 0 right and down, then press F
-        page.get_by_role("link", name="Correct").click()
-        head = page.locator('rect[data-part="head"][data-track="1"]').first
-        head.wait_for()
-        page.wait_for_timeout(500)
-        bb = head.bounding_box()
-        scale = 320 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
-        cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
-        page.mouse.move(cx, cy)
-        page.mouse.down()
-        page.mouse.move(cx + 15, cy + 10, steps=4)
-        page.mouse.move(cx + 30, cy + 20, steps=4)
-        page.mouse.up()
-        page.keyboard.press("f")
+    # a project and the clip (the demo project may be there already; make our own)
+    page.get_by_text("New project").first.wait_for()
+    page.wait_for_timeout(500)
+    if not page.get_by_label("Project name").is_visible():  # expanded when there is no project yet
+        page.get_by_text("New project").first.click()
+    page.get_by_label("Project name").fill("browser")
+    page.get_by_role("button", name="Create project").click()
+    page.get_by_text("Created project 'browser'.").wait_for()
+    page.get_by_text("Project: browser").wait_for()
+    page.locator("input[type=file]").first.set_input_files(str(clip_file))
+    page.get_by_text("Added walker.mp4: 12 frames").wait_for()
+    project = store.project_by_name("browser")
+    [clip] = store.clips(project.id)
 
-        def saved():
-            df = store.frame_boxes(clip.id, 0)
-            row = df[(df.part == "head") & (df.track_id == 1)]
-            return [row.iloc[0]] if len(row) and bool(row.iloc[0].failure) else None
+    # track: start from the init boxes of frame 0 (or, until the tracker lands, import all boxes)
+    page.get_by_role("link", name="Track").click()
+    page.get_by_test_id("stExpander").get_by_text("Import boxes from a tracks CSV").click()
+    init = boxes if missing("app.pipeline") else boxes[boxes.frame == 0]
+    init.to_csv(tmp_path / "init.csv", index=False)
+    page.locator("input[type=file]").last.set_input_files(str(tmp_path / "init.csv"))
+    page.get_by_role("button", name="Store these boxes as a tracker run").click()
+    page.get_by_text(f"Stored {len(init)} boxes as run").wait_for()
+    if not missing("app.pipeline"):
+        page.get_by_text("the stored boxes of frame 0").click()
+        page.get_by_role("button", name="Track the whole clip").click()
+        page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)
+        assert store.runs(clip.id).tracker.tolist() == ["import", "body"]
+        assert store.tracks(clip.id).frame.max() == 11  # the tracker followed the walker to the end
+    head0 = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
 
-        [head1] = _wait_for(saved, what="the moved and flagged head box in the store")
-        assert head1.source == "human" and int(head1.revision) == 2
-        assert head1.x - head0.x == pytest.approx(30 * scale, abs=1.0)
-        assert head1.y - head0.y == pytest.approx(20 * scale, abs=1.0)
-        assert (head1.w, head1.h) == (head0.w, head0.h)
-        page.get_by_text("head FAIL").first.wait_for()
+    # correct: drag the head box of frame 0 right and down, then press F
+    page.get_by_role("link", name="Correct").click()
+    head = page.locator('rect[data-part="head"][data-track="1"]').first
+    head.wait_for()
+    page.wait_for_timeout(500)
+    bb = head.bounding_box()
+    scale = 320 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
+    cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
+    page.mouse.move(cx, cy)
+    page.mouse.down()
+    page.mouse.move(cx + 15, cy + 10, steps=4)
+    page.mouse.move(cx + 30, cy + 20, steps=4)
+    page.mouse.up()
+    page.keyboard.press("f")
 
-        shot = ROOT / "docs" / "correct.png" if os.environ.get("PARTLAB_SCREENSHOT") == "1" \
-            else tmp_path / "correct.png"
-        shot.parent.mkdir(parents=True, exist_ok=True)
-        page.screenshot(path=str(shot), full_page=True)
-        assert shot.stat().st_size > 10_000
-        browser.close()
+    def saved():
+        df = store.frame_boxes(clip.id, 0)
+        row = df[(df.part == "head") & (df.track_id == 1)]
+        return [row.iloc[0]] if len(row) and bool(row.iloc[0].failure) else None
+
+    [head1] = _wait_for(saved, what="the moved and flagged head box in the store")
+    assert head1.source == "human" and int(head1.revision) == 2
+    assert head1.x - head0.x == pytest.approx(30 * scale, abs=1.0)
+    assert head1.y - head0.y == pytest.approx(20 * scale, abs=1.0)
+    assert (head1.w, head1.h) == (head0.w, head0.h)
+    page.get_by_text("head FAIL").first.wait_for()
+
+    # undo (Ctrl+Z) takes the flag back off as a new revision; redo (Ctrl+Y) puts it on again
+    def head_now():
+        df = store.frame_boxes(clip.id, 0)
+        return df[(df.part == "head") & (df.track_id == 1)].iloc[0]
+
+    page.keyboard.press("Control+z")
+    _wait_for(lambda: int(head_now().revision) == 3, what="the undo")
+    assert not bool(head_now().failure) and head_now().x == head1.x
+    page.keyboard.press("Control+y")
+    _wait_for(lambda: int(head_now().revision) == 4, what="the redo")
+    assert bool(head_now().failure) and head_now().x == head1.x
+
+    shot = ROOT / "docs" / "correct.png" if os.environ.get("PARTLAB_SCREENSHOT") == "1" \
+        else tmp_path / "correct.png"
+    shot.parent.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(shot), full_page=True)
+    assert shot.stat().st_size > 10_000
 
     # killing the app mid-session loses no saved edit
     proc.kill()
     proc.wait(10)
     [again] = _wait_for(saved, timeout=1, what="the edit after the app was killed")
-    assert (again.x, again.y, int(again.revision)) == (head1.x, head1.y, 2)
+    assert (again.x, again.y, bool(again.failure), int(again.revision)) == (head1.x, head1.y, True, 4)
