@@ -308,7 +308,7 @@ class Editor {
     if (!moved) { this.render(); return; }
     // a tenth of a pixel is plenty; a move keeps the box's size exactly
     for (const k of d.handle ? ["x", "y", "w", "h"] : ["x", "y"]) {
-      if (b[k] !== o[k]) b[k] = Math.round(b[k] * 10) / 10;
+      if (b[k] !== o[k] || d.isNew) b[k] = Math.round(b[k] * 10) / 10;
     }
     if (d.isNew && (b.w < MIN_SIZE || b.h < MIN_SIZE)) {
       this.boxes = this.boxes.filter((x) => x !== b);
@@ -318,8 +318,8 @@ class Editor {
     if (this.data.mode === "occluders") this.emitOccluders();
     else this.emitBox(b, d.isNew ? { added: true } : {});
     this.selected = keyOf(b);
-    this.setStatus(`${d.isNew ? "added" : "moved"} ${b.part} of #${b.track_id}: ` +
-      `x=${b.x} y=${b.y} w=${b.w} h=${b.h}`);
+    const what = this.data.mode === "occluders" ? "occluder region" : `${b.part} of #${b.track_id}`;
+    this.setStatus(`${d.isNew ? "added" : "changed"} ${what}: x=${b.x} y=${b.y} w=${b.w} h=${b.h}`);
     this.render();
   }
 
