@@ -4,6 +4,7 @@ Edits are written to the store as they are made (a refused stale edit says so); 
 frames are the decoder's frames by index, the same the tracker used.
 """
 
+import threading
 import time
 
 import streamlit as st
@@ -27,8 +28,16 @@ st.session_state[fkey] = state.frame(clip.id, clip.frame_count)
 
 
 @st.cache_resource(max_entries=8)
-def video(path: str) -> VideoClip:
-    return VideoClip(path)
+def video(path: str) -> tuple[VideoClip, threading.Lock]:
+    """One open decoder per clip, shared by the sessions (seeking is the slow part);
+    the lock keeps two sessions from moving the same decoder at once."""
+    return VideoClip(path), threading.Lock()
+
+
+def read_frame(path: str, index: int):
+    clip_reader, lock = video(path)
+    with lock:
+        return clip_reader.read(index)
 
 
 @st.cache_data(max_entries=32, show_spinner=False)
@@ -53,7 +62,7 @@ occluder_mode = c5.toggle("Edit occluder regions", key=f"occluders:{clip.id}",
 frame = st.session_state[fkey]
 
 try:
-    image = video(str(clip.path)).read(frame)
+    image = read_frame(str(clip.path), frame)
 except (VideoError, IndexError) as exc:
     st.error(f"Cannot show frame {frame}: {exc}")
     st.stop()

@@ -171,3 +171,10 @@ def test_evaluate_page_compares_two_runs_against_the_truth(store, tracked_clip, 
     at.run()
     assert not at.exception
     assert len(at.get("plotly_chart")) == 3  # two rate curves and the trajectories
+
+
+def test_pages_without_a_project_say_what_to_do_first():
+    for name in ("track", "correct", "train", "evaluate"):
+        at = page(name)
+        assert not at.exception, name
+        assert any("No project yet" in i for i in texts(at, "info")), name
