@@ -61,4 +61,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":  # python -m app.cli
-    sys.exit(main())
+    # Run the imported module's main, not this __main__ copy: commands raise app.cli.CommandError,
+    # which is a different class from __main__.CommandError.
+    from app.cli import main as _main
+
+    sys.exit(_main())

@@ -19,7 +19,7 @@ def make_truth() -> pd.DataFrame:
     for t in range(N):
         people = [(0, 10.0 + 2.5 * t, 20.0)]
         if not 8 <= t <= 11:
-            people.append((3, 120.0 - 1.5 * t + (30.0 if t > 15 else 0.0), 25.5))
+            people.append((3, 120.0 - 1.5 * t + (50.0 if t > 15 else 0.0), 25.5))
         for tid, x, y in people:
             parts = {"person": (x, y, 24.0, 80.0), "head": (x + 7.0, y, 10.0, 12.0),
                      "torso": (x + 2.0, y + 12.0, 20.0, 30.0), "hipleg": (x + 2.0, y + 42.0, 20.0, 38.0)}
