@@ -8,8 +8,9 @@ it lies on the true box and its centre is inside the true box. The rate at frame
 correct; the denominator varies with ``i`` because people stay in view for different
 times. The averaged rate is the mean of that curve over offsets. The person MBR rate
 compares the minimum bounding rectangle of the tracked head, torso and hip-leg with
-that of the true ones (seed 002 Fig. 4 (d)); truth or tracks without body parts (a
-whole-body tracker) use their ``person`` boxes instead. (For rectangles "half on the true box" already implies the centre lies
+that of the true ones (seed 002 Fig. 4 (d)), where at least two of the three are
+present; truth or tracks without body parts (a whole-body tracker) use their
+``person`` boxes instead. (For rectangles "half on the true box" already implies the centre lies
 in it, closed; the centre test is kept because the definition names it.)
 
 Tracks are matched to truth by ``track_id`` when the ids agree (runs from ``--init``
@@ -187,11 +188,17 @@ def match_tracks(truth: pd.DataFrame, tracks: pd.DataFrame, how: str = "auto") -
     return "iou", out
 
 
+MIN_MBR_PARTS = 2  # a single body part (e.g. the head of a limb tracker) is no person box
+
+
 def _mbr(df: pd.DataFrame, parts) -> pd.DataFrame:
-    """Minimum bounding rectangle per (frame, track_id) of the rows whose part is in ``parts``."""
+    """Minimum bounding rectangle per (frame, track_id) of the rows whose part is in ``parts``
+    (only where at least :data:`MIN_MBR_PARTS` of them are present)."""
     d = df[df["part"].isin(parts)]
     g = d.assign(x2=d["x"] + d["w"], y2=d["y"] + d["h"]).groupby(["frame", "track_id"])
-    out = g.agg(x=("x", "min"), y=("y", "min"), x2=("x2", "max"), y2=("y2", "max")).reset_index()
+    out = g.agg(x=("x", "min"), y=("y", "min"), x2=("x2", "max"), y2=("y2", "max"),
+                n=("part", "size")).reset_index()
+    out = out[out["n"] >= MIN_MBR_PARTS]
     out["w"] = out["x2"] - out["x"]
     out["h"] = out["y2"] - out["y"]
     return out[["frame", "track_id"] + XYWH]

@@ -90,3 +90,16 @@ def test_import_refuses_a_clip_with_another_frame_count(tmp_path, exported, trut
     with pytest.raises(FormatError, match="the clip has 12 frames but the annotations were made on a clip of 20"):
         import_dataset(exported, "cvat", video=short)
     assert len(import_dataset(exported, "cvat", video=clip[1])) == len(truth)
+
+
+def test_import_from_a_zip_of_the_export(tmp_path, exported, truth):
+    import shutil
+    import zipfile
+
+    archive = shutil.make_archive(str(tmp_path / "export"), "zip", exported.parent, exported.name)
+    pd.testing.assert_frame_equal(import_dataset(archive, "cvat"), truth)
+    evil = tmp_path / "evil.zip"
+    with zipfile.ZipFile(evil, "w") as z:
+        z.writestr("../annotations.xml", "<annotations/>")
+    with pytest.raises(FormatError, match="climbs out of the target"):
+        import_dataset(evil, "cvat")
