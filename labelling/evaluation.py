@@ -9,8 +9,8 @@ correct; the denominator varies with ``i`` because people stay in view for diffe
 times. The averaged rate is the mean of that curve over offsets. The person MBR rate
 compares the minimum bounding rectangle of the tracked head, torso and hip-leg with
 that of the true ones (seed 002 Fig. 4 (d)), where at least two of the three are
-present; truth or tracks without body parts (a whole-body tracker) use their
-``person`` boxes instead. (For rectangles "half on the true box" already implies the centre lies
+present in the truth; tracks without body parts (a whole-body tracker) are judged by
+their ``person`` boxes, as in that figure. (For rectangles "half on the true box" already implies the centre lies
 in it, closed; the centre test is kept because the definition names it.)
 
 Tracks are matched to truth by ``track_id`` when the ids agree (runs from ``--init``
@@ -244,7 +244,7 @@ def evaluate(truth_df: pd.DataFrame, tracks_df: pd.DataFrame, at: int = DEFAULT_
 
     judged = _judge(truth, matched, ["frame", "track_id", "part"])
     judged["column"] = judged["part"]
-    truth_person = _person_boxes(truth, prefer_person=not truth["part"].isin(BODY_PARTS).any())
+    truth_person = _mbr(truth, BODY_PARTS)  # no body parts: the "person" column already says it all
     if len(truth_person):
         track_person = _person_boxes(matched, prefer_person=not tracks["part"].isin(BODY_PARTS).any())
         pj = _judge(truth_person, track_person, ["frame", "track_id"])
@@ -318,13 +318,16 @@ def mot_metrics(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame:
 
 
 def hota_metrics(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame | None:
-    """HOTA, DetA, AssA per part (TrackEval at alpha-averaged thresholds), or None without TrackEval."""
+    """HOTA, DetA, AssA per part and overall (TrackEval, averaged over its IoU thresholds
+    0.05..0.95), or None when TrackEval is not installed. TrackEval is optional: its PyPI
+    metadata pins ``opencv-python``, which clashes with our headless OpenCV, so ``make test``
+    installs it with ``--no-deps`` (its metrics need only numpy and scipy)."""
     try:
         from trackeval.metrics import HOTA
     except Exception:  # not installed, or broken against this numpy
         return None
     metric = HOTA()
-    rows = {}
+    results = {}
     for p in [p for p in PART_NAMES if p in set(truth["part"])]:
         t, k = truth[truth["part"] == p], tracks[tracks["part"] == p]
         frames = sorted(set(t["frame"]) | set(k["frame"]))
@@ -341,9 +344,13 @@ def hota_metrics(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame | No
             data["gt_ids"].append(a["track_id"].map(t_ids).to_numpy(dtype=int))
             data["tracker_ids"].append(b["track_id"].map(k_ids).to_numpy(dtype=int))
             data["similarity_scores"].append(iou_xywh(a[XYWH].to_numpy(), b[XYWH].to_numpy()))
-        res = metric.eval_sequence(data)
-        rows[p] = {"hota": float(np.mean(res["HOTA"])), "deta": float(np.mean(res["DetA"])),
-                   "assa": float(np.mean(res["AssA"]))}
+        results[p] = metric.eval_sequence(data)
+    if len(results) > 1:
+        results["overall"] = metric.combine_sequences(dict(results))
+    else:
+        results["overall"] = next(iter(results.values()))
+    rows = {name: {"hota": float(np.mean(r["HOTA"])), "deta": float(np.mean(r["DetA"])),
+                   "assa": float(np.mean(r["AssA"]))} for name, r in results.items()}
     return pd.DataFrame.from_dict(rows, orient="index")
 
 

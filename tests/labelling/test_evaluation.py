@@ -153,3 +153,34 @@ def test_bad_input():
         evaluate(truth.iloc[:0], tr)
     with pytest.raises(EvaluationError, match="tracks: 1 repeated"):
         evaluate(truth, pd.concat([tr, tr.iloc[[0]]]))
+
+
+def test_eval_matches_motmetrics_published_numbers_on_tud():
+    """motmetrics ships TUD-Campus/Stadtmitte truth and a tracker's output with the MOTChallenge
+    devkit's numbers in its own tests; our MOT importer and evaluate must reproduce them."""
+    from pathlib import Path
+
+    from labelling.formats import import_dataset
+
+    data = Path(mm.__file__).parent / "data"
+    published = {"TUD-Campus": (0.526462, 0.557659, 0.277201, 7, 13, 150),
+                 "TUD-Stadtmitte": (0.564014, 0.644619, 0.345904, 7, 45, 452)}
+    for seq, (mota, idf1, motp, switches, fp, fn) in published.items():
+        gt = import_dataset(data / seq / "gt.txt", "mot")
+        test = import_dataset(data / seq / "test.txt", "mot")
+        m = evaluate(gt, test, hota=False).mot.loc["person"]
+        assert (m.mota, m.idf1, m.motp) == pytest.approx((mota, idf1, motp), abs=1e-6)
+        assert (m.num_switches, m.num_false_positives, m.num_misses) == (switches, fp, fn)
+
+
+def test_hota_known_by_hand():
+    pytest.importorskip("trackeval")
+    # one person tracked perfectly but under id 5 for frames 0-1 and id 6 for frames 2-3:
+    # DetA = 1, AssA = 2 / (2 + 2 + 0) = 0.5, HOTA = sqrt(DetA * AssA)
+    truth = tracks([(f, 1, "head", 0, 0, 10, 10) for f in range(4)])
+    tr = tracks([(f, 5 if f < 2 else 6, "head", 0, 0, 10, 10) for f in range(4)])
+    m = evaluate(truth, tr).mot
+    assert m.loc["head", "deta"] == pytest.approx(1.0)
+    assert m.loc["head", "assa"] == pytest.approx(0.5)
+    assert m.loc["head", "hota"] == pytest.approx(np.sqrt(0.5))
+    assert evaluate(truth, truth).mot.loc["overall", "hota"] == pytest.approx(1.0)
