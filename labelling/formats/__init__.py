@@ -8,6 +8,7 @@ The registry :data:`FORMATS` maps a format name to its module's ``export`` and
 
 from __future__ import annotations
 
+import shutil
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,6 +68,12 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise FormatError(f"{out}: exists and is not a directory; -o names the output directory")
+    if out.is_dir() and any(out.iterdir()):
+        if ExportManifest.read(out) is None:
+            raise FormatError(f"{out}: the directory is not empty and holds no partlab export; choose a new or "
+                              "empty directory (a previous partlab export there is replaced)")
+        for child in out.iterdir():  # a previous export of ours: replace it, so no stale frames stay
+            shutil.rmtree(child) if child.is_dir() and not child.is_symlink() else child.unlink()
     if frames and video_path is None and fmt != "parquet":
         raise FormatError(f"writing frames for {fmt} needs the video (or pass frames=False / --no-frames)")
     return f.export(tracks_df, out, video_info, video_path=video_path, every=every,

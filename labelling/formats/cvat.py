@@ -176,6 +176,10 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         label = t.get("label", "")
         part = map_label(label, names)
         boxes = t.findall("box")
+        others = [c.tag for c in t if c.tag != "box"]
+        if others:
+            key = f"<{others[0]}> shapes (only boxes are read)"
+            skipped[key] = skipped.get(key, 0) + len(others)
         if part is None:
             skipped[label] = skipped.get(label, 0) + len(boxes)
             continue
