@@ -21,7 +21,8 @@ from labelling.formats import coco, cvat, mot, parquet, voc, yolo
 from labelling.formats.base import ExportManifest, FormatError, check_frame_count
 from labelling.video import VideoInfo, probe
 
-__all__ = ["FORMATS", "IMPORT_FORMATS", "FormatError", "Format", "export_dataset", "import_dataset"]
+__all__ = ["FORMATS", "IMPORT_FORMATS", "FormatError", "Format", "export_dataset", "import_dataset", "export_clip",
+           "export_project"]
 
 
 @dataclass(frozen=True)
@@ -118,3 +119,26 @@ def import_dataset(path, fmt: str, mapping=None, video=None) -> pd.DataFrame:
                 root = entries[0]
             return _import_dir(root, f, mapping, video)
     return _import_dir(p, f, mapping, video)
+
+
+def _clip_dir_name(clip) -> str:
+    stem = "".join(c if c.isalnum() or c in "-_." else "_" for c in Path(clip.name).stem) or "clip"
+    return f"{clip.id:04d}_{stem}"
+
+
+def export_clip(store, clip_id: int, fmt: str, out_dir, every: int = 1, frames: bool = True) -> Path:
+    """Export a clip of the annotation store (its effective boxes: tracker boxes under human
+    edits) against the frame count and fps recorded when the clip was added; marks it exported."""
+    clip = store.clip(clip_id)
+    info = VideoInfo(clip.path, clip.fps, clip.width, clip.height, clip.frame_count)
+    out = export_dataset(store.tracks(clip_id), fmt, out_dir, info, video_path=clip.path, every=every,
+                         frames=frames)
+    store.mark_exported(clip_id)
+    return out
+
+
+def export_project(store, project_id: int, fmt: str, out_dir, every: int = 1, frames: bool = True) -> list[Path]:
+    """Export every clip of a project, each into ``out_dir/<clip id>_<clip name>/``."""
+    out = Path(out_dir)
+    return [export_clip(store, c.id, fmt, out / _clip_dir_name(c), every=every, frames=frames)
+            for c in store.clips(project_id)]
