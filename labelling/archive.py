@@ -71,13 +71,14 @@ def safe_extract(archive: str | os.PathLike, dest: str | os.PathLike, *, max_byt
                  max_members: int = MAX_MEMBERS) -> Path:
     """Unpack a zip or tar archive into ``dest`` (created); returns ``dest``.
 
-    Raises :class:`ArchiveError` naming the offending member; on error the partial
-    content is removed from ``dest``.
+    Raises :class:`ArchiveError` naming the offending member; on error what this call
+    wrote into ``dest`` is removed (what was there before is kept).
     """
     archive = Path(archive)
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     root = dest.resolve()
+    before = set(root.iterdir())
     try:
         if zipfile.is_zipfile(archive):
             _extract_zip(archive, root, max_bytes, max_members)
@@ -86,7 +87,7 @@ def safe_extract(archive: str | os.PathLike, dest: str | os.PathLike, *, max_byt
         else:
             raise ArchiveError(f"{archive}: not a zip or tar archive")
     except ArchiveError:
-        for child in root.iterdir():
+        for child in set(root.iterdir()) - before:  # only what this call wrote
             shutil.rmtree(child) if child.is_dir() and not child.is_symlink() else child.unlink()
         raise
     except (zipfile.BadZipFile, tarfile.TarError, EOFError, OSError) as exc:

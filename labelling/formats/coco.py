@@ -123,7 +123,9 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         if not (isinstance(bbox, list) and len(bbox) == 4):
             raise FormatError(f"{js}: annotation {a.get('id')} has no [x, y, w, h] bbox")
         attrs = a.get("attributes") if isinstance(a.get("attributes"), dict) else {}
-        track_id = a.get("track_id", attrs.get("track_id", a.get("id")))
+        track_id = a.get("track_id", attrs.get("track_id"))
+        if track_id is None:
+            track_id = a.get("id", len(rows))
         score = attrs.get("score", a.get("score"))
         occlusion = attrs.get("occlusion", 1.0 if attrs.get("occluded") else 0.0)
         rows.append({

@@ -26,7 +26,7 @@ from defusedxml.common import DefusedXmlException
 
 from labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
                                     prepare_tracks, select_frames)
-from labelling.formats.frames import frame_name, write_frames
+from labelling.formats.frames import all_frames, frame_name, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
 
@@ -115,8 +115,8 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
                 _box(track, r._replace(frame=gap), outside=True)
     ET.indent(root, space="  ")
     ET.ElementTree(root).write(out_dir / FILE_NAME, encoding="utf-8", xml_declaration=True)
-    if frames:
-        write_frames(video_path, info, keep, out_dir / "images", name=frame_name)
+    if frames:  # a CVAT task holds every frame (meta size), thinned by --every
+        write_frames(video_path, info, all_frames(info, every), out_dir / "images", name=frame_name)
     ExportManifest.for_video(NAME, info, every, frames,
                              notes="CVAT track group_id = track_id + 1").write(out_dir)
     return out_dir

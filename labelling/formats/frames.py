@@ -20,6 +20,12 @@ def frame_name(frame: int) -> str:
     return f"frame_{int(frame):06d}"
 
 
+def all_frames(info: VideoInfo, every: int = 1) -> np.ndarray:
+    """Every ``every``-th decoder index of the clip: the frames of a MOT sequence or CVAT task.
+    (COCO, YOLO and VOC write only annotated frames: an unannotated frame is unlabelled, not empty.)"""
+    return np.arange(0, info.frame_count, every)
+
+
 def write_frames(video_path, info: VideoInfo, frames: np.ndarray, out_dir: Path,
                  name: Callable[[int], str] = frame_name, ext: str = ".jpg") -> dict[int, Path]:
     """Decode ``video_path`` once and write the listed frames to ``out_dir/name(frame)+ext``.

@@ -23,7 +23,7 @@ import pandas as pd
 
 from labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
                                     prepare_tracks, select_frames)
-from labelling.formats.frames import write_frames
+from labelling.formats.frames import all_frames, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
 
@@ -68,8 +68,8 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     }
     with open(out_dir / "seqinfo.ini", "w", encoding="utf-8") as f:
         seq.write(f, space_around_delimiters=False)
-    if frames:
-        write_frames(video_path, info, keep, out_dir / "img1", name=lambda i: f"{i + 1:06d}")
+    if frames:  # img1/ is the whole sequence (seqLength frames), thinned by --every
+        write_frames(video_path, info, all_frames(info, every), out_dir / "img1", name=lambda i: f"{i + 1:06d}")
     ExportManifest.for_video(NAME, info, every, frames, notes=ID_RULE).write(out_dir)
     return out_dir
 
@@ -124,7 +124,9 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     skipped: dict[str, int] = {}
     with open(gt, newline="", encoding="utf-8") as f:
         for lineno, cells in enumerate(csv.reader(f), start=1):
-            cells = [c.strip() for c in cells if c.strip() != ""] if cells else []
+            cells = [c.strip() for c in cells]
+            while cells and cells[-1] == "":  # trailing commas
+                cells.pop()
             if not cells:
                 continue
             if len(cells) < 6:

@@ -3,9 +3,9 @@
 One XML per exported frame, an ``<object>`` per box named after the part. VOC boxes are
 integer pixels, 1-based and inclusive (``xmin = x + 1``, ``xmax = x + w``), inside the
 image: boxes are clipped to the frame and ``truncated`` is 1 when clipping cut them.
-``occluded`` is 1 when ``occluded > 0``; ``difficult`` is 1 for boxes marked as tracker
-failures; the track id, source and failure flag are kept as ``<attributes>`` (as
-Datumaro writes them). ``labelmap.txt`` lists the parts so Datumaro reads our labels.
+``occluded`` is 1 when ``occluded > 0``; ``difficult`` is 0 (we do not guess what a
+``failure`` flag means to a detector); the track id, source, failure flag and occlusion
+fraction are kept as ``<attributes>`` (as Datumaro writes them). ``labelmap.txt`` lists the parts so Datumaro reads our labels.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ def _object(ann: ET.Element, r, box: np.ndarray, truncated: bool) -> None:
     ET.SubElement(obj, "pose").text = "Unspecified"
     ET.SubElement(obj, "truncated").text = "1" if truncated else "0"
     ET.SubElement(obj, "occluded").text = "1" if r.occluded > 0 else "0"
-    ET.SubElement(obj, "difficult").text = "1" if r.failure else "0"
+    ET.SubElement(obj, "difficult").text = "0"
     bnd = ET.SubElement(obj, "bndbox")
     x1, y1, x2, y2 = np.round(box).astype(int)
     for tag, v in (("xmin", x1 + 1), ("ymin", y1 + 1), ("xmax", x2), ("ymax", y2)):

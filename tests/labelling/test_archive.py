@@ -77,3 +77,13 @@ def test_not_an_archive(tmp_path):
     f.write_bytes(b"hello")
     with pytest.raises(ArchiveError, match="not a zip or tar archive"):
         safe_extract(f, tmp_path / "o")
+
+
+def test_a_refused_archive_leaves_earlier_content_alone(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "mine.txt").write_text("keep")
+    a = _zip(tmp_path / "a.zip", [("new/ok.txt", b"x"), ("../evil.txt", b"y")])
+    with pytest.raises(ArchiveError):
+        safe_extract(a, out)
+    assert [p.name for p in out.iterdir()] == ["mine.txt"]

@@ -120,3 +120,13 @@ def test_export_refuses_duplicates_and_frames_outside_the_clip(tmp_path, truth, 
         export_dataset(late, "mot", tmp_path / "b", info, frames=False)
     with pytest.raises(FormatError, match="needs the video"):
         export_dataset(truth, "mot", tmp_path / "c", info)
+
+
+def test_trailing_commas_and_no_frames(tmp_path, truth, clip):
+    f = tmp_path / "gt.txt"
+    f.write_text("2,3,11,21,5,6,1,1,1,,\n")
+    assert import_dataset(f, "mot")[["frame", "track_id", "x"]].values.tolist() == [[1, 3, 10]]
+    path, info = clip
+    out = export_dataset(truth.iloc[:4], "mot", tmp_path / "m", info, video_path=path, every=3)
+    # img1/ holds the whole sequence (thinned), not only the annotated frame 0
+    assert len(list((out / "img1").iterdir())) == 7  # frames 0, 3, ..., 18

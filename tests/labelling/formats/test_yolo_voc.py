@@ -40,7 +40,8 @@ def test_voc_read_by_datumaro_with_flags(tmp_path, truth, clip):
     assert a.attributes["occluded"] is True and a.attributes["truncated"] is False
     assert a.get_bbox() == pytest.approx([27.0, 32.0, 20.0, 30.0])  # x = 10 + 2.5*6 + 2
     assert anns[("frame_000017", "person", 3)].attributes["truncated"] is True
-    assert anns[("frame_000015", "head", 3)].attributes["difficult"] is True  # a marked tracker failure
+    failure = anns[("frame_000015", "head", 3)].attributes
+    assert failure["failure"] == "true" and failure["difficult"] is False  # a marked tracker failure
     # person 3, frames 16..19: all four parts cross x = 160 at 16 and 17, the head ends inside from 18 on
     assert sum(a.attributes["truncated"] for a in anns.values()) == 4 + 4 + 3 + 3
 
