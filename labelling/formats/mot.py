@@ -1,15 +1,17 @@
-"""MOTChallenge ground truth: ``seqinfo.ini``, ``gt/gt.txt``, ``labels.txt`` and optional ``img1/``.
+"""MOTChallenge ground truth: ``seqinfo.ini``, ``gt/gt.txt``, ``gt/labels.txt`` and optional ``img1/``.
 
 ``gt.txt`` rows are ``frame, id, x, y, w, h, conf, class, visibility`` (MOT16/17
 layout): frames, ids and pixel coordinates count from 1 (the devkit's Matlab convention,
 which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider the box), ``class`` is the
-1-based line of ``labels.txt`` naming the part, and ``visibility = 1 - occluded``.
+1-based line of ``gt/labels.txt`` naming the part (where Datumaro's ``mot_seq`` reads it), and ``visibility = 1 - occluded``.
 MOT ids must be unique per object, and each of our people has several parts, so the id
 of (track_id, part) is ``10 * track_id + part_index + 1`` (part_index in
 :data:`tracking.parts.PART_NAMES`); the importer inverts this for our own exports
 (recognised by ``partlab.json``). Foreign files keep their ids as track ids; rows with
 ``conf == 0`` in a ``gt.txt`` are ignored boxes in MOTChallenge and are skipped, and
-10-column MOT15 files (no class) are read as ``pedestrian``.
+10-column MOT15 files (no class) are read as ``pedestrian``. Datumaro copies MOT
+coordinates without the 1-pixel shift, so boxes it converted from another format into
+MOT come in one pixel up and left.
 """
 
 from __future__ import annotations
@@ -54,7 +56,7 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     with open(out_dir / "gt" / "gt.txt", "w", encoding="utf-8") as f:
         for r, i, c, v in zip(df.itertuples(index=False), ids, part_index, vis):
             f.write(f"{r.frame + 1},{i},{_num(r.x + 1)},{_num(r.y + 1)},{_num(r.w)},{_num(r.h)},1,{c + 1},{_num(v)}\n")
-    (out_dir / "labels.txt").write_text("".join(f"{p}\n" for p in PART_NAMES), encoding="utf-8")
+    (out_dir / "gt" / "labels.txt").write_text("".join(f"{p}\n" for p in PART_NAMES), encoding="utf-8")
     seq = configparser.ConfigParser()
     seq.optionxform = str  # MOT keys are camelCase
     seq["Sequence"] = {
@@ -115,8 +117,8 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     root = path if path.is_dir() else (gt.parent.parent if gt.parent.name == "gt" else gt.parent)
     manifest = ExportManifest.read(root)
     ours = manifest is not None and manifest.format == NAME
-    labels_path = root / "labels.txt"
-    labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path.is_file() else []
+    labels_path = next((p for p in (gt.parent / "labels.txt", root / "labels.txt") if p.is_file()), None)
+    labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path else []
     names = parse_mapping(mapping)
     names.setdefault("1", "person")  # MOT16/17 class 1 is 'pedestrian'
     is_gt = gt.name == "gt.txt"

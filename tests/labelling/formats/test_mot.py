@@ -25,7 +25,7 @@ def test_layout_states_the_clip(exported, clip):
     seq.read(exported / "seqinfo.ini")
     assert dict(seq["Sequence"]) == {"name": "clip", "imdir": "img1", "framerate": "10", "seqlength": "20",
                                      "imwidth": "160", "imheight": "120", "imext": ".jpg"}
-    assert (exported / "labels.txt").read_text().split() == list(PART_NAMES)
+    assert (exported / "gt" / "labels.txt").read_text().split() == list(PART_NAMES)
     images = sorted(p.name for p in (exported / "img1").iterdir())
     assert images[0] == "000001.jpg" and images[-1] == "000020.jpg" and len(images) == 20
 
@@ -130,3 +130,17 @@ def test_trailing_commas_and_no_frames(tmp_path, truth, clip):
     out = export_dataset(truth.iloc[:4], "mot", tmp_path / "m", info, video_path=path, every=3)
     # img1/ holds the whole sequence (thinned), not only the annotated frame 0
     assert len(list((out / "img1").iterdir())) == 7  # frames 0, 3, ..., 18
+
+
+def test_datumaro_reads_our_mot_and_we_read_datumaros(exported, truth, tmp_path):
+    from datumaro.components.dataset import Dataset
+
+    ds = Dataset.import_from(str(exported), "mot_seq")
+    names = [c.name for c in ds.categories()[list(ds.categories())[0]]]
+    anns = [a for item in ds for a in item.annotations]
+    assert len(anns) == len(truth) and sorted({names[a.label] for a in anns}) == ["head", "hipleg", "person", "torso"]
+    ds.export(str(tmp_path / "dm"), "mot_seq_gt")  # a MOT sequence written by another tool
+    back = import_dataset(tmp_path / "dm", "mot")
+    assert len(back) == len(truth) and (back["part"].value_counts() == 36).all()
+    # Datumaro keeps MOT's 1-based pixels as they are on both sides, so the boxes come back exactly
+    assert np.allclose(np.sort(back["x"]), np.sort(truth["x"]))
