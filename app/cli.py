@@ -61,8 +61,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":  # python -m app.cli
-    # Run the imported module's main, not this __main__ copy: commands raise app.cli.CommandError,
-    # which is a different class from __main__.CommandError.
+    # dispatch through the imported module, so that commands' ``app.cli.CommandError``
+    # is the class caught here (under ``-m`` this file is ``__main__``, a second copy)
     from app.cli import main as _main
 
     sys.exit(_main())
