@@ -3,7 +3,8 @@
 ``gt.txt`` rows are ``frame, id, x, y, w, h, conf, class, visibility`` (MOT16/17
 layout): frames, ids and pixel coordinates count from 1 (the devkit's Matlab convention,
 which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider the box), ``class`` is the
-1-based line of ``gt/labels.txt`` naming the part (where Datumaro's ``mot_seq`` reads it), and ``visibility = 1 - occluded``.
+1-based line of ``gt/labels.txt`` naming the part (where Datumaro's ``mot_seq`` reads
+it), and ``visibility = 1 - occluded``.
 MOT ids must be unique per object, and each of our people has several parts, so the id
 of (track_id, part) is ``10 * track_id + part_index + 1`` (part_index in
 :data:`tracking.parts.PART_NAMES`); the importer inverts this for our own exports

@@ -5,7 +5,8 @@ integer pixels, 1-based and inclusive (``xmin = x + 1``, ``xmax = x + w``), insi
 image: boxes are clipped to the frame and ``truncated`` is 1 when clipping cut them.
 ``occluded`` is 1 when ``occluded > 0``; ``difficult`` is 0 (we do not guess what a
 ``failure`` flag means to a detector); the track id, source, failure flag and occlusion
-fraction are kept as ``<attributes>`` (as Datumaro writes them). ``labelmap.txt`` lists the parts so Datumaro reads our labels.
+fraction are kept as ``<attributes>`` (as Datumaro writes them). ``labelmap.txt`` lists
+the parts so Datumaro reads our labels.
 """
 
 from __future__ import annotations

@@ -83,7 +83,8 @@ def test_ids_that_differ_are_matched_by_mean_iou():
 def test_mota_and_idf1_known_by_hand():
     # objects 1 and 2 over 4 frames (8 boxes). Tracker 10 follows 1 but misses frame 1 (1 miss),
     # 20 then 30 follow 2 (1 switch), 40 is a false positive at frame 3.
-    truth = tracks([(f, 1, "torso", 0, 0, 10, 10) for f in range(4)] + [(f, 2, "torso", 50, 0, 10, 10) for f in range(4)])
+    truth = tracks([(f, 1, "torso", 0, 0, 10, 10) for f in range(4)]
+                   + [(f, 2, "torso", 50, 0, 10, 10) for f in range(4)])
     tr = tracks([(f, 10, "torso", 1, 0, 10, 10) for f in (0, 2, 3)] + [(f, 20, "torso", 50, 0, 10, 10) for f in (0, 1)]
                 + [(f, 30, "torso", 50, 0, 10, 10) for f in (2, 3)] + [(3, 40, "torso", 100, 0, 10, 10)])
     m = evaluate(truth, tr, hota=False).mot.loc["torso"]

@@ -113,7 +113,8 @@ def test_bad_files_say_what_was_expected(tmp_path):
 
 def test_export_refuses_duplicates_and_frames_outside_the_clip(tmp_path, truth, clip):
     path, info = clip
-    with pytest.raises(FormatError, match=r"2 rows repeat a \(frame, track_id, part\), e.g. frame 0, track 0, part head"):
+    repeated = r"2 rows repeat a \(frame, track_id, part\), e.g. frame 0, track 0, part head"
+    with pytest.raises(FormatError, match=repeated):
         export_dataset(pd.concat([truth, truth.iloc[[1]]]), "mot", tmp_path / "a", info, frames=False)
     late = truth.assign(frame=truth["frame"] + 5)
     with pytest.raises(FormatError, match="outside the clip's 20 frames"):
