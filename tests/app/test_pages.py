@@ -178,3 +178,11 @@ def test_pages_without_a_project_say_what_to_do_first():
         at = page(name)
         assert not at.exception, name
         assert any("No project yet" in i for i in texts(at, "info")), name
+
+
+def test_play_steps_through_the_frames_to_the_end(store, tracked_clip):
+    project, clip = tracked_clip
+    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 8})
+    at.toggle(key=f"play:{clip.id}").set_value(True).run()
+    assert not at.exception
+    assert at.session_state[f"frame:{clip.id}"] == 11 and at.slider[0].value == 11
