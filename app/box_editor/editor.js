@@ -9,7 +9,7 @@
 // textContent, never parsed as HTML.
 
 const SVG_NS = "http://www.w3.org/2000/svg";
-const HANDLE_PX = 7; // handle half-size in screen pixels
+const HANDLE_PX = 4; // handle half-size in screen pixels (small: heads can be 10 px wide)
 const MIN_SIZE = 3;  // smallest box side in image pixels
 const INSTANCES = new WeakMap();
 
@@ -237,7 +237,7 @@ class Editor {
 
   hit(p) {
     const sel = this.selectedBox();
-    const s = HANDLE_PX * this.scale() * 1.5;
+    const s = HANDLE_PX * this.scale() * 2; // a grab area larger than the drawn handle
     if (sel) {
       for (const [name, x, y] of this.corners(sel)) {
         if (Math.abs(p[0] - x) <= s && Math.abs(p[1] - y) <= s) return { box: sel, handle: name };
