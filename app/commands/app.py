@@ -38,6 +38,7 @@ def streamlit_command(host: str, port: int) -> list[str]:
         "--server.fileWatcherType", "none",
         "--server.maxUploadSize", str(max_mb),
         "--server.runOnSave", "false",
+        "--client.toolbarMode", "minimal",  # no "Deploy" button: this is a local labelling tool
     ]
 
 

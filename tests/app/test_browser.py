@@ -193,3 +193,41 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     proc.wait(10)
     [again] = _wait_for(saved, timeout=1, what="the edit after the app was killed")
     assert (again.x, again.y, bool(again.failure), int(again.revision)) == (head1.x, head1.y, True, 4)
+
+
+def _drag(page, locator, dx: float, dy: float) -> None:
+    bb = locator.bounding_box()
+    cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
+    page.mouse.move(cx, cy)
+    page.mouse.down()
+    page.mouse.move(cx + dx / 2, cy + dy / 2, steps=3)
+    page.mouse.move(cx + dx, cy + dy, steps=3)
+    page.mouse.up()
+
+
+def test_a_stale_edit_from_a_second_session_is_refused_not_lost(server, page, store, scene):
+    url, _ = server
+    clip_file, boxes = scene
+    project = store.create_project("shared")  # before the app's first run: the first project
+    clip = store.add_clip(project.id, clip_file)
+    store.save_tracker_run(clip.id, boxes.drop(columns=["source"]))
+    second = page.context.browser.new_page(viewport={"width": 1280, "height": 1000})  # another session
+    second.set_default_timeout(30_000)
+    heads = []
+    for pg in (page, second):
+        pg.goto(url + "/correct")
+        heads.append(pg.locator('rect[data-part="head"][data-track="1"]').first)
+        heads[-1].wait_for()
+    before = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
+
+    _drag(page, heads[0], 20, 0)  # the first session moves the head right...
+    _wait_for(lambda: store.revision(clip.id, 0, 1, "head") == 1, what="the first session's edit")
+    _drag(second, heads[1], 0, 20)  # ...the second, which still shows the old box, moves it down
+    second.get_by_text("was changed by someone else (revision 1, you had 0)").wait_for()
+    after = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
+    assert int(after.revision) == 1 and after.x > before.x and after.y == before.y  # the first edit stands
+    # the refused session now shows the stored box and can apply its change again
+    _drag(second, heads[1], 0, 20)
+    _wait_for(lambda: store.revision(clip.id, 0, 1, "head") == 2, what="the second session's retry")
+    final = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
+    assert final.x == after.x and final.y > after.y
