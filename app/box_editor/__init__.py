@@ -73,10 +73,35 @@ def applied_key(key: str) -> str:
     return f"{key}:applied_seq"
 
 
+def _new_events(raw, key: str) -> list[dict]:
+    """Events above the last applied ``seq``, oldest first; marks them applied."""
+    done = int(st.session_state.get(applied_key(key), 0))
+    events = [e for e in (raw or []) if isinstance(e, dict) and int(e.get("seq", 0)) > done]
+    events.sort(key=lambda e: int(e["seq"]))
+    if events:
+        st.session_state[applied_key(key)] = int(events[-1]["seq"])
+    return events
+
+
+def pending_events(key: str) -> list[dict]:
+    """The editor's new events, read *before* it is drawn in this run.
+
+    A component's trigger values are visible in ``st.session_state[key]`` from the
+    start of the run it caused, so the page can apply them and draw the editor with
+    the result at once, instead of drawing stale boxes and rerunning.
+    """
+    try:
+        value = st.session_state[key]
+    except (KeyError, AttributeError):
+        return []
+    raw = value.get("events") if isinstance(value, dict) else None
+    return _new_events(raw, key)
+
+
 def box_editor(image: np.ndarray, boxes: pd.DataFrame | list[dict], *, key: str, frame: int, frame_count: int,
                tracks: list[int] | None = None, next_track_id: int = 1, parts: tuple[str, ...] = PART_NAMES,
                mode: str = "boxes", width: int | str = "stretch") -> list[dict]:
-    """Show the editor and return the new events since the last call (oldest first).
+    """Show the editor and return the new events not yet taken by :func:`pending_events`.
 
     ``boxes``: the frame's effective boxes (tracks CSV columns + ``revision``), or dicts
     ``{x, y, w, h}`` for ``mode="occluders"``.
@@ -94,8 +119,4 @@ def box_editor(image: np.ndarray, boxes: pd.DataFrame | list[dict], *, key: str,
                 tracks=sorted(int(t) for t in (tracks or [])), next_track_id=int(next_track_id), mode=mode,
                 applied_seq=done)
     result = _component()(key=key, data=data, width=width, on_events_change=lambda: None)
-    events = [e for e in (result.get("events") or []) if isinstance(e, dict) and int(e.get("seq", 0)) > done]
-    events.sort(key=lambda e: int(e["seq"]))
-    if events:
-        st.session_state[applied_key(key)] = int(events[-1]["seq"])
-    return events
+    return _new_events(result.get("events"), key)

@@ -10,7 +10,7 @@ import time
 import streamlit as st
 
 from app import state
-from app.box_editor import box_editor
+from app.box_editor import box_editor, pending_events
 from app.editing import apply_events
 from app.pages.common import bound_widget, job_panel, pick_clip, require_project
 from app.runs import missing, next_human_frame, start_tracking
@@ -51,14 +51,30 @@ def step(delta: int) -> None:
     st.session_state[fkey] = min(max(st.session_state[fkey] + delta, 0), last)
 
 
+history = state.history(clip.id)
+occluder_mode = bool(st.session_state.get(f"occluders:{clip.id}"))
+editor_key = state.editor_key(clip.id, "occluders" if occluder_mode else "boxes")
+
+
+def apply(events: list[dict]) -> None:
+    """Write the editor's events; the messages show above the editor on this run."""
+    result = apply_events(s, clip.id, events, history, author=state.author())
+    st.session_state.setdefault("correct_messages", []).extend(result.errors + result.notes)
+    if result.frame is not None:
+        st.session_state[fkey] = min(max(result.frame, 0), last)
+
+
+# events the user made since the last run are applied first, so the editor is drawn with their result
+apply(pending_events(editor_key))
+
 c1, c2, c3, c4, c5 = st.columns([5, 1, 1, 1.4, 2.6], vertical_alignment="bottom")
 with c1:
     bound_widget(st.slider, fkey, f"frame_slider:{clip.id}", "Frame", 0, max(last, 1), disabled=last == 0)
 c2.button("◀", on_click=step, args=(-1,), help="previous frame", width="stretch")
 c3.button("▶", on_click=step, args=(1,), help="next frame", width="stretch")
 playing = c4.toggle("Play", key=f"play:{clip.id}")
-occluder_mode = c5.toggle("Edit occluder regions", key=f"occluders:{clip.id}",
-                          help="regions that hide people (shelves, pillars); drawn once per clip")
+c5.toggle("Edit occluder regions", key=f"occluders:{clip.id}",
+          help="regions that hide people (shelves, pillars); drawn once per clip")
 frame = st.session_state[fkey]
 
 try:
@@ -67,26 +83,21 @@ except (VideoError, IndexError) as exc:
     st.error(f"Cannot show frame {frame}: {exc}")
     st.stop()
 
-history = state.history(clip.id)
+for message in st.session_state.pop("correct_messages", []):
+    (st.error if message.startswith("Not saved") else st.info)(message)
 if occluder_mode:
     regions = [dict(x=b.x, y=b.y, w=b.w, h=b.h) for b in s.occluders(clip.id)]
-    events = box_editor(image, regions, key=state.editor_key(clip.id, "occluders"), frame=frame,
-                        frame_count=clip.frame_count, mode="occluders")
+    events = box_editor(image, regions, key=editor_key, frame=frame, frame_count=clip.frame_count,
+                        mode="occluders")
 else:
     boxes = s.frame_boxes(clip.id, frame)
     next_id = s.next_track_id(clip.id)
     tracks = track_ids(s.url, clip.id, len(s.runs(clip.id)), next_id)
-    events = box_editor(image, boxes, key=state.editor_key(clip.id), frame=frame, frame_count=clip.frame_count,
+    events = box_editor(image, boxes, key=editor_key, frame=frame, frame_count=clip.frame_count,
                         tracks=tracks, next_track_id=next_id, parts=PART_NAMES)
-
-if events:
-    result = apply_events(s, clip.id, events, history, author=state.author())
-    st.session_state["correct_messages"] = result.errors + result.notes
-    if result.frame is not None:
-        st.session_state[fkey] = min(max(result.frame, 0), last)
+if events:  # events the early read did not see (not expected; kept so none is ever dropped)
+    apply(events)
     st.rerun()
-for message in st.session_state.pop("correct_messages", []):
-    (st.error if message.startswith("Not saved") else st.info)(message)
 
 progress = s.progress(clip.id)
 st.caption(f"Frame {frame} of {last} · {progress['corrected_frames']} corrected frames "
