@@ -69,7 +69,7 @@ apply(pending_events(editor_key))
 
 c1, c2, c3, c4, c5 = st.columns([5, 1, 1, 1.4, 2.6], vertical_alignment="bottom")
 with c1:
-    bound_widget(st.slider, fkey, f"frame_slider:{clip.id}", "Frame", 0, max(last, 1), disabled=last == 0)
+    bound_widget(st.slider, fkey, state.slider_key(clip.id), "Frame", 0, max(last, 1), disabled=last == 0)
 c2.button("◀", on_click=step, args=(-1,), help="previous frame", width="stretch")
 c3.button("▶", on_click=step, args=(1,), help="next frame", width="stretch")
 playing = c4.toggle("Play", key=f"play:{clip.id}")

@@ -149,8 +149,12 @@ def test_retrack_from_a_fix_stops_at_the_next_corrected_frame(store, tracked_cli
     assert job.status == "done", job.error
     assert (job.result["start"], job.result["stop"]) == (3, 8)
     after = store.tracks(clip.id)
-    keep = lambda df: df[(df.frame < 3) | (df.frame >= 8)].reset_index(drop=True)  # noqa: E731
-    assert keep(after)[["frame", "part", "x", "y", "source"]].equals(keep(before)[["frame", "part", "x", "y", "source"]])
+    cols = ["frame", "part", "x", "y", "source"]
+
+    def outside(df):  # frames before the fix and from the next corrected frame on
+        return df[(df.frame < 3) | (df.frame >= 8)].reset_index(drop=True)[cols]
+
+    assert outside(after).equals(outside(before))
     fixed = after[(after.frame == 3) & (after.part == "head")].iloc[0]
     assert (fixed.source, fixed.x) == ("human", head.x + 1)  # the fix itself is never overwritten
     assert set(after[(after.frame > 3) & (after.frame < 8)].source) == {"tracker"}
