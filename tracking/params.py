@@ -59,6 +59,47 @@ class BodyParams:
     min_person_height: float = 40.0
     min_person_width: float = 12.0
     part_noise: dict[str, PartNoise] = field(default_factory=_default_part_noise)
+    # seed 002 sec. 3.1 equalization: the reference is smoothed (Gaussian, in levels) and mixed
+    # with a uniform share before its quantiles become bin edges, so that colours next to a
+    # narrow peak (a plain shirt) still fall into distinct bins instead of all into one.
+    equalization_smoothing: float = 2.0
+    equalization_floor: float = 0.05
+    # New particles are spread by this many process-noise sigmas around the start box.
+    init_spread: float = 1.5
+    # A part's width and height stay within these factors of its size at (re)initialisation:
+    # the camera distance changes slowly, and unbounded sizes let a filter grow onto background.
+    size_range: tuple[float, float] = (0.75, 1.35)
+    # Background model (OpenCV MOG2, the adaptive Gaussian mixture of seed 002 sec. 4 [15]):
+    # history (frames), variance threshold, shadows dropped, computed at ``background_scale``
+    # of the frame size (the mask is only used for blobs and decomposition), then opened and
+    # closed with elliptic kernels (pixels at full size).
+    background_history: int = 300
+    background_var_threshold: float = 16.0
+    background_scale: float = 0.5
+    background_learning_rate: float = -1.0
+    morph_open: int = 3
+    morph_close: int = 9
+    # Automatic detection: a person-size blob must be seen this many frames running, overlap no
+    # tracked person by more than ``detection_overlap`` of its area, and have this fraction of
+    # foreground inside its box; a track ends after ``lost_frames`` frames without foreground
+    # support (fraction below ``support_min``) or when its box leaves the frame.
+    start_frames: int = 3
+    detection_overlap: float = 0.2
+    blob_fill_min: float = 0.25
+    max_person_aspect: float = 1.2
+    lost_frames: int = 10
+    support_min: float = 0.1
+    leave_fraction: float = 0.5
+    # Occlusion (sec. 4.3.1-4.3.2): two persons occlude each other when their boxes overlap by
+    # more than this fraction of the smaller; a part is behind an occluder region when that
+    # fraction of it is covered. The occluded one is tracked by dynamics, model frozen.
+    occlusion_overlap: float = 0.2
+    occluder_overlap: float = 0.3
+    # The appearance model is updated (eq. (1)) only when the estimate matches it at least this well
+    # (a part that slid onto background should not learn the background).
+    update_min_similarity: float = 0.6
+    # Failure detector input: how many past frames of part states are kept per person.
+    history_frames: int = 30
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -72,8 +113,9 @@ class BodyParams:
         data = dict(data)
         if "part_noise" in data:
             data["part_noise"] = {k: PartNoise(**v) for k, v in data["part_noise"].items()}
-        if "height_ratios" in data:
-            data["height_ratios"] = tuple(data["height_ratios"])
+        for name in ("height_ratios", "size_range"):
+            if name in data:
+                data[name] = tuple(data[name])
         return cls(**data)
 
 
