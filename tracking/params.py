@@ -76,7 +76,11 @@ class BodyParams:
     background_history: int = 300
     background_var_threshold: float = 16.0
     background_scale: float = 0.5
-    background_learning_rate: float = -1.0
+    # MOG2's own schedule learns at 1/(2n) in the first frames, which absorbs a walker into the
+    # background within a few frames; the rate is held at most 1/background_warmup instead, and a
+    # colour must take more than 1 - background_ratio of a pixel's weight before it is background.
+    background_warmup: int = 60
+    background_ratio: float = 0.7
     morph_open: int = 3
     morph_close: int = 9
     # Automatic detection: a person-size blob must be seen this many frames running, overlap no
@@ -84,17 +88,22 @@ class BodyParams:
     # foreground inside its box; a track ends after ``lost_frames`` frames without foreground
     # support (fraction below ``support_min``) or when its box leaves the frame.
     start_frames: int = 3
+    # blobs touching the frame border (people still entering) do not start tracks: their box
+    # would be cut and the decomposition wrong.
+    detection_border: int = 2
     detection_overlap: float = 0.2
     blob_fill_min: float = 0.25
     max_person_aspect: float = 1.2
     lost_frames: int = 10
     support_min: float = 0.1
     leave_fraction: float = 0.5
-    # Occlusion (sec. 4.3.1-4.3.2): two persons occlude each other when their boxes overlap by
-    # more than this fraction of the smaller; a part is behind an occluder region when that
+    # Occlusion (sec. 4.3.1-4.3.2): two persons occlude each other when parts of theirs overlap by
+    # more than ``occlusion_overlap`` of the smaller part and the touching parts' similarities to
+    # their models differ by at least ``occlusion_margin`` (the lower one is behind); a part is behind an occluder region when that
     # fraction of it is covered. The occluded one is tracked by dynamics, model frozen.
-    occlusion_overlap: float = 0.2
-    occluder_overlap: float = 0.3
+    occlusion_overlap: float = 0.1
+    occlusion_margin: float = 0.02
+    occluder_overlap: float = 0.1
     # The appearance model is updated (eq. (1)) only when the estimate matches it at least this well
     # (a part that slid onto background should not learn the background).
     update_min_similarity: float = 0.6
@@ -143,6 +152,9 @@ class LimbParams:
     lost_likelihood: float = 0.15
     lost_frames: int = 5
     start_frames: int = 3
+    # blobs touching the frame border (people still entering) do not start tracks: their box
+    # would be cut and the decomposition wrong.
+    detection_border: int = 2
     # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2), drop tiny ones
     blob_alpha: float = 1.0
     min_blob_area: float = 30.0
