@@ -53,7 +53,14 @@ def head_from_torso(torso: Box, hipleg: Box, previous: Box, mask: np.ndarray | N
     bottom = yt - 0.5 * ht
     region = Box(xt - wt, min(top, bottom), 2 * wt, abs(bottom - top))
     fg, x0, y0 = _foreground(mask, region, W, H)
-    rect = inner_rectangle(fg, x0, y0) if fg is not None and fg.mean() > 0.05 else None
+    rect = None
+    if fg is not None and fg.mean() > 0.05:
+        # the region reaches down to the torso's inner rectangle, i.e. over the shoulders: the
+        # head is the top of its foreground, about one previous head height (sec. 4.1's
+        # height-ratio step applied to this region)
+        rows = np.nonzero(fg.any(axis=1))[0]
+        span = max(int(round(1.2 * previous.h)), 2)
+        rect = inner_rectangle(fg[rows[0]:rows[0] + span], x0, y0 + rows[0])
     if rect is None:
         rect = Box(xt - previous.w / 2, bottom - previous.h, previous.w, previous.h)
     return rect

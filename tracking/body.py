@@ -270,9 +270,14 @@ class BodyTracker:
                 f.coast()
             return
         visible = [n for n in person.filters if n not in person.hidden_parts]
+        # the torso first: head and hip-leg are then kept near its centre line (coherence)
+        visible.sort(key=lambda n: n != "torso")
+        anchor, sigma = None, 0.0
         for name in visible:
             f = person.filters[name]
-            f.measure(ycc)
+            f.measure(ycc, anchor, sigma)
+            if name == "torso" and self.params.coherence > 0:
+                anchor, sigma = float(f.state[0]), self.params.coherence * float(f.state[2])
             person.observed[name] = q = f.appearance(ycc)
             person.scores[name] = f.score(q)
         if person.hidden_parts:

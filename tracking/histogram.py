@@ -19,6 +19,8 @@ independently, so the order does not matter.
 
 from __future__ import annotations
 
+from functools import lru_cache
+
 import cv2
 import numpy as np
 
@@ -98,13 +100,11 @@ def uniform_map(bins: int = 8) -> np.ndarray:
     return np.stack([row, row, row])
 
 
-def binned_histogram(reference_or_levels: np.ndarray, mapping: np.ndarray, bins: int = 8) -> np.ndarray:
+def binned_histogram(levels: np.ndarray, mapping: np.ndarray, bins: int = 8) -> np.ndarray:
     """A 256-level histogram ``(3, 256)`` pushed through ``mapping`` -> ``(3 * bins,)``,
     each channel's ``bins`` entries summing to its channel's mass."""
-    out = np.zeros((3, bins), dtype=np.float64)
-    for c in range(3):
-        np.add.at(out[c], mapping[c], reference_or_levels[c])
-    return out.reshape(-1)
+    index = (mapping.astype(np.intp) + (np.arange(3) * bins)[:, None]).ravel()
+    return np.bincount(index, weights=np.asarray(levels, dtype=np.float64).ravel(), minlength=3 * bins)
 
 
 def onehot_lut(mapping: np.ndarray, bins: int = 8) -> np.ndarray:
@@ -118,6 +118,39 @@ def onehot_lut(mapping: np.ndarray, bins: int = 8) -> np.ndarray:
     for c in range(3):
         lut[c, levels, c * bins + mapping[c].astype(np.intp)] = 1
     return lut
+
+
+@lru_cache(maxsize=4)
+def _code_planes(bins: int) -> np.ndarray:
+    codes = np.arange(bins ** 3)
+    b = np.stack([codes // (bins * bins), (codes // bins) % bins, codes % bins], axis=1)
+    planes = np.zeros((bins ** 3, 3 * bins), dtype=np.uint8)
+    for c in range(3):
+        planes[codes, c * bins + b[:, c]] = 1
+    planes.flags.writeable = False
+    return planes
+
+
+def fused_lut(mapping: np.ndarray, bins: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """The map as two tables for the integral histogram's hot loop.
+
+    ``channel_lut (1, 256, 3) uint8`` for ``cv2.LUT`` (each channel's level -> its bin) and
+    ``code_planes (bins**3, 3 * bins) uint8`` (shared by all targets): for a pixel's bin code
+    ``(b_Y * bins + b_Cr) * bins + b_Cb``, a one in columns ``b_Y``, ``bins + b_Cr`` and
+    ``2 bins + b_Cb``. One gather of ``code_planes`` gives all 24 one-hot planes.
+    """
+    channel_lut = np.ascontiguousarray(mapping.T[None, :, :], dtype=np.uint8)
+    return channel_lut, _code_planes(int(bins))
+
+
+def bhattacharyya_counts(counts: np.ndarray, areas: np.ndarray, sqrt_target: np.ndarray) -> np.ndarray:
+    """Fast ``rho`` for raw pixel counts ``(N, 3 * bins)`` of rectangles of ``areas (N,)`` pixels
+    against ``sqrt_target = sqrt(p)`` of a per-channel-normalised target: every channel of a
+    rectangle sums to its area, so ``rho = (sqrt(counts) . sqrt(p)) / (3 sqrt(area))``."""
+    rho = np.sqrt(counts) @ sqrt_target.astype(counts.dtype)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = rho / (3.0 * np.sqrt(areas))
+    return np.where(areas > 0, rho, 0.0)
 
 
 def bhattacharyya(candidates: np.ndarray, target: np.ndarray, bins: int = 8) -> np.ndarray:

@@ -107,6 +107,11 @@ class BodyParams:
     # The appearance model is updated (eq. (1)) only when the estimate matches it at least this well
     # (a part that slid onto background should not learn the background).
     update_min_similarity: float = 0.6
+    # Body coherence (not in the paper, which leaves this to the failure detector): head and
+    # hip-leg particle weights are multiplied by a Gaussian of their horizontal distance to the
+    # torso's centre, sigma = coherence x torso width, so that a head does not follow another
+    # person's head of the same skin colour. 0 turns it off (the paper's independent filters).
+    coherence: float = 1.0
     # Failure detector input: how many past frames of part states are kept per person.
     history_frames: int = 30
 

@@ -22,10 +22,11 @@ from tracking.box import Box
 from tracking.histogram import (
     binned_histogram,
     bhattacharyya,
+    bhattacharyya_counts,
     equalization_map,
+    fused_lut,
     level_histogram,
     likelihood,
-    onehot_lut,
     update_reference,
 )
 from tracking.integral_histogram import particle_rectangles, rectangle_histograms
@@ -79,8 +80,11 @@ class PartFilter:
         p = self.params
         self.mapping = equalization_map(self.reference, p.bins_per_channel, p.equalization_smoothing,
                                         p.equalization_floor)
-        self.lut = onehot_lut(self.mapping, p.bins_per_channel)
+        self.lut = fused_lut(self.mapping, p.bins_per_channel)
         self.target = binned_histogram(self.reference, self.mapping, p.bins_per_channel)
+        per_channel = self.target.reshape(3, -1)
+        per_channel = per_channel / np.maximum(per_channel.sum(axis=1, keepdims=True), 1e-12)
+        self.sqrt_target = np.sqrt(per_channel).reshape(-1)
 
     def _clip_sizes(self) -> None:
         lo, hi = self.params.size_range
@@ -110,15 +114,23 @@ class PartFilter:
         s[0:2] += s[4:6]
         return state_to_box(s)
 
-    def measure(self, ycc: np.ndarray) -> None:
+    def measure(self, ycc: np.ndarray, anchor_x: float | None = None, anchor_sigma: float = 0.0) -> None:
         """Weigh every particle by its colour likelihood (one integral histogram) and take
-        the weighted mean as the estimate."""
+        the weighted mean as the estimate.
+
+        With ``anchor_x`` and ``anchor_sigma > 0`` the weights are also multiplied by
+        ``exp(-0.5 ((X - anchor_x) / anchor_sigma)^2)``: a part of a body stays near the
+        body's axis (the torso's centre line) instead of following a look-alike part of
+        someone else (see ``BodyParams.coherence``)."""
         H, W = ycc.shape[:2]
         rects = particle_rectangles(self.particles, W, H)
         counts = rectangle_histograms(ycc, self.lut, rects)
-        rho = bhattacharyya(counts, self.target, self.params.bins_per_channel)
+        areas = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
         weights = likelihood(rho, self.noise.lam)
-        weights[(rects[:, 2] - rects[:, 0] < 2) | (rects[:, 3] - rects[:, 1] < 2)] = 0.0
+        weights[areas < 4] = 0.0
+        if anchor_x is not None and anchor_sigma > 0:
+            weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
         self.weights = normalise_weights(weights)
         self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
 

@@ -71,10 +71,13 @@ def test_torso_is_the_mean_of_head_and_hipleg_eq4():
 
 def test_head_and_hipleg_regions_use_the_foreground_or_geometry():
     mask = np.zeros((200, 100), np.uint8)
-    mask[20:40, 40:60] = 255          # a head blob above the torso
+    mask[20:34, 44:56] = 255          # a head blob above the torso
+    mask[34:60, 32:68] = 255          # shoulders and torso below it
     torso, hip = Box(35, 45, 30, 40), Box(38, 85, 24, 30)
     head = head_from_torso(torso, hip, Box(0, 0, 12, 12), mask, 100, 200)
-    assert head.centre == pytest.approx((50.0, 30.0), abs=0.6)
+    # the top 1.2 x 12 = 14 rows of the foreground: the head, not the shoulders
+    assert head.centre == pytest.approx((50.0, 27.0), abs=0.6)
+    assert head.w < 14
     # no foreground: the previous size straight above the torso
     head2 = head_from_torso(torso, hip, Box(0, 0, 12, 12), None, 100, 200)
     assert head2.as_tuple() == pytest.approx((44.0, 33.0, 12.0, 12.0))
