@@ -132,6 +132,7 @@ class BodyTracker:
         self.people: dict[int, Person] = {}
         self.next_id = max(self.starts, default=0) + 1
         self.candidates: list[tuple[Box, int]] = []
+        self.frames_seen = 0
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -152,6 +153,8 @@ class BodyTracker:
     def start_track(self, track_id: int, boxes: dict[str, Box], ycc: np.ndarray, mask: np.ndarray | None,
                     index: int) -> Person:
         """Start tracking a person from its boxes (person and/or part boxes)."""
+        if self.frames_seen < self.params.background_warmup // 2:
+            mask = None  # the background model has not learnt the scene yet: decompose by contrast
         parts = self._part_boxes_for_start(boxes, ycc, mask)
         H, W = ycc.shape[:2]
         filters = {}
@@ -199,6 +202,7 @@ class BodyTracker:
         p = self.params
         ycc = to_ycc(frame)
         H, W = ycc.shape[:2]
+        self.frames_seen += 1
         mask = foreground if foreground is not None else None
         new_ids = set()
         if self.pending:

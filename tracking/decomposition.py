@@ -17,13 +17,15 @@ above or below a torso to rebuild a lost head or hip-leg.
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 from tracking.box import Box
 from tracking.params import BodyParams
 
-#: below this share of foreground in the person's box the mask is not trusted
-#: (first frames of the background model, a person standing still): the whole box is used.
+#: below this share of foreground in the person's box the mask is not trusted (first frames
+#: of the background model, a person standing still): the box's colour contrast with its
+#: surroundings stands in for it (:func:`contrast_foreground`), else the whole box.
 MIN_FOREGROUND_SHARE = 0.15
 
 
@@ -38,6 +40,32 @@ def inner_rectangle(fg: np.ndarray, x0: float = 0.0, y0: float = 0.0, min_size: 
     return Box(x0 + cx - sx, y0 + cy - sy, 2 * sx, 2 * sy)
 
 
+def contrast_foreground(ycc: np.ndarray, x1: int, y1: int, x2: int, y2: int, ring: float = 0.3,
+                        levels: int = 16) -> np.ndarray:
+    """Foreground of the box ``[x1, x2) x [y1, y2)`` without a background model: pixels whose
+    colour (YCrCb quantised to ``levels`` per channel) is more frequent inside the box than
+    in a ring of ``ring`` x the box size around it. Used when a person box is given (an
+    init row) before the background model has learnt anything. ``(y2 - y1, x2 - x1) bool``."""
+    H, W = ycc.shape[:2]
+    bw, bh = x2 - x1, y2 - y1
+    rx1, ry1 = max(x1 - int(ring * bw), 0), max(y1 - int(ring * bh * 0.5), 0)
+    rx2, ry2 = min(x2 + int(ring * bw), W), min(y2 + int(ring * bh * 0.5), H)
+    shift = int(np.log2(256 // levels))
+    q = (ycc[ry1:ry2, rx1:rx2] >> shift).astype(np.int32)
+    codes = (q[..., 0] * levels + q[..., 1]) * levels + q[..., 2]
+    inside = np.zeros(codes.shape, dtype=bool)
+    inside[y1 - ry1:y2 - ry1, x1 - rx1:x2 - rx1] = True
+    n = levels ** 3
+    h_in = np.bincount(codes[inside], minlength=n).astype(np.float64)
+    h_out = np.bincount(codes[~inside], minlength=n).astype(np.float64)
+    if h_out.sum() == 0:
+        return np.ones((bh, bw), dtype=bool)
+    p_in = h_in / max(h_in.sum(), 1.0)
+    p_out = h_out / h_out.sum()
+    fg = (p_in > p_out)[codes[inside].reshape(bh, bw)]
+    return cv2.medianBlur(fg.astype(np.uint8) * 255, 3) > 0
+
+
 def _region(ycc: np.ndarray, mask: np.ndarray | None, box: Box):
     H, W = ycc.shape[:2]
     x1, y1 = max(int(round(box.x)), 0), max(int(round(box.y)), 0)
@@ -45,10 +73,9 @@ def _region(ycc: np.ndarray, mask: np.ndarray | None, box: Box):
     if x2 - x1 < 2 or y2 - y1 < 3:
         raise ValueError(f"person box {box.as_tuple()} has less than 2 x 3 pixels inside the {W}x{H} frame")
     colours = ycc[y1:y2, x1:x2].astype(np.float64)
-    if mask is None:
-        fg = np.ones(colours.shape[:2], dtype=bool)
-    else:
-        fg = mask[y1:y2, x1:x2] > 0
+    fg = None if mask is None else mask[y1:y2, x1:x2] > 0
+    if fg is None or fg.mean() < MIN_FOREGROUND_SHARE:
+        fg = contrast_foreground(ycc, x1, y1, x2, y2)
         if fg.mean() < MIN_FOREGROUND_SHARE:
             fg = np.ones_like(fg)
     return x1, y1, colours, fg
@@ -101,7 +128,7 @@ def decompose(ycc: np.ndarray, mask: np.ndarray | None, box: Box, params: BodyPa
     """Head, torso and hip-leg inner rectangles of the person in ``box``.
 
     ``ycc (H, W, 3) uint8`` is the frame in YCrCb, ``mask (H, W)`` the foreground (or None:
-    the whole box is the person). Returns ``{"head", "torso", "hipleg"} -> Box``.
+    the box's colour contrast with its surroundings decides, :func:`contrast_foreground`). Returns ``{"head", "torso", "hipleg"} -> Box``.
     """
     p = params or BodyParams()
     x0, y0, colours, fg = _region(ycc, mask, box)
