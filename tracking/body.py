@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from tracking.box import Box, iou_xywh
-from tracking.decomposition import decompose, minimum_bounding_rectangle
+from tracking.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from tracking.detection import person_blobs
 from tracking.frame_tracker import FailureDetector, FailureVerdict
 from tracking.histogram import to_ycc
@@ -87,6 +87,7 @@ class Person:
     prev: dict[str, np.ndarray] = field(default_factory=dict)
     observed: dict[str, np.ndarray] = field(default_factory=dict)
     centres: deque = field(default_factory=lambda: deque(maxlen=11))
+    offsets: dict[str, float] = field(default_factory=dict)  # part Y - torso Y, in torso heights
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent frames (robust to
@@ -141,6 +142,8 @@ class BodyTracker:
                 return {"person": boxes["person"]}
             return {"person": minimum_bounding_rectangle(boxes[p] for p in BODY_PARTS if p in boxes)}
         parts = {p: boxes[p] for p in BODY_PARTS if p in boxes}
+        if self.params.shrink_given_parts:
+            parts = {p: shrink_part(ycc, mask, b, p) for p, b in parts.items()}
         if len(parts) < 3:
             person = boxes.get("person")
             if person is None:  # some parts only: their MBR stands in for the person
@@ -164,6 +167,10 @@ class BodyTracker:
                 b = Box(b.x, b.y, max(b.w, 2.0), max(b.h, 2.0))
             filters[name] = PartFilter(b, ycc, self.params, self.params.part_noise[name], self.rng)
         person = Person(track_id, filters, deque(maxlen=self.params.history_frames), started=index)
+        if "torso" in filters:
+            t = filters["torso"].state
+            person.offsets = {n: float((f.state[1] - t[1]) / max(t[3], 1.0))
+                              for n, f in filters.items() if n != "torso"}
         self.people[track_id] = person
         return person
 
@@ -276,12 +283,16 @@ class BodyTracker:
         visible = [n for n in person.filters if n not in person.hidden_parts]
         # the torso first: head and hip-leg are then kept near its centre line (coherence)
         visible.sort(key=lambda n: n != "torso")
-        anchor, sigma = None, 0.0
+        torso = None
         for name in visible:
             f = person.filters[name]
-            f.measure(ycc, anchor, sigma)
-            if name == "torso" and self.params.coherence > 0:
-                anchor, sigma = float(f.state[0]), self.params.coherence * float(f.state[2])
+            if torso is None or name not in person.offsets:
+                f.measure(ycc)
+            else:
+                ax, ay = torso[0], torso[1] + person.offsets[name] * torso[3]
+                f.measure(ycc, ax, self.params.coherence * torso[2], ay, self.params.coherence_y * torso[3])
+            if name == "torso":
+                torso = f.state.copy()
             person.observed[name] = q = f.appearance(ycc)
             person.scores[name] = f.score(q)
         if person.hidden_parts:

@@ -156,6 +156,23 @@ def decompose(ycc: np.ndarray, mask: np.ndarray | None, box: Box, params: BodyPa
     return out
 
 
+def shrink_part(ycc: np.ndarray, mask: np.ndarray | None, box: Box, part: str) -> Box:
+    """The inner rectangle of a given part box (an init row): the box is taken as the part's
+    section ``R`` of sec. 4.1 and shrunk the same way (mass centre +- standard deviation of
+    its foreground; the hip-leg keeps the upper half of its foreground rows), so that a
+    tight box drawn around legs or arms is tracked by its stable, mostly-foreground core."""
+    x0, y0, _, fg = _region(ycc, mask, box)
+    if part == "hipleg":
+        rows = np.nonzero(fg.any(axis=1))[0]
+        if len(rows) >= 4:
+            half = max((rows[-1] + 1 - rows[0]) // 2, 2)
+            rect = inner_rectangle(fg[rows[0]:rows[0] + half], x0, y0 + rows[0])
+            if rect is not None:
+                return Box(rect.x, y0 + rows[0], rect.w, float(half))
+    rect = inner_rectangle(fg, x0, y0)
+    return rect if rect is not None else box
+
+
 def minimum_bounding_rectangle(boxes) -> Box:
     """The person box of the three-part tracker: the MBR of its parts' boxes (sec. 5.3)."""
     boxes = list(boxes)

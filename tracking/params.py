@@ -112,6 +112,13 @@ class BodyParams:
     # torso's centre, sigma = coherence x torso width, so that a head does not follow another
     # person's head of the same skin colour. 0 turns it off (the paper's independent filters).
     coherence: float = 1.0
+    # Likewise vertically: head and hip-leg stay near their starting height relative to the
+    # torso (in torso heights), sigma = coherence_y x torso height (bending changes it slowly).
+    coherence_y: float = 0.5
+    # Part boxes given in an init table are shrunk to their inner rectangles (sec. 4.1's shrinking
+    # applied to the given box) before tracking: a tight box around legs is half floor, and a
+    # histogram that is half floor slides onto the floor. False tracks the boxes exactly as given.
+    shrink_given_parts: bool = True
     # Failure detector input: how many past frames of part states are kept per person.
     history_frames: int = 30
 

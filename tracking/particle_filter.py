@@ -114,14 +114,16 @@ class PartFilter:
         s[0:2] += s[4:6]
         return state_to_box(s)
 
-    def measure(self, ycc: np.ndarray, anchor_x: float | None = None, anchor_sigma: float = 0.0) -> None:
+    def measure(self, ycc: np.ndarray, anchor_x: float | None = None, anchor_sigma: float = 0.0,
+                anchor_y: float | None = None, anchor_sigma_y: float = 0.0) -> None:
         """Weigh every particle by its colour likelihood (one integral histogram) and take
         the weighted mean as the estimate.
 
         With ``anchor_x`` and ``anchor_sigma > 0`` the weights are also multiplied by
         ``exp(-0.5 ((X - anchor_x) / anchor_sigma)^2)``: a part of a body stays near the
         body's axis (the torso's centre line) instead of following a look-alike part of
-        someone else (see ``BodyParams.coherence``)."""
+        someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
+        relative to the torso near the one it started with."""
         H, W = ycc.shape[:2]
         rects = particle_rectangles(self.particles, W, H)
         counts = rectangle_histograms(ycc, self.lut, rects)
@@ -131,6 +133,8 @@ class PartFilter:
         weights[areas < 4] = 0.0
         if anchor_x is not None and anchor_sigma > 0:
             weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
+        if anchor_y is not None and anchor_sigma_y > 0:
+            weights *= np.exp(-0.5 * ((self.particles[:, 1] - anchor_y) / anchor_sigma_y) ** 2)
         self.weights = normalise_weights(weights)
         self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
 
