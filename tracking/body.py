@@ -289,6 +289,12 @@ class BodyTracker:
             if torso is None or name not in person.offsets:
                 f.measure(ycc)
             else:
+                s = self.params.shared_motion
+                if s > 0:  # one body moves as one: the torso's motion carries the other parts
+                    step = torso[0:2] - person.prev["torso"][0:2]
+                    delta = np.float32(s) * (step.astype(np.float32) - f.particles[:, 4:6])
+                    f.particles[:, 0:2] += delta
+                    f.particles[:, 4:6] += delta
                 ax, ay = torso[0], torso[1] + person.offsets[name] * torso[3]
                 f.measure(ycc, ax, self.params.coherence * torso[2], ay, self.params.coherence_y * torso[3])
             if name == "torso":

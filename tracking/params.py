@@ -106,12 +106,12 @@ class BodyParams:
     occluder_overlap: float = 0.1
     # The appearance model is updated (eq. (1)) only when the estimate matches it at least this well
     # (a part that slid onto background should not learn the background).
-    update_min_similarity: float = 0.6
+    update_min_similarity: float = 0.3
     # Body coherence (not in the paper, which leaves this to the failure detector): head and
     # hip-leg particle weights are multiplied by a Gaussian of their horizontal distance to the
     # torso's centre, sigma = coherence x torso width, so that a head does not follow another
     # person's head of the same skin colour. 0 turns it off (the paper's independent filters).
-    coherence: float = 1.0
+    coherence: float = 0.5
     # Likewise vertically: head and hip-leg stay near their starting height relative to the
     # torso (in torso heights), sigma = coherence_y x torso height (bending changes it slowly).
     coherence_y: float = 0.5
@@ -119,6 +119,11 @@ class BodyParams:
     # applied to the given box) before tracking: a tight box around legs is half floor, and a
     # histogram that is half floor slides onto the floor. False tracks the boxes exactly as given.
     shrink_given_parts: bool = True
+    # Shared motion (not in the paper): after the torso is measured, the head's and hip-leg's
+    # predicted particles move by this share of the torso's displacement instead of their own
+    # velocity. A small part (a head of 15 px) cannot learn a sudden turn or speed-up from its
+    # own few pixels quickly enough; the torso can. 0 gives the paper's independent dynamics.
+    shared_motion: float = 0.7
     # Failure detector input: how many past frames of part states are kept per person.
     history_frames: int = 30
 
