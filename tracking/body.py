@@ -86,15 +86,20 @@ class Person:
     scores: dict[str, float] = field(default_factory=dict)
     prev: dict[str, np.ndarray] = field(default_factory=dict)
     observed: dict[str, np.ndarray] = field(default_factory=dict)
-    centres: deque = field(default_factory=lambda: deque(maxlen=11))
+    centres: deque = field(default_factory=lambda: deque(maxlen=11))  # (frame, cx, cy), clean frames
+    touching: bool = False                  # parts touch another person's this frame
+    occluded_frames: int = 0
     offsets: dict[str, float] = field(default_factory=dict)  # part Y - torso Y, in torso heights
 
     def velocity(self) -> np.ndarray | None:
-        """Median per-frame motion of the person box's centre over its recent frames (robust to
-        the few frames in which an occluder already dragged the estimate); None if too new."""
+        """Median per-frame motion of the person box's centre over its recent *clean* frames
+        (not touching anyone, not occluded: another person passing in front drags the
+        estimate before the occlusion is decided); None if too few."""
         if len(self.centres) < 3:
             return None
-        return np.median(np.diff(np.asarray(self.centres), axis=0), axis=0)
+        c = np.asarray(self.centres, dtype=np.float64)
+        dt = np.diff(c[:, 0])
+        return np.median(np.diff(c[:, 1:], axis=0) / dt[:, None], axis=0)
 
     def part_boxes(self) -> dict[str, Box]:
         return {name: f.box for name, f in self.filters.items()}
@@ -254,7 +259,8 @@ class BodyTracker:
                 f.resample()
 
         for person in active:
-            person.centres.append(person.box().centre)
+            if not person.touching and person.occluded_by is None and not person.hidden_parts:
+                person.centres.append((index, *person.box().centre))
         self._end_tracks(active, mask, W, H)
         if self.auto and mask is not None:
             self._detect(index, ycc, mask)
@@ -263,11 +269,15 @@ class BodyTracker:
     def _update_person_occlusion(self, person: Person) -> None:
         """Sec. 4.3.1: stay occluded while the person in front still overlaps; sec. 4.3.2:
         which parts are behind an occluder region."""
+        person.touching = False
         if person.occluded_by is not None:
+            person.occluded_frames += 1
             front = self.people.get(person.occluded_by)
-            predicted = minimum_bounding_rectangle(f.predicted_box() for f in person.filters.values())
-            if front is None or predicted.intersection(front.box()) <= 0:
+            predicted = {n: f.predicted_box() for n, f in person.filters.items()}
+            if (front is None or not self._touching(predicted, front.part_boxes())[0]
+                    or person.occluded_frames > self.params.occlusion_max_frames):
                 person.occluded_by = None
+                person.occluded_frames = 0
         hidden = []
         for name, f in person.filters.items():
             b = f.predicted_box()
@@ -279,6 +289,7 @@ class BodyTracker:
         if person.occluded_by is not None:
             for f in person.filters.values():
                 f.coast()
+            self._probe_occluded(person, ycc)
             return
         visible = [n for n in person.filters if n not in person.hidden_parts]
         # the torso first: head and hip-leg are then kept near its centre line (coherence)
@@ -313,6 +324,30 @@ class BodyTracker:
                     f.set_velocity(v)
                 f.coast()
 
+    def _probe_occluded(self, person: Person, ycc: np.ndarray) -> None:
+        """An occluded person whose torso shows clearly again (similarity at least
+        ``release_similarity``, clear of the front person's box) near its prediction is released
+        there, all parts moved with it: dynamics cannot foresee a stop or a turn behind
+        someone, and the two may walk on together without ever separating."""
+        p = self.params
+        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
+        f = person.filters[anchor]
+        if person.occluded_frames < 2 or p.release_similarity <= 0:
+            return
+        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
+        if rho < p.release_similarity:
+            return
+        front = self.people.get(person.occluded_by)
+        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        if front is not None and found.intersection(front.box()) > 0:
+            return  # still behind (or beside and touching) the front person: keep waiting
+        delta = state[0:2] - f.state[0:2]
+        for g in person.filters.values():
+            g.shift(delta)
+            g.set_velocity(np.zeros(2))
+        person.occluded_by = None
+        person.occluded_frames = 0
+
     def _resolve_inter_person_occlusion(self, active: list[Person]) -> None:
         """Sec. 4.3.1: when parts of two measured persons touch, the one whose touching parts
         look less like their models is behind; it goes back to its dynamics-only prediction.
@@ -324,16 +359,10 @@ class BodyTracker:
             for b in visible[i + 1:]:
                 if a.occluded_by is not None or b.occluded_by is not None:
                     continue
-                touching_a, touching_b = set(), set()
-                for na, fa in a.filters.items():
-                    for nb, fb in b.filters.items():
-                        ba, bb = fa.box, fb.box
-                        smaller = min(ba.area, bb.area)
-                        if smaller > 0 and ba.intersection(bb) > p.occlusion_overlap * smaller:
-                            touching_a.add(na)
-                            touching_b.add(nb)
+                touching_a, touching_b = self._touching(a.part_boxes(), b.part_boxes())
                 if not touching_a:
                     continue
+                a.touching = b.touching = True
                 sa = min(a.scores.get(n, 1.0) for n in touching_a)
                 sb = min(b.scores.get(n, 1.0) for n in touching_b)
                 if abs(sa - sb) < p.occlusion_margin:
@@ -347,6 +376,22 @@ class BodyTracker:
                     if v is not None:
                         f.set_velocity(v)
                     f.coast()
+
+    def _touching(self, boxes_a: dict[str, Box], boxes_b: dict[str, Box]) -> tuple[set, set]:
+        """Parts of two persons that overlap by more than ``occlusion_overlap`` of the smaller."""
+        ta, tb = set(), set()
+        pad = self.params.occlusion_pad
+        if pad > 0:  # inner rectangles are narrower than the parts they stand for
+            grow = lambda b: Box(b.x - pad * b.w, b.y, b.w * (1 + 2 * pad), b.h)  # noqa: E731
+            boxes_a = {n: grow(b) for n, b in boxes_a.items()}
+            boxes_b = {n: grow(b) for n, b in boxes_b.items()}
+        for na, ba in boxes_a.items():
+            for nb, bb in boxes_b.items():
+                smaller = min(ba.area, bb.area)
+                if smaller > 0 and ba.intersection(bb) > self.params.occlusion_overlap * smaller:
+                    ta.add(na)
+                    tb.add(nb)
+        return ta, tb
 
     def _similarity(self, person: Person) -> float:
         return float(np.mean([person.scores.get(n, 1.0) for n in person.filters]))

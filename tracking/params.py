@@ -103,6 +103,17 @@ class BodyParams:
     # fraction of it is covered. The occluded one is tracked by dynamics, model frozen.
     occlusion_overlap: float = 0.1
     occlusion_margin: float = 0.02
+    # Part boxes are widened by this share of their width on each side for the touching test:
+    # an inner rectangle (mean +- one std) covers about 60% of its part's width.
+    occlusion_pad: float = 0.35
+    # An occluded person is measured again when its parts no longer touch the front person's,
+    # or after this many frames at most (two walkers moving together would otherwise keep the
+    # one behind on dynamics forever).
+    occlusion_max_frames: int = 50
+    # While occluded, the torso is looked for within release_search x its width of the
+    # prediction; a match of at least release_similarity off the front person ends the occlusion.
+    release_similarity: float = 0.9
+    release_search: float = 1.5
     occluder_overlap: float = 0.1
     # The appearance model is updated (eq. (1)) only when the estimate matches it at least this well
     # (a part that slid onto background should not learn the background).

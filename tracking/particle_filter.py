@@ -138,6 +138,27 @@ class PartFilter:
         self.weights = normalise_weights(weights)
         self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
 
+    def probe(self, ycc: np.ndarray, spread: float, n: int = 200) -> tuple[np.ndarray, float]:
+        """Look for the part around the current estimate without changing the filter: ``n``
+        candidate centres within ``spread`` pixels (Gaussian), the one whose histogram matches
+        the (frozen) model best. Returns ``(state (6,), rho)``; used to end an occlusion when the
+        hidden person shows again away from where its dynamics put it."""
+        cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
+        cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
+        H, W = ycc.shape[:2]
+        rects = particle_rectangles(cand, W, H)
+        counts = rectangle_histograms(ycc, self.lut, rects)
+        areas = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        rho[areas < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
+        k = int(np.argmax(rho))
+        return cand[k].astype(np.float64), float(rho[k])
+
+    def shift(self, delta: np.ndarray) -> None:
+        """Move the estimate and every particle by ``delta`` (dx, dy)."""
+        self.state[0:2] += delta
+        self.particles[:, 0:2] += np.asarray(delta, dtype=np.float32)
+
     def coast(self) -> None:
         """Dynamics only (occlusion, sec. 4.3.1-4.3.2): the estimate moves by its velocity and
         the particles are re-centred on it, so the cloud does not drift or spread."""
