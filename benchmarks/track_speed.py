@@ -47,7 +47,8 @@ def walkers_scene(n: int, n_frames: int, seed: int = 0):
     from labelling.synth.scenarios import BUILDERS, Actor, Script
 
     def build(rng, camera, frames, fps):
-        apps = sample_appearances(rng, n)
+        apps = sample_appearances(rng, min(n, 7))  # synth has 7 distinct outfits; repeat beyond
+        apps = [apps[k % len(apps)] for k in range(n)]
         actors = []
         for k, app in enumerate(apps):
             z = 6.5 + 4.5 * k / max(n - 1, 1)

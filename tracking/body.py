@@ -355,10 +355,15 @@ class BodyTracker:
         yet (both still fully visible); the decision waits for a frame that tells them apart."""
         p = self.params
         visible = [q for q in active if q.occluded_by is None]
+        p_boxes = {q.track_id: q.box() for q in visible}
+        pad = 1 + 2 * p.occlusion_pad
         for i, a in enumerate(visible):
             for b in visible[i + 1:]:
                 if a.occluded_by is not None or b.occluded_by is not None:
                     continue
+                ba, bb = p_boxes[a.track_id], p_boxes[b.track_id]
+                if abs(ba.centre[0] - bb.centre[0]) * 2 > pad * (ba.w + bb.w) or ba.y > bb.y2 or bb.y > ba.y2:
+                    continue  # person boxes far apart: no part can touch
                 touching_a, touching_b = self._touching(a.part_boxes(), b.part_boxes())
                 if not touching_a:
                     continue

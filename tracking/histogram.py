@@ -66,13 +66,13 @@ def update_reference(reference: np.ndarray, observed: np.ndarray, rate: float = 
 
 
 def _smooth(hist: np.ndarray, sigma: float) -> np.ndarray:
+    """Gaussian smoothing of each row of ``hist (C, 256)`` along the levels, edges replicated."""
     if sigma <= 0:
         return hist
     radius = int(np.ceil(3 * sigma))
-    k = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
-    k /= k.sum()
-    padded = np.pad(hist, ((0, 0), (radius, radius)), mode="edge")
-    return np.stack([np.convolve(padded[c], k, mode="valid") for c in range(hist.shape[0])])
+    out = cv2.GaussianBlur(np.ascontiguousarray(hist, dtype=np.float64), (2 * radius + 1, 1), sigmaX=sigma,
+                           sigmaY=1e-6, borderType=cv2.BORDER_REPLICATE)
+    return out.reshape(hist.shape)
 
 
 def equalization_map(reference: np.ndarray, bins: int = 8, smoothing: float = 2.0,

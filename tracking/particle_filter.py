@@ -88,8 +88,9 @@ class PartFilter:
 
     def _clip_sizes(self) -> None:
         lo, hi = self.params.size_range
-        np.clip(self.particles[:, 2], lo * self.base_size[0], hi * self.base_size[0], out=self.particles[:, 2])
-        np.clip(self.particles[:, 3], lo * self.base_size[1], hi * self.base_size[1], out=self.particles[:, 3])
+        wh = self.particles[:, 2:4]
+        np.maximum(wh, (lo * self.base_size).astype(np.float32), out=wh)
+        np.minimum(wh, (hi * self.base_size).astype(np.float32), out=wh)
 
     # -- one frame --------------------------------------------------------------------
     @property
@@ -98,7 +99,13 @@ class PartFilter:
 
     @property
     def box(self) -> Box:
-        return state_to_box(self.state)
+        """The estimate as a ``Box`` (cached while the estimate's X, Y, W, H do not change)."""
+        key = self.state[:4].tobytes()
+        if key != getattr(self, "_box_key", None):
+            x, y, w, h = self.state[:4].tolist()
+            self._box = Box(x - w / 2.0, y - h / 2.0, max(w, 0.0), max(h, 0.0))
+            self._box_key = key
+        return self._box
 
     def predict(self) -> None:
         """Constant-velocity motion plus process noise (seed 002 sec. 3)."""
