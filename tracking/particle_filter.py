@@ -29,7 +29,7 @@ from tracking.histogram import (
     likelihood,
     update_reference,
 )
-from tracking.integral_histogram import particle_rectangles, rectangle_histograms
+from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 from tracking.params import BodyParams, PartNoise
 from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
 
@@ -133,11 +133,12 @@ class PartFilter:
         relative to the torso near the one it started with."""
         H, W = ycc.shape[:2]
         rects = particle_rectangles(self.particles, W, H)
-        counts = rectangle_histograms(ycc, self.lut, rects)
-        areas = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        stride = self._stride()
+        counts = rectangle_histograms(ycc, self.lut, rects, stride)
+        areas = sampled_areas(rects, stride)
         rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
         weights = likelihood(rho, self.noise.lam)
-        weights[areas < 4] = 0.0
+        weights[areas * (stride * stride) < 4] = 0.0
         if anchor_x is not None and anchor_sigma > 0:
             weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
         if anchor_y is not None and anchor_sigma_y > 0:
@@ -154,10 +155,12 @@ class PartFilter:
         cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
         H, W = ycc.shape[:2]
         rects = particle_rectangles(cand, W, H)
-        counts = rectangle_histograms(ycc, self.lut, rects)
-        areas = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        stride = self._stride()
+        counts = rectangle_histograms(ycc, self.lut, rects, stride)
+        areas = sampled_areas(rects, stride)
         rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
-        rho[areas < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
+        full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        rho[full < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
         k = int(np.argmax(rho))
         return cand[k].astype(np.float64), float(rho[k])
 
@@ -165,6 +168,11 @@ class PartFilter:
         """Move the estimate and every particle by ``delta`` (dx, dy)."""
         self.state[0:2] += delta
         self.particles[:, 0:2] += np.asarray(delta, dtype=np.float32)
+
+    def _stride(self) -> int:
+        """2 (every second pixel) for parts at least ``histogram_stride_min`` wide and tall."""
+        m = self.params.histogram_stride_min
+        return 2 if m > 0 and min(self.state[2], self.state[3]) >= m else 1
 
     def coast(self) -> None:
         """Dynamics only (occlusion, sec. 4.3.1-4.3.2): the estimate moves by its velocity and

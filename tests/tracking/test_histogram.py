@@ -9,6 +9,7 @@ from tracking.histogram import (
     bhattacharyya,
     binned_histogram,
     equalization_map,
+    fused_lut,
     level_histogram,
     onehot_lut,
     uniform_map,
@@ -77,3 +78,25 @@ def test_integral_histograms_match_direct_counts():
     # the last box is clipped at the frame's corner: 3 x 3 pixels remain (73..76 -> clipped 73..80)
     assert rects[2].tolist() == [73, 53, 80, 60]
     assert got[2].sum() == pytest.approx(3 * 7 * 7)
+
+
+def test_strided_integral_histograms_count_the_sampled_pixels():
+    from tracking.integral_histogram import sampled_areas
+
+    rng = np.random.default_rng(4)
+    ycc = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)
+    mapping = equalization_map(level_histogram(ycc[10:30, 10:30]))
+    lut = fused_lut(mapping)
+    rects = np.array([[11, 13, 40, 41], [12, 14, 13, 15], [20, 30, 61, 60]], np.int32)
+    got = rectangle_histograms(ycc, lut, rects, stride=2)
+    sub = ycc[13::2, 11::2]  # the grid starts at the union's corner (11, 13)
+    for (x1, y1, x2, y2), row, area in zip(rects, got, sampled_areas(rects, 2)):
+        kx = slice(-((11 - x1) // 2), -((11 - x2) // 2))
+        ky = slice(-((13 - y1) // 2), -((13 - y2) // 2))
+        part = sub[ky, kx]
+        assert area == part.shape[0] * part.shape[1]
+        direct = binned_histogram(level_histogram(part) * area, mapping)
+        assert row == pytest.approx(direct)
+    # 29 x 28 pixels -> 15 x 14 samples; the 1 x 1 rectangle at an odd offset has none;
+    # 41 x 30 pixels starting 9 and 17 px into the grid -> 20 x 15
+    assert sampled_areas(rects, 2).tolist() == [210.0, 0.0, 300.0]
