@@ -136,9 +136,9 @@ class BodyParams:
     # own few pixels quickly enough; the torso can. 0 gives the paper's independent dynamics.
     shared_motion: float = 0.7
     # Parts at least this many pixels wide and tall are histogrammed on every second pixel of
-    # every second row (4x less work; a 24 x 24 part still counts 144 pixels, 18 per bin per
-    # channel). 0 counts every pixel.
-    histogram_stride_min: float = 24.0
+    # every second row (4x less work). Off by default (0 counts every pixel): at 24 px it cut the
+    # PETS09 person rate from 0.62 to 0.54 for about 10% less tracker time.
+    histogram_stride_min: float = 0.0
     # Failure detector input: how many past frames of part states are kept per person.
     history_frames: int = 30
 
