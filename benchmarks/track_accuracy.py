@@ -30,7 +30,6 @@ sys.path.insert(0, str(ROOT))
 
 from tracking.background import BackgroundModel  # noqa: E402
 from tracking.body import BodyTracker  # noqa: E402
-from tracking.box import intersection_xywh  # noqa: E402
 from tracking.params import BodyParams  # noqa: E402
 from tracking.tracks import records_to_frame  # noqa: E402
 

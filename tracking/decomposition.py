@@ -128,7 +128,8 @@ def decompose(ycc: np.ndarray, mask: np.ndarray | None, box: Box, params: BodyPa
     """Head, torso and hip-leg inner rectangles of the person in ``box``.
 
     ``ycc (H, W, 3) uint8`` is the frame in YCrCb, ``mask (H, W)`` the foreground (or None:
-    the box's colour contrast with its surroundings decides, :func:`contrast_foreground`). Returns ``{"head", "torso", "hipleg"} -> Box``.
+    the box's colour contrast with its surroundings decides, :func:`contrast_foreground`).
+    Returns ``{"head", "torso", "hipleg"} -> Box``.
     """
     p = params or BodyParams()
     x0, y0, colours, fg = _region(ycc, mask, box)
