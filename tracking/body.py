@@ -313,16 +313,38 @@ class BodyTracker:
             person.observed[name] = q = f.appearance(ycc)
             person.scores[name] = f.score(q)
         if person.hidden_parts:
-            # hidden parts follow the visible parts' motion (they belong to one body)
+            # hidden parts follow the visible parts' motion (they belong to one body); when all
+            # are hidden, the person's own recent motion
             if visible:
                 v = np.mean([person.filters[n].state[4:6] for n in visible], axis=0)
             else:
-                v = None
+                v = person.velocity()
             for name in person.hidden_parts:
                 f = person.filters[name]
                 if v is not None:
                     f.set_velocity(v)
                 f.coast()
+            if not visible:
+                self._probe_hidden(person, ycc)
+
+    def _probe_hidden(self, person: Person, ycc: np.ndarray) -> None:
+        """A person wholly behind occluder regions whose torso shows clearly again away from
+        them (similarity at least ``release_similarity``) is moved there: a walker may speed
+        up or slow down behind a pillar."""
+        p = self.params
+        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
+        f = person.filters[anchor]
+        if p.release_similarity <= 0:
+            return
+        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
+        if rho < p.release_similarity:
+            return
+        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        if any(_overlap_fraction(found, o) >= p.occluder_overlap for o in self.occluders):
+            return
+        delta = state[0:2] - f.state[0:2]
+        for g in person.filters.values():
+            g.shift(delta)
 
     def _probe_occluded(self, person: Person, ycc: np.ndarray) -> None:
         """An occluded person whose torso shows clearly again (similarity at least
