@@ -4,20 +4,24 @@ Every tracked person has three part filters (head, torso, hip-leg; or one ``pers
 filter in whole-body mode, the paper's baseline of Fig. 4(d)). Each frame:
 
 1. tracks listed in ``init`` start at their first frame (a person row is decomposed
-   by sec. 4.1, part rows are used as they are); without ``init``, person-size
-   foreground blobs seen for ``start_frames`` frames running start tracks;
+   by sec. 4.1; part rows are used as given, shrunk to their inner rectangles); without
+   ``init``, person-size foreground blobs seen for ``start_frames`` frames running start
+   tracks;
 2. every part is predicted; parts behind a given occluder region (pillars, doors,
    sec. 4.3.2) and persons hidden behind another person (sec. 4.3.1) follow their
-   dynamics with the appearance model frozen; the others are measured;
-3. when two measured persons overlap, the one whose parts match their models worse is
-   the occluded one: it is put back on its dynamics until the two separate;
+   dynamics with the appearance model frozen; the others are measured, the torso first,
+   then head and hip-leg carried by the torso's motion and kept near their place on the
+   body (``shared_motion``, ``coherence``: additions to the paper's independent filters);
+3. when parts of two measured persons touch, the one whose touching parts match their
+   models worse is the occluded one: it goes back to its dynamics until the two separate,
+   or until its torso shows clearly again clear of the other person;
 4. the failure detector (if any) judges the unoccluded persons and
    ``tracking.adjustment`` repairs failed parts (sec. 4.3);
 5. models are updated by eq. (1), particles resampled by eq. (2), tracks that leave
    the frame (or, when detecting automatically, lose their foreground) end.
 
 The output of a frame is one row per part and a ``person`` row holding the minimum
-bounding rectangle of the three parts (sec. 5.3).
+bounding rectangle of the three parts (sec. 5.3). All numbers come from ``BodyParams``.
 """
 
 from __future__ import annotations
@@ -215,7 +219,7 @@ class BodyTracker:
         ycc = to_ycc(frame)
         H, W = ycc.shape[:2]
         self.frames_seen += 1
-        mask = foreground if foreground is not None else None
+        mask = foreground
         new_ids = set()
         if self.pending:
             before = set(self.people)

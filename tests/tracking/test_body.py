@@ -71,6 +71,18 @@ def test_decomposition_finds_the_three_parts_of_a_drawn_person():
     assert parts["hipleg"].y2 < p.y2 - 0.2 * p.h
 
 
+def test_decomposition_without_a_mask_uses_colour_contrast():
+    """First frames: no background model yet; the person is told from its surroundings."""
+    frames, truths = _scene(n=1, walkers=(dict(x0=150, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    t = truths[0][1]
+    loose = Box(t["person"].x - 20, t["person"].y - 6, t["person"].w + 24, t["person"].h + 12)  # more room left
+    parts = decompose(to_ycc(frames[0]), None, loose, BodyParams())
+    for name in ("head", "torso", "hipleg"):
+        assert correct(parts[name], t[name]), (name, parts[name], t[name])
+    # (with the whole loose box as foreground the head box takes in the background on the left)
+    assert abs(parts["torso"].centre[0] - t["torso"].centre[0]) < 5
+
+
 def test_boxes_stay_on_a_walker_and_person_row_is_the_mbr():
     frames, truths = _scene(n=60)
     tracks = _run(BodyTracker(BodyParams(), np.random.default_rng(1), init=_init(truths[0])), frames)
