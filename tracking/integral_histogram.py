@@ -18,13 +18,12 @@ def particle_rectangles(states: np.ndarray, width: int, height: int) -> np.ndarr
     """Integer corners ``(N, 4) int32 [x1, y1, x2, y2]`` of centre-size states
     ``(N, >=4) [X, Y, W, H, ...]``, clipped to a ``width`` x ``height`` frame."""
     s = np.asarray(states)
-    half_w = 0.5 * s[:, 2]
-    half_h = 0.5 * s[:, 3]
-    x1 = np.clip(np.rint(s[:, 0] - half_w), 0, width)
-    x2 = np.clip(np.rint(s[:, 0] + half_w), 0, width)
-    y1 = np.clip(np.rint(s[:, 1] - half_h), 0, height)
-    y2 = np.clip(np.rint(s[:, 1] + half_h), 0, height)
-    return np.stack([x1, y1, x2, y2], axis=1).astype(np.int32)
+    half = 0.5 * s[:, 2:4]
+    corners = np.concatenate([s[:, 0:2] - half, s[:, 0:2] + half], axis=1)
+    np.rint(corners, out=corners)
+    np.maximum(corners, 0, out=corners)
+    np.minimum(corners, np.array([width, height, width, height], dtype=corners.dtype), out=corners)
+    return corners.astype(np.int32)
 
 
 def rectangle_histograms(ycc: np.ndarray, lut, rects: np.ndarray, stride: int = 1) -> np.ndarray:
