@@ -185,9 +185,6 @@ class LimbParams:
     lost_likelihood: float = 0.15
     lost_frames: int = 5
     start_frames: int = 3
-    # blobs touching the frame border (people still entering) do not start tracks: their box
-    # would be cut and the decomposition wrong.
-    detection_border: int = 2
     # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2), drop tiny ones
     blob_alpha: float = 1.0
     min_blob_area: float = 30.0
