@@ -169,6 +169,12 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     assert (head1.w, head1.h) == (head0.w, head0.h)
     page.get_by_text("head FAIL").first.wait_for()
 
+    shot = ROOT / "docs" / "correct.png" if os.environ.get("PARTLAB_SCREENSHOT") == "1" \
+        else tmp_path / "correct.png"
+    shot.parent.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(shot), full_page=True)
+    assert shot.stat().st_size > 10_000
+
     # undo (Ctrl+Z) takes the flag back off as a new revision; redo (Ctrl+Y) puts it on again
     def head_now():
         df = store.frame_boxes(clip.id, 0)
@@ -180,12 +186,6 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     page.keyboard.press("Control+y")
     _wait_for(lambda: int(head_now().revision) == 4, what="the redo")
     assert bool(head_now().failure) and head_now().x == head1.x
-
-    shot = ROOT / "docs" / "correct.png" if os.environ.get("PARTLAB_SCREENSHOT") == "1" \
-        else tmp_path / "correct.png"
-    shot.parent.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(shot), full_page=True)
-    assert shot.stat().st_size > 10_000
 
     # killing the app mid-session loses no saved edit
     proc.kill()
