@@ -53,8 +53,9 @@ def show_summary(summary: dict, key: str) -> None:
                                    positives=v.get("n_positive"), negatives=v.get("n_negative"), note=v.get("note"))
                               for k, v in svms.items()])
         st.dataframe(table, hide_index=True)
-        cols = st.columns(len(svms))
-        for col, (k, v) in zip(cols, svms.items()):
+        trained = {k: v for k, v in svms.items() if v.get("trained")}
+        cols = st.columns(max(len(trained), 1))
+        for col, (k, v) in zip(cols, trained.items()):  # rows truth, columns prediction: [[TN, FP], [FN, TP]]
             cm = v.get("confusion") or [[0, 0], [0, 0]]
             fig = go.Figure(go.Heatmap(z=cm, x=["pred. failed", "pred. tracked"], y=["failed", "tracked"], text=cm,
                                        texttemplate="%{text}", colorscale="Blues", showscale=False))
