@@ -120,6 +120,11 @@ def test_train_page_produces_a_bundle(store, tracked_clip, boxes):
     [bundle] = store.bundles(project.id)
     assert bundle.name == "bundle-1" and Path(bundle.path).is_dir()
     assert store.project(project.id).default_bundle_id == bundle.id
+    at.run()  # the bundle's summary: a row per SVM with its cross-validated rates, the variance chart
+    assert not at.exception
+    svms = at.dataframe[0].value
+    assert svms.svm.tolist() == list(bundle.summary["svms"]) and {"CV TNR", "CV TPR"} <= set(svms.columns)
+    assert len(at.get("plotly_chart")) >= 1
 
 
 @pytest.mark.skipif(bool(missing("labelling.formats")), reason="labelling.formats (the datasets issue) has not landed")
