@@ -83,7 +83,9 @@ class LimbParams:
 
     The paper gives no state-machine thresholds; they are parameters here. The
     ``sigma_*`` terms are the 2D variances of the candidate priors (seed 000 eq. 25-27),
-    fitted from training video by ``models/``.
+    fitted from training video by ``models/``. ``sigma_v`` and ``sigma_d`` compare two
+    cameras (eq. 25-26) and are kept for multi-camera use; one camera uses ``sigma_s``
+    (eq. 27, distance of a blob to the silhouette) and ``sigma_xy`` (p(x|Z), eq. 17).
     """
 
     particles: int = 300
@@ -93,17 +95,55 @@ class LimbParams:
     sigma_v: float = 12.0
     sigma_d: float = 20.0
     sigma_s: float = 8.0
+    # spread of p(x | Z_c), the particle-to-candidate term of seed 000 eq. 17 (pixels):
+    # about a hand's radius, so a particle on the blob scores near 1 and one beside it little.
+    sigma_xy: float = 8.0
+    # a particle far from every blob keeps this much blob likelihood, so the hue term still
+    # guides it through frames where its limb's blob is missed (shadow, occlusion).
+    blob_floor: float = 0.01
     noise_xy: float = 6.0
+    # velocity noise of the second-order dynamics x_t - x_{t-1} = x_{t-1} - x_{t-2} + w_t
+    # (seed 003 sec. 3); the decay < 1 damps the velocity so a stopped hand does not overshoot.
+    noise_v: float = 2.0
+    velocity_decay: float = 0.8
+    # seed 003 eq. (1): pi = exp(-lam D^2); the paper's lam = 1 is too flat to separate
+    # skin from the background once multiplied by the blob term, 20 as in the body tracker.
     lam: float = 20.0
+    # hue is undefined for grey pixels: only pixels with S and V at least these count.
+    hue_min_saturation: int = 30
+    hue_min_value: int = 40
+    # seed 003 sec. 3: mean shift on the back-projection refines the PF mean.
+    mean_shift_iterations: int = 10
+    mean_shift_eps: float = 1.0
     # state machine thresholds (seed 000 sec. 5.2)
     combine_distance: float = 20.0
     split_distance: float = 30.0
     lost_likelihood: float = 0.15
+    # hysteresis: a lost target comes back only above this confidence.
+    recover_likelihood: float = 0.3
     lost_frames: int = 5
     start_frames: int = 3
-    # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2), drop tiny ones
-    blob_alpha: float = 1.0
+    # prior p(Z) a candidate needs for start_frames frames to start a tracker (sec. 5.2).
+    start_prior: float = 0.5
+    # frames of estimates kept to read the direction between two targets before they join.
+    history_frames: int = 10
+    # a combined filter spreads its particles this much wider so it sees both modes.
+    combined_noise_scale: float = 2.0
+    # labelling (seed 000 sec. 7.1): a hand belongs to the nearest head within this many
+    # head heights; a person facing the camera has the left hand on the image's right.
+    person_radius: float = 5.0
+    facing_camera: bool = True
+    # frames an unlabelled tracker with no head nearby waits before it is taken as a head.
+    head_guess_frames: int = 5
+    # seed 003 sec. 3: re-acquire the head with the face detector after this many frames
+    # below reacquire_confidence.
+    reacquire_frames: int = 5
+    reacquire_confidence: float = 0.3
+    # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2: alpha > 1), drop tiny ones
+    blob_alpha: float = 1.5
     min_blob_area: float = 30.0
+    # skin probability above which a pixel is skin (skin.SkinModel)
+    skin_threshold: float = 0.5
 
     def to_dict(self) -> dict:
         return asdict(self)

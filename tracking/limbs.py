@@ -1,0 +1,436 @@
+"""The limb tracker: head, left hand and right hand of every person in one camera (seed 000, 003).
+
+Per frame (``LimbTracker.step``):
+
+1. observations: skin pixels within the foreground, connected blobs (``tracking.skin``),
+   candidates with a prior that is a product of named terms (``tracking.limb_filter``);
+2. low layer: every active filter predicts, is weighted against all candidates and
+   its hue histogram (seed 000 eq. 17, seed 003 eq. 1-2), refined by mean shift on the
+   back-projection and resampled;
+3. high layer: the per-tracker state machine (``tracking.state_machine``) combines,
+   splits, loses and recovers targets; this module acts on its transitions (one filter
+   for a combined pair, one filter per mode after a split, labels by the direction
+   cue), labels auto-started trackers (face detector for heads, side of the head for
+   hands) and re-acquires a head with the face detector (seed 003 sec. 3).
+
+A tracker's output row has ``track_id`` = the person, ``part`` in head/left_hand/right_hand,
+``state`` = its state-machine state and ``score`` = the filter's confidence.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+
+from tracking.box import Box
+from tracking.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from tracking.limb_filter import Candidates, LimbFilter, candidate_modes, candidate_terms
+from tracking.params import LimbParams
+from tracking.parts import LIMB_PARTS
+from tracking.skin import SkinModel, find_blobs
+from tracking.state_machine import JoinEvent, LimbState, LimbStateMachine, Observation
+from tracking.tracks import TrackRecord, normalise_tracks
+
+EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a",
+                                  "track_id_b", "part_b", "ended_by")
+
+FACE_CASCADE_FILE = "haarcascade_frontalface_default.xml"
+
+
+def load_face_detector() -> cv2.CascadeClassifier | None:
+    """OpenCV's bundled frontal-face cascade, or None if this OpenCV build lacks it
+    (then heads are started and re-acquired from skin blobs only)."""
+    data = getattr(cv2, "data", None)
+    if data is None:
+        return None
+    path = Path(data.haarcascades) / FACE_CASCADE_FILE
+    if not path.exists():
+        return None
+    det = cv2.CascadeClassifier(str(path))
+    return None if det.empty() else det
+
+
+def event_kind(part_a: str | None, track_a: int | None, part_b: str | None, track_b: int | None) -> str:
+    """Activity class of a join (seed 000 sec. 7.1): two hands of one person -> clap (or an
+    exchange between the hands), hands of two people -> handshake, a hand and a head -> hand_head."""
+    hands = {"left_hand", "right_hand"}
+    if part_a in hands and part_b in hands:
+        return "clap" if track_a == track_b else "handshake"
+    if {part_a, part_b} & hands and "head" in (part_a, part_b):
+        return "hand_head"
+    return "join"
+
+
+def write_events(events: pd.DataFrame, path: str | PathLike) -> None:
+    """Write the join/separation events as ``EVENTS.csv`` (columns :data:`EVENT_COLUMNS`)."""
+    missing = [c for c in EVENT_COLUMNS if c not in events.columns]
+    if missing:
+        raise ValueError(f"events table lacks column(s) {', '.join(missing)}")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    events.loc[:, list(EVENT_COLUMNS)].sort_values(["start_frame", "track_id_a"], kind="stable").to_csv(
+        path, index=False, lineterminator="\n")
+
+
+@dataclass
+class _Target:
+    """What the tracker knows of one head or hand beyond its state."""
+
+    track_id: int | None = None
+    part: str | None = None
+    filter: LimbFilter | None = None
+    size: tuple[float, float] = (0.0, 0.0)
+    ref_hist: np.ndarray | None = None
+    last: np.ndarray | None = None  # last confident position (lost-state search centre)
+    low_frames: int = 0  # frames below reacquire_confidence (heads)
+    unlabelled_frames: int = 0
+    candidate: np.ndarray | None = None  # uninitialized: the candidate it would start from
+    candidate_box: np.ndarray | None = None
+    missed: int = 0  # uninitialized: frames without its candidate
+
+    @property
+    def labelled(self) -> bool:
+        return self.track_id is not None and self.part is not None
+
+
+class LimbTracker:
+    """Head and hands of several people; implements ``tracking.frame_tracker.FrameTracker``.
+
+    ``init``: a tracks table (INIT.csv) whose head/left_hand/right_hand rows start
+    tracks at their first listed frame with their ``track_id``; without it, trackers
+    start from persistent skin blobs and are labelled by the face detector and by
+    position relative to a head.
+    """
+
+    def __init__(self, params: LimbParams | None = None, rng: np.random.Generator | None = None,
+                 init: pd.DataFrame | None = None, skin: SkinModel | None = None,
+                 face_detector: bool = True):
+        self.params = params or LimbParams()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.skin = skin or SkinModel.default()
+        self.machine = LimbStateMachine(self.params)
+        self.targets: dict[int, _Target] = {}
+        self.face = load_face_detector() if face_detector else None
+        self._next_tracker = 0
+        self._next_person = 0
+        self._last_frame = -1
+        self._init: dict[int, list[tuple[int, str, np.ndarray]]] = {}
+        self.auto_start = init is None
+        if init is not None:
+            init = normalise_tracks(init)
+            rows = init[init["part"].isin(LIMB_PARTS)]
+            if rows.empty:
+                raise ValueError("the init table has no head/left_hand/right_hand rows for the limb tracker")
+            first = rows.sort_values("frame", kind="stable").groupby(["track_id", "part"], sort=False).head(1)
+            for r in first.itertuples(index=False):
+                self._init.setdefault(int(r.frame), []).append(
+                    (int(r.track_id), str(r.part), np.array([r.x, r.y, r.w, r.h], float)))
+            self._next_person = int(init["track_id"].max()) + 1
+
+    # -- public ----------------------------------------------------------------------------
+    @property
+    def events(self) -> pd.DataFrame:
+        """Join/separation events so far (:data:`EVENT_COLUMNS`); a join still open ends at the last frame."""
+        rows = []
+        evs = list(self.machine.events)
+        for t in self.machine.trackers():
+            p = self.machine.partner(t)
+            if self.machine.state(t) == LimbState.COMBINED and p is not None and t < p:
+                evs.append(JoinEvent(self.machine.joined_at(t), self._last_frame, t, p, "open"))
+        for e in evs:
+            a, b = self.targets[e.tracker_a], self.targets[e.tracker_b]
+            rows.append({"start_frame": e.start_frame, "end_frame": e.end_frame,
+                         "kind": event_kind(a.part, a.track_id, b.part, b.track_id),
+                         "track_id_a": a.track_id, "part_a": a.part, "track_id_b": b.track_id,
+                         "part_b": b.part, "ended_by": e.ended_by})
+        return pd.DataFrame(rows, columns=list(EVENT_COLUMNS))
+
+    def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None = None) -> list[TrackRecord]:
+        p = self.params
+        frame = np.asarray(frame)
+        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
+            raise ValueError(f"expected a BGR (H, W, 3) uint8 frame, got shape {frame.shape} dtype {frame.dtype}")
+        if foreground is not None and np.asarray(foreground).shape != frame.shape[:2]:
+            raise ValueError(f"foreground mask shape {np.asarray(foreground).shape} does not match the frame "
+                             f"{frame.shape[:2]}")
+        self._last_frame = index
+
+        # 1. observations ------------------------------------------------------------------
+        skin_prob = self.skin.probability(frame)
+        skin_mask = skin_prob >= p.skin_threshold
+        fg = None if foreground is None else np.asarray(foreground) > 0
+        if fg is not None:
+            skin_mask &= fg
+        people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
+        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, p.min_blob_area)
+        cands = candidate_terms(blobs, foreground, skin_prob, p)
+        hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
+        bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
+        if fg is not None:
+            bins = np.where(fg, bins, -1).astype(np.int16)
+        skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)
+        integral = integral_histogram(bins, p.hue_bins)
+        weight = fg.astype(np.float32) if fg is not None else None
+
+        for track_id, part, box in self._init.get(index, []):
+            self._start(index, box, skin_bins, bins, track_id, part)
+
+        # 2. low layer ---------------------------------------------------------------------
+        active = [t for t in self.machine.trackers()
+                  if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
+        observations: dict[int, Observation] = {}
+        for t in active:
+            tgt = self.targets[t]
+            state = self.machine.state(t)
+            if state == LimbState.LOST:
+                tgt.filter.reset(tgt.last, self.rng, spread=p.noise_xy * p.combined_noise_scale)
+                obs_c = self._unclaimed(cands, exclude=t)
+            else:
+                tgt.filter.predict(self.rng, p.combined_noise_scale if state == LimbState.COMBINED else 1.0)
+                obs_c = cands
+            tgt.filter.weigh(obs_c, integral)
+            modes: tuple = ()
+            if state == LimbState.COMBINED:
+                radius = p.split_distance + 3 * p.noise_xy * p.combined_noise_scale
+                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, cands, p.sigma_xy, radius)
+                modes = tuple(map(tuple, m[:2]))
+            if state != LimbState.LOST:
+                bp = back_projection(bins, tgt.filter.ref_hist, weight)
+                tgt.filter.refine(bp)
+            tgt.filter.resample(self.rng)
+            if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:
+                tgt.last = tgt.filter.estimate.copy()
+                if state == LimbState.NORMAL:
+                    tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
+            observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
+                                          labelled=tgt.labelled, modes=modes)
+        # followers of a combined pair report the leader's estimate
+        for t in self.machine.trackers():
+            if self.machine.state(t) == LimbState.COMBINED and not self.machine.is_leader(t):
+                lead = observations.get(self.machine.partner(t))
+                if lead is not None:
+                    observations[t] = Observation(position=lead.position, likelihood=lead.likelihood,
+                                                  labelled=self.targets[t].labelled)
+        if self.auto_start:
+            self._propose(cands, observations)
+        self._label(index, frame, observations)
+        self._reacquire_heads(frame, skin_bins, observations)
+
+        # 3. high layer --------------------------------------------------------------------
+        for tr in self.machine.update(index, observations):
+            self._apply(tr, index, skin_bins)
+        return self._records(index)
+
+    # -- starting trackers -----------------------------------------------------------------
+    def _new_tracker(self, target: _Target, state: LimbState) -> int:
+        t = self._next_tracker
+        self._next_tracker += 1
+        self.targets[t] = target
+        self.machine.add(t, state)
+        return t
+
+    def _make_filter(self, tgt: _Target, centre) -> LimbFilter:
+        return LimbFilter(centre, tgt.size, tgt.ref_hist, self.params, self.rng)
+
+    def _reference(self, box, skin_bins: np.ndarray, bins: np.ndarray) -> np.ndarray:
+        """Hue reference of a box: its skin pixels, else its coloured pixels, else a flat histogram."""
+        for img in (skin_bins, bins):
+            h = reference_histogram(img, box, self.params.hue_bins)
+            if h is not None:
+                return h
+        return np.full(self.params.hue_bins, 1.0 / self.params.hue_bins)
+
+    def _start(self, index: int, box, skin_bins, bins, track_id: int, part: str) -> None:
+        """Start a labelled tracker from an INIT.csv box (state normal)."""
+        box = np.asarray(box, float)
+        tgt = _Target(track_id=track_id, part=part, size=(max(box[2], 2.0), max(box[3], 2.0)),
+                      ref_hist=self._reference(box, skin_bins, bins))
+        centre = box[:2] + box[2:] / 2
+        tgt.filter = self._make_filter(tgt, centre)
+        tgt.last = centre.copy()
+        self._new_tracker(tgt, LimbState.NORMAL)
+
+    def _unclaimed(self, cands: Candidates, exclude: int) -> Candidates:
+        """Candidates not explained by another active tracker (a lost target must not
+        recover onto a limb someone else tracks)."""
+        if len(cands) == 0:
+            return cands
+        keep = np.ones(len(cands), bool)
+        for t, tgt in self.targets.items():
+            if t == exclude or tgt.filter is None:
+                continue
+            if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
+                d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
+                keep &= d > max(tgt.size) / 2 + self.params.sigma_xy
+        return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
+                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep])
+
+    def _propose(self, cands: Candidates, observations: dict[int, Observation]) -> None:
+        """Uninitialized trackers follow candidates no existing tracker explains (sec. 5.2)."""
+        free = self._unclaimed(cands, exclude=-1)
+        pending = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNINITIALIZED]
+        used: set[int] = set()
+        for t in pending:
+            tgt = self.targets[t]
+            if len(free):
+                d = np.hypot(*(free.centres - tgt.candidate[None, :]).T)
+                d[list(used)] = np.inf
+                j = int(np.argmin(d))
+                if d[j] <= 2 * self.params.sigma_xy + self.params.noise_xy:
+                    used.add(j)
+                    tgt.candidate, tgt.candidate_box, tgt.missed = free.centres[j].copy(), free.boxes[j].copy(), 0
+                    observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
+                    continue
+            tgt.missed += 1
+            observations[t] = Observation()
+        for j in range(len(free)):
+            if j not in used:
+                tgt = _Target(candidate=free.centres[j].copy(), candidate_box=free.boxes[j].copy())
+                t = self._new_tracker(tgt, LimbState.UNINITIALIZED)
+                observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
+        for t in pending:  # forget candidates that vanished
+            if self.targets[t].missed > self.params.start_frames:
+                self.machine.remove(t)
+                self.targets.pop(t)
+
+    # -- labelling (unlabelled -> normal) -----------------------------------------------------
+    def _faces(self, frame: np.ndarray) -> np.ndarray:
+        if self.face is None:
+            return np.zeros((0, 4))
+        grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+        found = self.face.detectMultiScale(grey, scaleFactor=1.1, minNeighbors=4, minSize=(12, 12))
+        return np.asarray(found, float).reshape(-1, 4)
+
+    def _label(self, index: int, frame: np.ndarray, observations: dict[int, Observation]) -> None:
+        """Cues for unlabelled trackers that never had a type: a face -> new person's head;
+        beside a head -> that person's hand on that side; alone and topmost for a while -> head."""
+        p = self.params
+        todo = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNLABELLED
+                and not self.targets[t].labelled and self.targets[t].filter is not None]
+        if not todo:
+            return
+        faces = self._faces(frame)
+        for t in sorted(todo, key=lambda t: self.targets[t].filter.estimate[1]):  # topmost first
+            tgt = self.targets[t]
+            tgt.unlabelled_frames += 1
+            cx, cy = tgt.filter.estimate
+            on_face = any(fx <= cx <= fx + fw and fy <= cy <= fy + fh for fx, fy, fw, fh in faces)
+            head = self._nearest_head(tgt.filter.estimate)
+            if on_face and head is None:
+                self._assign(t, self._next_person, "head")
+                self._next_person += 1
+            elif head is not None:
+                hid, htgt = head
+                right_side = cx < htgt.filter.estimate[0]  # image left of the head
+                side = ("right_hand" if right_side else "left_hand") if p.facing_camera else \
+                    ("left_hand" if right_side else "right_hand")
+                taken = self._parts_of(htgt.track_id)
+                other = "left_hand" if side == "right_hand" else "right_hand"
+                if side not in taken:
+                    self._assign(t, htgt.track_id, side)
+                elif other not in taken:
+                    self._assign(t, htgt.track_id, other)
+            elif tgt.unlabelled_frames >= p.head_guess_frames:
+                self._assign(t, self._next_person, "head")
+                self._next_person += 1
+            if tgt.labelled and t in observations:
+                o = observations[t]
+                observations[t] = Observation(o.position, o.likelihood, o.prior, True, o.modes)
+
+    def _assign(self, t: int, track_id: int, part: str) -> None:
+        tgt = self.targets[t]
+        tgt.track_id, tgt.part = track_id, part
+
+    def _parts_of(self, track_id: int) -> set[str]:
+        return {tgt.part for tgt in self.targets.values() if tgt.track_id == track_id and tgt.part}
+
+    def _nearest_head(self, point) -> tuple[int, _Target] | None:
+        best, best_d = None, math.inf
+        for t, tgt in self.targets.items():
+            if tgt.part != "head" or tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
+                continue
+            d = float(np.hypot(*(np.asarray(point) - tgt.filter.estimate)))
+            if d <= self.params.person_radius * tgt.size[1] and d < best_d:
+                best, best_d = (t, tgt), d
+        return best
+
+    # -- head re-acquisition (seed 003 sec. 3) -------------------------------------------------
+    def _reacquire_heads(self, frame: np.ndarray, skin_bins: np.ndarray, observations) -> None:
+        p = self.params
+        if self.face is None:
+            return
+        faces = None
+        for t, tgt in self.targets.items():
+            if tgt.part != "head" or tgt.filter is None or t not in observations:
+                continue
+            if self.machine.state(t) == LimbState.COMBINED:
+                continue
+            tgt.low_frames = tgt.low_frames + 1 if tgt.filter.confidence < p.reacquire_confidence else 0
+            if tgt.low_frames < p.reacquire_frames:
+                continue
+            if faces is None:
+                faces = self._faces(frame)
+            if len(faces) == 0:
+                continue
+            centres = faces[:, :2] + faces[:, 2:] / 2
+            last = tgt.last if tgt.last is not None else tgt.filter.estimate
+            d = np.hypot(*(centres - last[None, :]).T)
+            j = int(np.argmin(d))
+            if d[j] > p.person_radius * tgt.size[1]:
+                continue
+            tgt.filter.reset(centres[j], self.rng)
+            ref = reference_histogram(skin_bins, faces[j], p.hue_bins)
+            if ref is not None:  # replace the colour reference with the face's (sec. 3)
+                tgt.filter.ref_hist = ref
+            tgt.last, tgt.low_frames = centres[j].copy(), 0
+            o = observations[t]
+            observations[t] = Observation(tuple(centres[j]), max(o.likelihood, p.recover_likelihood),
+                                          o.prior, o.labelled, o.modes)
+
+    # -- acting on transitions -----------------------------------------------------------------
+    def _apply(self, tr, index: int, skin_bins: np.ndarray) -> None:
+        tgt = self.targets[tr.tracker]
+        if tr.old == LimbState.UNINITIALIZED and tr.new == LimbState.UNLABELLED:
+            box = tgt.candidate_box
+            side = float(max(box[2], box[3], 4.0))
+            tgt.size = (side, side)
+            tgt.ref_hist = self._reference(box, skin_bins, skin_bins)
+            tgt.filter = self._make_filter(tgt, tgt.candidate)
+            tgt.last = tgt.candidate.copy()
+        elif tr.new == LimbState.COMBINED and not self.machine.is_leader(tr.tracker):
+            tgt.filter = None  # the leader's filter tracks both
+        elif tr.reason == "split":
+            if tgt.filter is None:
+                tgt.filter = self._make_filter(tgt, tr.position)
+            tgt.filter.reset(tr.position, self.rng)
+            tgt.last = np.asarray(tr.position, float)
+        elif tr.new == LimbState.LOST:
+            if tgt.filter is None:  # a follower of a lost pair
+                tgt.filter = self._make_filter(tgt, tgt.last)
+            if tgt.last is None:
+                tgt.last = tgt.filter.estimate.copy()
+
+    def _records(self, index: int) -> list[TrackRecord]:
+        out = []
+        for t, tgt in self.targets.items():
+            state = self.machine.state(t)
+            if state == LimbState.UNINITIALIZED or not tgt.labelled:
+                continue
+            if state == LimbState.COMBINED and tgt.filter is None:
+                lead = self.targets[self.machine.partner(t)].filter
+                centre, conf = lead.estimate, lead.confidence
+            elif state == LimbState.LOST:
+                centre, conf = tgt.last if tgt.last is not None else tgt.filter.estimate, tgt.filter.confidence
+            else:
+                centre, conf = tgt.filter.estimate, tgt.filter.confidence
+            w, h = tgt.size
+            box = Box(float(centre[0] - w / 2), float(centre[1] - h / 2), float(w), float(h))
+            out.append(TrackRecord(index, int(tgt.track_id), str(tgt.part), box, score=float(conf),
+                                   failure=state == LimbState.LOST, state=state.value, source="limbs"))
+        return out
