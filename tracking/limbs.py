@@ -34,7 +34,7 @@ from tracking.limb_filter import Candidates, LimbFilter, candidate_modes, candid
 from tracking.params import LimbParams
 from tracking.parts import LIMB_PARTS
 from tracking.skin import SkinModel, find_blobs
-from tracking.state_machine import JoinEvent, LimbState, LimbStateMachine, Observation
+from tracking.state_machine import JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction
 from tracking.tracks import TrackRecord, normalise_tracks
 
 EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a",
@@ -93,6 +93,7 @@ class _Target:
     candidate: np.ndarray | None = None  # uninitialized: the candidate it would start from
     candidate_box: np.ndarray | None = None
     missed: int = 0  # uninitialized: frames without its candidate
+    shown: np.ndarray | None = None  # combined: the position written for this member
 
     @property
     def labelled(self) -> bool:
@@ -191,14 +192,18 @@ class LimbTracker:
             if state == LimbState.LOST:
                 tgt.filter.reset(tgt.last, self.rng, spread=p.noise_xy * p.combined_noise_scale)
                 obs_c = self._unclaimed(cands, exclude=t)
+            elif state == LimbState.COMBINED:
+                # the pair's filter sees only candidates no other tracker explains (its own blobs)
+                tgt.filter.predict(self.rng, p.combined_noise_scale)
+                obs_c = self._unclaimed(cands, exclude=(t, self.machine.partner(t)))
             else:
-                tgt.filter.predict(self.rng, p.combined_noise_scale if state == LimbState.COMBINED else 1.0)
+                tgt.filter.predict(self.rng)
                 obs_c = cands
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
-                radius = p.split_distance + 3 * p.noise_xy * p.combined_noise_scale
-                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, cands, p.sigma_xy, radius)
+                radius = p.split_distance + p.noise_xy * p.combined_noise_scale
+                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, p.sigma_xy, radius)
                 modes = tuple(map(tuple, m[:2]))
             if state != LimbState.LOST:
                 bp = back_projection(bins, tgt.filter.ref_hist, weight)
@@ -210,6 +215,7 @@ class LimbTracker:
                     tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
             observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
                                           labelled=tgt.labelled, modes=modes)
+            self._place_pair(t, modes)
         # followers of a combined pair report the leader's estimate
         for t in self.machine.trackers():
             if self.machine.state(t) == LimbState.COMBINED and not self.machine.is_leader(t):
@@ -226,6 +232,21 @@ class LimbTracker:
         for tr in self.machine.update(index, observations):
             self._apply(tr, index, skin_bins)
         return self._records(index)
+
+    def _place_pair(self, leader: int, modes: tuple) -> None:
+        """Output positions of a combined pair: while two modes show (not yet far enough apart
+        to split), each member takes the one on its side (direction cue of sec. 7.1); with one
+        mode both sit on the filter's estimate."""
+        tgt = self.targets[leader]
+        tgt.shown = None
+        if self.machine.state(leader) != LimbState.COMBINED:
+            return
+        other = self.targets[self.machine.partner(leader)]
+        if len(modes) >= 2:
+            pos_a, pos_b = assign_by_direction(self.machine.direction_before(leader), np.asarray(modes[:2]))
+            tgt.shown, other.shown = pos_a, pos_b
+        else:
+            tgt.shown = other.shown = tgt.filter.estimate.copy()
 
     # -- starting trackers -----------------------------------------------------------------
     def _new_tracker(self, target: _Target, state: LimbState) -> int:
@@ -256,14 +277,15 @@ class LimbTracker:
         tgt.last = centre.copy()
         self._new_tracker(tgt, LimbState.NORMAL)
 
-    def _unclaimed(self, cands: Candidates, exclude: int) -> Candidates:
+    def _unclaimed(self, cands: Candidates, exclude: int | tuple) -> Candidates:
         """Candidates not explained by another active tracker (a lost target must not
         recover onto a limb someone else tracks)."""
         if len(cands) == 0:
             return cands
         keep = np.ones(len(cands), bool)
+        exclude = set(exclude) if isinstance(exclude, tuple) else {exclude}
         for t, tgt in self.targets.items():
-            if t == exclude or tgt.filter is None:
+            if t in exclude or tgt.filter is None:
                 continue
             if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
                 d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
@@ -422,9 +444,10 @@ class LimbTracker:
             state = self.machine.state(t)
             if state == LimbState.UNINITIALIZED or not tgt.labelled:
                 continue
-            if state == LimbState.COMBINED and tgt.filter is None:
-                lead = self.targets[self.machine.partner(t)].filter
-                centre, conf = lead.estimate, lead.confidence
+            if state == LimbState.COMBINED:
+                lead = tgt.filter or self.targets[self.machine.partner(t)].filter
+                centre = tgt.shown if tgt.shown is not None else lead.estimate
+                conf = lead.confidence
             elif state == LimbState.LOST:
                 centre, conf = tgt.last if tgt.last is not None else tgt.filter.estimate, tgt.filter.confidence
             else:

@@ -106,9 +106,11 @@ class LimbParams:
     # (seed 003 sec. 3); the decay < 1 damps the velocity so a stopped hand does not overshoot.
     noise_v: float = 2.0
     velocity_decay: float = 0.8
-    # seed 003 eq. (1): pi = exp(-lam D^2); the paper's lam = 1 is too flat to separate
-    # skin from the background once multiplied by the blob term, 20 as in the body tracker.
-    lam: float = 20.0
+    # seed 003 eq. (1): pi = exp(-lam D^2). The reference holds only skin pixels while a
+    # candidate box also holds ~20% background at its corners (D^2 ~ 0.1 when on target):
+    # lam = 4 keeps that near 0.65 and a box on background (D^2 ~ 1) near 0.02; the paper's
+    # lam = 1 is too flat to tell them apart, the body tracker's 20 rejects even the target.
+    lam: float = 4.0
     # hue is undefined for grey pixels: only pixels with S and V at least these count.
     hue_min_saturation: int = 30
     hue_min_value: int = 40
@@ -128,7 +130,7 @@ class LimbParams:
     # frames of estimates kept to read the direction between two targets before they join.
     history_frames: int = 10
     # a combined filter spreads its particles this much wider so it sees both modes.
-    combined_noise_scale: float = 2.0
+    combined_noise_scale: float = 1.5
     # labelling (seed 000 sec. 7.1): a hand belongs to the nearest head within this many
     # head heights; a person facing the camera has the left hand on the image's right.
     person_radius: float = 5.0

@@ -132,6 +132,11 @@ class LimbStateMachine:
         """Frame at which a combined tracker joined its partner (-1 if not combined)."""
         return self._status[tracker].joined_at
 
+    def direction_before(self, tracker: int) -> np.ndarray | None:
+        """This combined tracker's position minus its partner's before they joined."""
+        b = self._status[tracker].before
+        return None if b is None else b.copy()
+
     def remove(self, tracker: int) -> None:
         """Forget an uninitialized tracker whose candidate vanished."""
         if self._status[tracker].state != LimbState.UNINITIALIZED:
@@ -153,8 +158,11 @@ class LimbStateMachine:
         p = self.params
         out: list[Transition] = []
 
+        moved: set[int] = set()  # one transition per tracker per frame
+
         def move(t: int, new: LimbState, reason: str, partner=None, position=None) -> None:
             s = self._status[t]
+            moved.add(t)
             out.append(Transition(t, frame, s.state, new, reason, partner, position))
             s.state = new
             s.low = 0
@@ -167,6 +175,8 @@ class LimbStateMachine:
 
         for t, s in list(self._status.items()):
             obs = observations.get(t, Observation())
+            if t in moved:
+                continue
             if s.state == LimbState.UNINITIALIZED:
                 s.strong = s.strong + 1 if obs.prior >= p.start_prior else 0
                 if s.strong >= p.start_frames:
