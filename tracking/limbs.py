@@ -186,6 +186,7 @@ class LimbTracker:
         active = [t for t in self.machine.trackers()
                   if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
         observations: dict[int, Observation] = {}
+        owners = self._owners(cands, active)
         for t in active:
             tgt = self.targets[t]
             state = self.machine.state(t)
@@ -198,7 +199,7 @@ class LimbTracker:
                 obs_c = self._unclaimed(cands, exclude=(t, self.machine.partner(t)))
             else:
                 tgt.filter.predict(self.rng)
-                obs_c = cands
+                obs_c = self._owned(cands, t, owners)
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
@@ -277,6 +278,31 @@ class LimbTracker:
         tgt.last = centre.copy()
         self._new_tracker(tgt, LimbState.NORMAL)
 
+    def _owners(self, cands: Candidates, active: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """For each candidate, the nearest tracked target (by last frame's estimate) and whether
+        it lies within that target's reach (half its size plus sigma_xy): ``(K,) int, (K,) bool``."""
+        live = [t for t in active if self.machine.state(t) != LimbState.LOST]
+        if len(cands) == 0 or not live:
+            return np.full(len(cands), -1), np.zeros(len(cands), bool)
+        est = np.array([self.targets[t].filter.estimate for t in live])
+        reach = np.array([max(self.targets[t].size) / 2 + self.params.sigma_xy for t in live])
+        d = np.hypot(cands.centres[:, None, 0] - est[None, :, 0], cands.centres[:, None, 1] - est[None, :, 1])
+        j = d.argmin(axis=1)
+        return np.asarray(live)[j], d[np.arange(len(cands)), j] <= reach[j]
+
+    def _owned(self, cands: Candidates, t: int, owners: tuple[np.ndarray, np.ndarray]) -> Candidates:
+        """The candidates a normal filter is weighted against: all but those another target sits on
+        (exclusion). Without it, a filter whose blob vanishes jumps to a neighbour's blob within a
+        frame and looks confident there, so it would never be declared lost (seed 000 sec. 5.2)."""
+        nearest, within = owners
+        keep = ~within | (nearest == t)
+        return self._subset(cands, keep)
+
+    @staticmethod
+    def _subset(cands: Candidates, keep: np.ndarray) -> Candidates:
+        return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
+                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep])
+
     def _unclaimed(self, cands: Candidates, exclude: int | tuple) -> Candidates:
         """Candidates not explained by another active tracker (a lost target must not
         recover onto a limb someone else tracks)."""
@@ -290,8 +316,7 @@ class LimbTracker:
             if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
                 d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
                 keep &= d > max(tgt.size) / 2 + self.params.sigma_xy
-        return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
-                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep])
+        return self._subset(cands, keep)
 
     def _propose(self, cands: Candidates, observations: dict[int, Observation]) -> None:
         """Uninitialized trackers follow candidates no existing tracker explains (sec. 5.2)."""
