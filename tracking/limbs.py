@@ -165,12 +165,12 @@ class LimbTracker:
         # 1. observations ------------------------------------------------------------------
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
-        fg = None if foreground is None else np.asarray(foreground) > 0
+        fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
         if fg is not None:
             skin_mask &= fg
         people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
         blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, p.min_blob_area)
-        cands = candidate_terms(blobs, foreground, skin_prob, p)
+        cands = candidate_terms(blobs, fg, skin_prob, p)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
         bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
         if fg is not None:
@@ -248,6 +248,33 @@ class LimbTracker:
             tgt.shown, other.shown = pos_a, pos_b
         else:
             tgt.shown = other.shown = tgt.filter.estimate.copy()
+
+    def _support(self, fg: np.ndarray, index: int) -> np.ndarray:
+        """The foreground plus a neighbourhood of every tracked target.
+
+        An adaptive background model absorbs a person who sits still (the desk scene's head
+        after a few seconds, or from the first frame when they are there from the start);
+        a target already under track keeps its region observable, while new trackers still
+        need real foreground to start. The neighbourhood is the target's box scaled by
+        ``support_scale`` around its last estimate.
+        """
+        boxes = [b for _, _, b in self._init.get(index, [])]
+        for t, tgt in self.targets.items():
+            if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
+                continue
+            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else tgt.last
+            w, h = tgt.size[0] * self.params.support_scale, tgt.size[1] * self.params.support_scale
+            boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
+        if not boxes:
+            return fg
+        out = fg.copy()
+        hgt, wid = fg.shape
+        for x, y, w, h in boxes:
+            x1, y1 = max(int(x), 0), max(int(y), 0)
+            x2, y2 = min(int(np.ceil(x + w)), wid), min(int(np.ceil(y + h)), hgt)
+            if x2 > x1 and y2 > y1:
+                out[y1:y2, x1:x2] = True
+        return out
 
     # -- starting trackers -----------------------------------------------------------------
     def _new_tracker(self, target: _Target, state: LimbState) -> int:

@@ -141,6 +141,9 @@ class LimbParams:
     # below reacquire_confidence.
     reacquire_frames: int = 5
     reacquire_confidence: float = 0.3
+    # a tracked target keeps a box this many times its size around it observable even where
+    # the adaptive background model has absorbed a person who sits still (limbs._support).
+    support_scale: float = 2.0
     # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2: alpha > 1), drop tiny ones
     blob_alpha: float = 1.5
     min_blob_area: float = 30.0

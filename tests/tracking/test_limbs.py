@@ -137,3 +137,20 @@ def test_bundled_face_cascade_loads():
     assert det is not None and not det.empty()
     # a flat frame has no face
     assert len(det.detectMultiScale(np.full((80, 80), 128, np.uint8))) == 0
+
+
+def test_a_still_head_absorbed_by_the_background_model_stays_tracked():
+    frames, truth = clap_scene(40)
+    mog = cv2.createBackgroundSubtractorMOG2(history=50, detectShadows=False)
+    tr = LimbTracker(P, np.random.default_rng(4), init=truth[truth.frame == 0], face_detector=False)
+    recs, fgs = [], []
+    for i, f in enumerate(frames):
+        fg = mog.apply(f, learningRate=1.0 if i == 0 else 0.05)
+        fgs.append(fg)
+        recs += tr.step(i, f, fg)
+    assert fgs[-1][14:36, 69:91].max() == 0  # the head is background for MOG2
+    out = records_to_frame(recs)
+    err, m = centre_error(out, truth)
+    heads = m.part == "head"
+    assert (out[out.part == "head"].state == "normal").all()
+    assert err[heads].max() < 3.0
