@@ -33,7 +33,7 @@ from tracking.hue_histogram import back_projection, hue_bin_image, integral_hist
 from tracking.limb_filter import Candidates, LimbFilter, candidate_modes, candidate_terms
 from tracking.params import LimbParams
 from tracking.parts import LIMB_PARTS
-from tracking.skin import SkinModel, find_blobs
+from tracking.skin import SkinModel, find_blobs, train_skin_model
 from tracking.state_machine import JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction
 from tracking.tracks import TrackRecord, normalise_tracks
 
@@ -163,8 +163,18 @@ class LimbTracker:
         self._last_frame = index
 
         # 1. observations ------------------------------------------------------------------
+        starting = self._init.get(index, [])
+        if starting and p.skin_adapt:
+            # the given boxes show these people's skin against this scene: a Bayes skin model
+            # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
+            # accepts, because their colours fill far more of the frame than the boxes.
+            self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
+                                         bins=self.skin.bins, prior=self.skin)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
+        if p.skin_open > 1:  # remove speckle left by noise
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin_open, p.skin_open))
+            skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
         if fg is not None:
             skin_mask &= fg
@@ -179,7 +189,7 @@ class LimbTracker:
         integral = integral_histogram(bins, p.hue_bins)
         weight = fg.astype(np.float32) if fg is not None else None
 
-        for track_id, part, box in self._init.get(index, []):
+        for track_id, part, box in starting:
             self._start(index, box, skin_bins, bins, track_id, part)
 
         # 2. low layer ---------------------------------------------------------------------

@@ -149,6 +149,10 @@ class LimbParams:
     min_blob_area: float = 30.0
     # skin probability above which a pixel is skin (skin.SkinModel)
     skin_threshold: float = 0.5
+    # with --init, refit the skin model on the init frame's head/hand boxes (limbs.LimbTracker)
+    skin_adapt: bool = True
+    # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
+    skin_open: int = 3
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -27,10 +27,19 @@ def test_mask_is_skin_and_foreground():
     frame[:, :10] = SKIN_BGR[0]
     fg = np.zeros((10, 20), np.uint8)
     fg[:5] = 255
-    mask = SkinModel.default().mask(frame, fg)
+    mask = SkinModel.default(blur=1).mask(frame, fg)
     assert mask.dtype == np.uint8 and int((mask > 0).sum()) == 5 * 10
     with pytest.raises(ValueError, match="does not match"):
         SkinModel.default().mask(frame, fg[:4])
+
+
+def test_blur_turns_a_noisy_skin_patch_into_a_solid_one():
+    rng = np.random.default_rng(0)
+    frame = np.clip(np.full((40, 40, 3), (120, 137, 160), float) + rng.normal(0, 12, (40, 40, 3)), 0, 255)
+    frame = frame.astype(np.uint8)  # Cr ~ 141: near the rule edge (136), so noise flips pixels
+    raw = SkinModel.default(blur=1).probability(frame)[5:35, 5:35].mean()
+    smooth = SkinModel.default(blur=5).probability(frame)[5:35, 5:35].mean()
+    assert raw < 0.8 and smooth > 0.95
 
 
 def test_find_blobs_keeps_the_largest_ceil_3_alpha_people_and_drops_tiny_ones():
@@ -66,11 +75,12 @@ def test_training_learns_a_skin_colour_outside_the_rule_and_keeps_background_out
 
 def test_skin_model_round_trips_through_json_and_npz(tmp_path):
     table = np.random.default_rng(1).random((16, 16)).astype(np.float32)
-    m = SkinModel(table)
+    m = SkinModel(table, blur=7)
     for name in ("skin.json", "skin.npz"):
         m.save(tmp_path / name)
         back = SkinModel.load(tmp_path / name)
         np.testing.assert_allclose(back.table, table, atol=1e-5)
+        assert back.blur == 7
 
 
 def test_bad_inputs_get_clear_errors():
@@ -82,5 +92,7 @@ def test_bad_inputs_get_clear_errors():
         SkinModel.default().probability(np.zeros((4, 4), np.uint8))
     with pytest.raises(ValueError, match="no skin pixels"):
         train_skin_model([np.zeros((10, 10, 3), np.uint8)], [np.zeros((0, 4))])
+    with pytest.raises(ValueError, match="odd kernel"):
+        SkinModel(np.zeros((16, 16)), blur=4)
     with pytest.raises(ValueError, match="not a skin model"):
         SkinModel.from_dict({"kind": "other"})
