@@ -169,7 +169,7 @@ class LimbTracker:
             # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
             # accepts, because their colours fill far more of the frame than the boxes.
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
-                                         bins=self.skin.bins, prior=self.skin)
+                                         bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
         if p.skin_open > 1:  # remove speckle left by noise

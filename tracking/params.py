@@ -151,6 +151,8 @@ class LimbParams:
     skin_threshold: float = 0.5
     # with --init, refit the skin model on the init frame's head/hand boxes (limbs.LimbTracker)
     skin_adapt: bool = True
+    # luma bins of the refitted model: coarse, so lighting drift stays within a bin or two
+    skin_ybins: int = 8
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     skin_open: int = 3
 

@@ -1,14 +1,14 @@
 """Skin-colour observations of the limb tracker (seed 000 sec. 6.1-6.2).
 
-A pixel's skin probability comes from a 2D histogram over the chroma plane
-(Cr, Cb) of YCrCb: chroma separates skin from most backgrounds under changing
-brightness, which the luma channel carries. The default model is the classic
-rectangular rule Cr in [133, 173], Cb in [77, 127] (Chai & Ngan 1999), which holds
-for ordinary webcam skin of light to dark tones and for the synthetic scenes. A
-model is trained from boxes users corrected as the ratio of the chroma histogram
-inside the boxes to the histogram of the whole frames (a Bayes skin classifier,
-P(skin | colour) up to a constant), blended with the rule so that colours never
-seen keep their prior. Models are plain arrays: saved as JSON or ``.npz``, never pickles.
+A pixel's skin probability comes from a histogram table over YCrCb: chroma (Cr, Cb)
+separates skin from most backgrounds under changing brightness, which the luma
+channel carries. The default model is the classic rectangular rule Cr in [133, 173],
+Cb in [77, 127] (Chai & Ngan 1999), brightness-free, which holds for ordinary webcam
+skin of light to dark tones and for the synthetic scenes. A model is trained from
+boxes users corrected (or the ``--init`` boxes) as the ratio of the colour histogram
+inside the boxes to the histogram of the whole frames (a Bayes skin classifier),
+with coarse luma bins, blended with the rule so that colours never seen keep their
+prior. Models are plain arrays: saved as JSON or ``.npz``, never pickles.
 
 Skin pixels are intersected with the foreground mask (skin-coloured background is
 not a limb), split into connected blobs, and the ``ceil(3 * alpha * people)``
@@ -33,7 +33,11 @@ DEFAULT_CB: tuple[int, int] = (77, 127)
 
 @dataclass(frozen=True)
 class SkinModel:
-    """P(skin | Cr, Cb) as a ``(bins, bins) float32`` table in [0, 1], rows Cr, columns Cb.
+    """P(skin | Y, Cr, Cb) as a ``(ybins, bins, bins) float32`` table in [0, 1].
+
+    The default rule ignores brightness (``ybins = 1``). A trained model splits luma
+    coarsely too (8 bins): skin-coloured wood differs from a face in chroma by less
+    than the noise on some scenes but is much darker or lighter.
 
     ``blur``: odd Gaussian kernel size applied to the frame before the lookup (1 = none).
     Camera noise scatters a skin region's chroma over neighbouring bins (std ~2-3 levels
@@ -46,8 +50,12 @@ class SkinModel:
 
     def __post_init__(self) -> None:
         t = np.asarray(self.table, dtype=np.float32)
-        if t.ndim != 2 or t.shape[0] != t.shape[1] or t.shape[0] < 2 or 256 % t.shape[0]:
-            raise ValueError(f"skin table must be square (bins, bins) with bins dividing 256, got {t.shape}")
+        if t.ndim == 2:
+            t = t[None]
+        if (t.ndim != 3 or t.shape[1] != t.shape[2] or t.shape[1] < 2 or 256 % t.shape[1]
+                or 256 % t.shape[0]):
+            raise ValueError("skin table must be square (bins, bins) or (ybins, bins, bins) with bins "
+                             f"dividing 256, got {np.shape(self.table)}")
         if not np.all(np.isfinite(t)) or t.min() < 0 or t.max() > 1:
             raise ValueError("skin table values must be finite probabilities in [0, 1]")
         object.__setattr__(self, "table", t)
@@ -57,6 +65,10 @@ class SkinModel:
 
     @property
     def bins(self) -> int:
+        return int(self.table.shape[1])
+
+    @property
+    def ybins(self) -> int:
         return int(self.table.shape[0])
 
     @classmethod
@@ -65,7 +77,15 @@ class SkinModel:
         centres = (np.arange(bins) + 0.5) * (256 / bins)
         cr_in = (centres >= DEFAULT_CR[0]) & (centres <= DEFAULT_CR[1] + 1)
         cb_in = (centres >= DEFAULT_CB[0]) & (centres <= DEFAULT_CB[1] + 1)
-        return cls((cr_in[:, None] & cb_in[None, :]).astype(np.float32), blur)
+        return cls((cr_in[:, None] & cb_in[None, :]).astype(np.float32)[None], blur)
+
+    def with_ybins(self, ybins: int) -> "SkinModel":
+        """The same model over ``ybins`` luma bins (a 1-bin table is repeated)."""
+        if ybins == self.ybins:
+            return self
+        if self.ybins != 1:
+            raise ValueError(f"cannot change a model with {self.ybins} luma bins to {ybins}")
+        return SkinModel(np.repeat(self.table, ybins, axis=0), self.blur)
 
     def chroma(self, frame: np.ndarray) -> np.ndarray:
         """``(H, W, 3) uint8`` YCrCb of the frame after the model's blur."""
@@ -78,9 +98,8 @@ class SkinModel:
         """``(H, W) float32`` skin probability of a BGR ``(H, W, 3) uint8`` frame."""
         ycrcb = self.chroma(frame)
         shift = int(round(math.log2(256 // self.bins)))
-        cr = ycrcb[..., 1] >> shift
-        cb = ycrcb[..., 2] >> shift
-        return self.table[cr, cb]
+        yshift = int(round(math.log2(256 // self.ybins)))
+        return self.table[ycrcb[..., 0] >> yshift, ycrcb[..., 1] >> shift, ycrcb[..., 2] >> shift]
 
     def mask(self, frame: np.ndarray, foreground: np.ndarray | None = None, threshold: float = 0.5) -> np.ndarray:
         """``(H, W) uint8`` mask, 255 where skin probability >= ``threshold`` and (if given) foreground."""
@@ -94,7 +113,7 @@ class SkinModel:
 
     # -- persistence: plain arrays only ---------------------------------------------------
     def to_dict(self) -> dict:
-        return {"kind": "skin_ycrcb_table", "bins": self.bins, "blur": self.blur,
+        return {"kind": "skin_ycrcb_table", "bins": self.bins, "ybins": self.ybins, "blur": self.blur,
                 "table": np.round(self.table, 5).tolist()}
 
     @classmethod
@@ -127,35 +146,36 @@ def _check_frame(frame: np.ndarray) -> np.ndarray:
     return frame
 
 
-def train_skin_model(frames, boxes, bins: int = 32, prior: SkinModel | None = None,
-                     prior_weight: float = 20.0) -> SkinModel:
-    """Fit P(skin | Cr, Cb) from corrected head/hand boxes (the prior's blur is kept).
+def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinModel | None = None,
+                     prior_weight: float = 20.0, inner: float = 0.8) -> SkinModel:
+    """Fit P(skin | Y, Cr, Cb) from corrected head/hand boxes (the prior's blur is kept).
 
     ``frames``: BGR frames; ``boxes``: for each frame a ``(K, 4)`` array of ``x, y, w, h``
-    skin boxes (head and hands users corrected). Only the inner ellipse of each box counts
-    as skin (boxes include some background at their corners). The estimate
-    ``n_skin / n_all`` per chroma bin is shrunk towards ``prior`` (default rule) with
-    ``prior_weight`` pseudo-counts, so rare colours keep the prior's answer.
+    skin boxes (head and hands users corrected). Only the ellipse inscribed in each box,
+    shrunk to ``inner`` of its radii, counts as skin (box corners are background; a head
+    box's rim is hair). The estimate ``n_skin / n_all`` per colour bin is shrunk towards
+    ``prior`` (default: the rule) with ``prior_weight`` pseudo-counts, so colours seen
+    rarely keep the prior's answer while colours that fill the scene (a wooden desk)
+    get the low probability they earn.
     """
-    prior = prior or SkinModel.default(bins)
-    model = SkinModel(prior.table, prior.blur)
+    prior = (prior or SkinModel.default(bins)).with_ybins(ybins)
     if prior.bins != bins:
         raise ValueError(f"prior has {prior.bins} bins, expected {bins}")
-    skin = np.zeros((bins, bins), np.float64)
-    total = np.zeros((bins, bins), np.float64)
+    skin = np.zeros((ybins, bins, bins), np.float64)
+    total = np.zeros((ybins, bins, bins), np.float64)
     n_frames = 0
+    hist_args = ([0, 1, 2], [ybins, bins, bins], [0, 256, 0, 256, 0, 256])
     for frame, fboxes in zip(frames, boxes):
         n_frames += 1
-        ycrcb = model.chroma(frame)
-        hist_args = ([1, 2], None, [bins, bins], [0, 256, 0, 256])
-        total += cv2.calcHist([ycrcb], hist_args[0], None, *hist_args[2:])
+        ycrcb = prior.chroma(frame)
+        total += cv2.calcHist([ycrcb], hist_args[0], None, *hist_args[1:])
         mask = np.zeros(frame.shape[:2], np.uint8)
         for x, y, w, h in np.asarray(fboxes, dtype=float).reshape(-1, 4):
             if w < 2 or h < 2:
                 continue
             cv2.ellipse(mask, (int(round(x + w / 2)), int(round(y + h / 2))),
-                        (max(int(w / 2), 1), max(int(h / 2), 1)), 0, 0, 360, 255, -1)
-        skin += cv2.calcHist([ycrcb], hist_args[0], mask, *hist_args[2:])
+                        (max(int(inner * w / 2), 1), max(int(inner * h / 2), 1)), 0, 0, 360, 255, -1)
+        skin += cv2.calcHist([ycrcb], hist_args[0], mask, *hist_args[1:])
     if n_frames == 0:
         raise ValueError("train_skin_model needs at least one frame")
     if skin.sum() == 0:

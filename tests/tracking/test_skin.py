@@ -79,7 +79,7 @@ def test_skin_model_round_trips_through_json_and_npz(tmp_path):
     for name in ("skin.json", "skin.npz"):
         m.save(tmp_path / name)
         back = SkinModel.load(tmp_path / name)
-        np.testing.assert_allclose(back.table, table, atol=1e-5)
+        np.testing.assert_allclose(back.table[0], table, atol=1e-5)
         assert back.blur == 7
 
 
