@@ -130,7 +130,10 @@ class LimbFilter:
                                 np.full(len(self.particles), w), np.full(len(self.particles), h)])
 
     def weigh(self, candidates: Candidates, integral: np.ndarray) -> np.ndarray:
-        """Weights = blob likelihood (eq. 17, floored) x hue confidence (seed 003 eq. 1).
+        """Weights = blob likelihood (eq. 17) x hue confidence (seed 003 eq. 1) + a floor.
+
+        The floor is added, not multiplied by the hue term: a filter whose blob vanished
+        then diffuses around its last place instead of being drawn to another limb's skin.
 
         ``confidence`` becomes the best particle's unnormalised score in [0, 1], the
         likelihood level the state machine thresholds.
@@ -140,7 +143,7 @@ class LimbFilter:
         hue = hue_confidence(box_histograms(integral, self.particle_boxes()), self.ref_hist, p.lam)
         score = blob * hue
         self.confidence = float(score.max()) if score.size else 0.0
-        w = (blob + p.blob_floor) * hue
+        w = score + p.blob_floor
         total = w.sum()
         self.weights = w / total if total > 0 else np.full(len(w), 1.0 / len(w))
         self.estimate = (self.weights[:, None] * self.particles[:, :2]).sum(axis=0)

@@ -186,8 +186,11 @@ class LimbTracker:
         if fg is not None:
             bins = np.where(fg, bins, -1).astype(np.int16)
         skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)
-        integral = integral_histogram(bins, p.hue_bins)
-        weight = fg.astype(np.float32) if fg is not None else None
+        # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
+        # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
+        # The colour likelihood and the mean shift therefore run on the "skin-colour
+        # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
+        integral = integral_histogram(skin_bins, p.hue_bins)
 
         for track_id, part, box in starting:
             self._start(index, box, skin_bins, bins, track_id, part)
@@ -217,7 +220,7 @@ class LimbTracker:
                 m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, p.sigma_xy, radius)
                 modes = tuple(map(tuple, m[:2]))
             if state != LimbState.LOST:
-                bp = back_projection(bins, tgt.filter.ref_hist, weight)
+                bp = back_projection(skin_bins, tgt.filter.ref_hist)
                 tgt.filter.refine(bp)
             tgt.filter.resample(self.rng)
             if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:

@@ -98,8 +98,8 @@ class LimbParams:
     # spread of p(x | Z_c), the particle-to-candidate term of seed 000 eq. 17 (pixels):
     # about a hand's radius, so a particle on the blob scores near 1 and one beside it little.
     sigma_xy: float = 8.0
-    # a particle far from every blob keeps this much blob likelihood, so the hue term still
-    # guides it through frames where its limb's blob is missed (shadow, occlusion).
+    # weight every particle keeps (added to blob x hue, which is ~0.8 on target), so a filter
+    # whose blob is missed (shadow, occlusion) diffuses around its last place.
     blob_floor: float = 0.01
     noise_xy: float = 6.0
     # velocity noise of the second-order dynamics x_t - x_{t-1} = x_{t-1} - x_{t-2} + w_t

@@ -9,7 +9,8 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   for ``start_frames`` frames;
 - unlabelled -> normal: a labelling cue gave the tracker its type;
 - normal -> combined (both trackers): their estimates come closer than
-  ``combine_distance``; the vector between them before joining is kept;
+  ``combine_distance`` while both are confident (likelihood at least
+  ``lost_likelihood``); the vector between them before joining is kept;
 - combined -> unlabelled (both): the combined posterior's two strongest modes lie
   more than ``split_distance`` apart; each tracker receives the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
@@ -218,8 +219,11 @@ class LimbStateMachine:
     def _combine(self, frame: int, observations: dict[int, Observation], move) -> None:
         """Pair normal trackers whose estimates are closer than ``combine_distance``, closest first."""
         p = self.params
+        # a filter below the lost threshold has no meaningful maximum-likelihood point: it is
+        # drifting (its blob vanished), and must not be combined with the target it drifts onto
         ids = [t for t, s in self._status.items() if s.state == LimbState.NORMAL
-               and observations.get(t, Observation()).position is not None]
+               and observations.get(t, Observation()).position is not None
+               and observations[t].likelihood >= p.lost_likelihood]
         pairs = []
         for i, a in enumerate(ids):
             for b in ids[i + 1:]:

@@ -135,3 +135,11 @@ def test_remove_refuses_a_started_tracker():
         m.remove(0)
     with pytest.raises(ValueError, match="already exists"):
         m.add(0)
+
+
+def test_a_drifting_tracker_below_the_lost_threshold_is_not_combined():
+    m = LimbStateMachine(P)
+    m.add(0, S.NORMAL)
+    m.add(1, S.NORMAL)
+    m.update(0, {0: ok(0, 0, lik=0.05), 1: ok(10, 0)})
+    assert m.state(0) == S.NORMAL and m.state(1) == S.NORMAL
