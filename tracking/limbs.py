@@ -179,7 +179,7 @@ class LimbTracker:
         if fg is not None:
             skin_mask &= fg
         people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
-        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, p.min_blob_area)
+        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, self._min_area(starting))
         cands = candidate_terms(blobs, fg, skin_prob, p)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
         bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
@@ -261,6 +261,15 @@ class LimbTracker:
             tgt.shown, other.shown = pos_a, pos_b
         else:
             tgt.shown = other.shown = tgt.filter.estimate.copy()
+
+    def _min_area(self, starting) -> float:
+        """Smallest blob kept: ``min_blob_area``, or less when the targets are small (a distant
+        walker's hand): a quarter of the smallest target's box area."""
+        sizes = [t.size[0] * t.size[1] for t in self.targets.values() if t.filter is not None]
+        sizes += [float(b[2] * b[3]) for _, _, b in starting]
+        if not sizes:
+            return self.params.min_blob_area
+        return min(self.params.min_blob_area, 0.25 * min(sizes))
 
     def _support(self, fg: np.ndarray, index: int) -> np.ndarray:
         """The foreground plus a neighbourhood of every tracked target.
