@@ -96,10 +96,12 @@ def blob_likelihood(points: np.ndarray, candidates: Candidates, sigma_xy: float)
 class LimbFilter:
     """SIR particle filter of one target (a head, a hand, or two combined targets)."""
 
-    def __init__(self, centre, size, ref_hist: np.ndarray, params: LimbParams, rng: np.random.Generator):
+    def __init__(self, centre, size, ref_hist: np.ndarray | None, params: LimbParams, rng: np.random.Generator):
         self.params = params
         self.size = (float(size[0]), float(size[1]))
-        self.ref_hist = np.asarray(ref_hist, dtype=float)
+        # no reference yet (the caller fills it in): flat until then
+        self.ref_hist = (np.full(params.hue_bins, 1.0 / params.hue_bins) if ref_hist is None
+                         else np.asarray(ref_hist, dtype=float))
         self.particles = np.zeros((params.particles, 4))
         self.reset(centre, rng)
         self.confidence = 1.0

@@ -94,6 +94,7 @@ class _Target:
     candidate_box: np.ndarray | None = None
     missed: int = 0  # uninitialized: frames without its candidate
     shown: np.ndarray | None = None  # combined: the position written for this member
+    anchor: np.ndarray | None = None  # the person's head estimate when ``last`` was taken
 
     @property
     def labelled(self) -> bool:
@@ -194,6 +195,10 @@ class LimbTracker:
 
         for track_id, part, box in starting:
             self._start(index, box, skin_bins, bins, track_id, part)
+        self._fill_references(skin_bins)
+        for t, tgt in self.targets.items():  # started before their head was: anchor them now
+            if tgt.anchor is None and tgt.last is not None and tgt.part != "head":
+                tgt.anchor = self._head_of(t)
 
         # 2. low layer ---------------------------------------------------------------------
         active = [t for t in self.machine.trackers()
@@ -204,7 +209,7 @@ class LimbTracker:
             tgt = self.targets[t]
             state = self.machine.state(t)
             if state == LimbState.LOST:
-                tgt.filter.reset(tgt.last, self.rng, spread=p.noise_xy * p.combined_noise_scale)
+                tgt.filter.reset(self._search_centre(t), self.rng, spread=p.lost_search)
                 obs_c = self._unclaimed(cands, exclude=t)
             elif state == LimbState.COMBINED:
                 # the pair's filter sees only candidates no other tracker explains (its own blobs)
@@ -225,6 +230,7 @@ class LimbTracker:
             tgt.filter.resample(self.rng)
             if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:
                 tgt.last = tgt.filter.estimate.copy()
+                tgt.anchor = self._head_of(t)
                 if state == LimbState.NORMAL:
                     tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
             observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
@@ -245,7 +251,26 @@ class LimbTracker:
         # 3. high layer --------------------------------------------------------------------
         for tr in self.machine.update(index, observations):
             self._apply(tr, index, skin_bins)
+        self._fill_references(skin_bins)
         return self._records(index)
+
+    def _head_of(self, t: int) -> np.ndarray | None:
+        """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
+        tid = self.targets[t].track_id
+        for h, tgt in self.targets.items():
+            if (h != t and tgt.track_id == tid and tgt.part == "head" and tgt.filter is not None
+                    and self.machine.state(h) in (LimbState.NORMAL, LimbState.UNLABELLED)):
+                return tgt.filter.estimate.copy()
+        return None
+
+    def _search_centre(self, t: int) -> np.ndarray:
+        """Where a lost target is looked for: its last confident position (sec. 5.2), moved
+        with its person's head since then: a walker's hidden hand travels with the body."""
+        tgt = self.targets[t]
+        head = self._head_of(t)
+        if tgt.anchor is None or head is None:
+            return tgt.last
+        return tgt.last + (head - tgt.anchor)
 
     def _place_pair(self, leader: int, modes: tuple) -> None:
         """Output positions of a combined pair: while two modes show (not yet far enough apart
@@ -284,7 +309,7 @@ class LimbTracker:
         for t, tgt in self.targets.items():
             if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
                 continue
-            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else tgt.last
+            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else self._search_centre(t)
             w, h = tgt.size[0] * self.params.support_scale, tgt.size[1] * self.params.support_scale
             boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
         if not boxes:
@@ -309,13 +334,33 @@ class LimbTracker:
     def _make_filter(self, tgt: _Target, centre) -> LimbFilter:
         return LimbFilter(centre, tgt.size, tgt.ref_hist, self.params, self.rng)
 
-    def _reference(self, box, skin_bins: np.ndarray, bins: np.ndarray) -> np.ndarray:
-        """Hue reference of a box: its skin pixels, else its coloured pixels, else a flat histogram."""
-        for img in (skin_bins, bins):
-            h = reference_histogram(img, box, self.params.hue_bins)
-            if h is not None:
-                return h
-        return np.full(self.params.hue_bins, 1.0 / self.params.hue_bins)
+    def _reference(self, box, skin_bins: np.ndarray, bins: np.ndarray) -> np.ndarray | None:
+        """Hue reference of a box from its skin pixels; None when under a tenth of the box is
+        skin (a hand hidden behind the body at its first frame)."""
+        x, y, w, h = (int(round(v)) for v in box)
+        hgt, wid = skin_bins.shape
+        patch = skin_bins[max(y, 0):min(y + h, hgt), max(x, 0):min(x + w, wid)]
+        if patch.size == 0 or (patch >= 0).sum() < 0.1 * max(w * h, 1):
+            return None
+        return reference_histogram(skin_bins, box, self.params.hue_bins)
+
+    def _fill_references(self, skin_bins: np.ndarray) -> None:
+        """Targets started without a usable reference take their person's face colour (seed 003
+        sec. 3: the hands' reference comes from the face), else the hue of all skin in view."""
+        for t, tgt in self.targets.items():
+            if tgt.filter is None or tgt.ref_hist is not None:
+                continue
+            head = next((h for h in self.targets.values() if h.track_id == tgt.track_id and h.part == "head"
+                         and h.ref_hist is not None), None)
+            if head is not None:
+                ref = head.ref_hist.copy()
+            else:
+                vals = skin_bins[skin_bins >= 0]
+                ref = (np.bincount(vals, minlength=self.params.hue_bins).astype(float) if vals.size
+                       else np.ones(self.params.hue_bins))
+                ref = ref / ref.sum()
+            tgt.ref_hist = ref
+            tgt.filter.ref_hist = ref.copy()
 
     def _start(self, index: int, box, skin_bins, bins, track_id: int, part: str) -> None:
         """Start a labelled tracker from an INIT.csv box (state normal)."""
@@ -523,7 +568,8 @@ class LimbTracker:
                 centre = tgt.shown if tgt.shown is not None else lead.estimate
                 conf = lead.confidence
             elif state == LimbState.LOST:
-                centre, conf = tgt.last if tgt.last is not None else tgt.filter.estimate, tgt.filter.confidence
+                centre = self._search_centre(t) if tgt.last is not None else tgt.filter.estimate
+                conf = tgt.filter.confidence
             else:
                 centre, conf = tgt.filter.estimate, tgt.filter.confidence
             w, h = tgt.size

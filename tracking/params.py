@@ -124,6 +124,9 @@ class LimbParams:
     # hysteresis: a lost target comes back only above this confidence.
     recover_likelihood: float = 0.3
     lost_frames: int = 5
+    # a lost target's particles are spread this wide (pixels, std) around where it is looked
+    # for: about a swinging hand's excursion from where the body carried it.
+    lost_search: float = 20.0
     start_frames: int = 3
     # prior p(Z) a candidate needs for start_frames frames to start a tracker (sec. 5.2).
     start_prior: float = 0.5
