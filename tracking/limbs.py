@@ -221,8 +221,9 @@ class LimbTracker:
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
-                radius = p.split_distance + p.noise_xy * p.combined_noise_scale
-                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, p.sigma_xy, radius)
+                radius = p.mode_search * p.split_distance
+                # a kernel as wide as the search: the particles sit on one mode, the other may be far
+                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
                 modes = tuple(map(tuple, m[:2]))
             if state != LimbState.LOST:
                 bp = back_projection(skin_bins, tgt.filter.ref_hist)
