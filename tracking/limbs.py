@@ -173,12 +173,12 @@ class LimbTracker:
                                          bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
-        if p.skin_open > 1:  # remove speckle left by noise
-            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin_open, p.skin_open))
-            skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
         if fg is not None:
             skin_mask &= fg
+        if p.skin_open > 1:  # remove speckle left by noise
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin_open, p.skin_open))
+            skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
         people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
         blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, self._min_area(starting))
         cands = candidate_terms(blobs, fg, skin_prob, p)

@@ -147,13 +147,14 @@ def _check_frame(frame: np.ndarray) -> np.ndarray:
 
 
 def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinModel | None = None,
-                     prior_weight: float = 20.0, inner: float = 0.8) -> SkinModel:
+                     prior_weight: float = 20.0, inner: float = 1.0) -> SkinModel:
     """Fit P(skin | Y, Cr, Cb) from corrected head/hand boxes (the prior's blur is kept).
 
     ``frames``: BGR frames; ``boxes``: for each frame a ``(K, 4)`` array of ``x, y, w, h``
     skin boxes (head and hands users corrected). Only the ellipse inscribed in each box,
-    shrunk to ``inner`` of its radii, counts as skin (box corners are background; a head
-    box's rim is hair). The estimate ``n_skin / n_all`` per colour bin is shrunk towards
+    scaled by ``inner`` (1: the whole inscribed ellipse; tight boxes such as the synthetic
+    truth need all of it, a smaller hand loses a third of its pixels at 0.8), counts as
+    skin: the box corners are background. The estimate ``n_skin / n_all`` per colour bin is shrunk towards
     ``prior`` (default: the rule) with ``prior_weight`` pseudo-counts, so colours seen
     rarely keep the prior's answer while colours that fill the scene (a wooden desk)
     get the low probability they earn.
