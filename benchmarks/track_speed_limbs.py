@@ -17,7 +17,6 @@ import numpy as np
 
 from tracking.limbs import LimbTracker
 from tracking.params import LimbParams
-from tracking.tracks import TrackRecord  # noqa: F401  (the output type)
 
 SKIN = (105, 145, 195)
 

@@ -26,11 +26,12 @@ def hue_bin_image(hsv: np.ndarray, bins: int, min_saturation: int, min_value: in
 
 
 def integral_histogram(bin_image: np.ndarray, bins: int) -> np.ndarray:
-    """``(H+1, W+1, bins) float32`` integral of the one-hot bins; box sums in O(1) per box."""
+    """``(bins, H+1, W+1) int32`` integral images of the one-hot bins (``cv2.integral`` per
+    plane, contiguous); any box's histogram then costs four lookups per bin."""
     hgt, wid = bin_image.shape
-    out = np.zeros((hgt + 1, wid + 1, bins), np.float32)
-    for b in range(bins):  # one plane at a time keeps the peak memory at one (H, W) plane
-        out[1:, 1:, b] = (bin_image == b).astype(np.float32).cumsum(0).cumsum(1)
+    out = np.empty((bins, hgt + 1, wid + 1), np.int32)
+    for b in range(bins):
+        out[b] = cv2.integral((bin_image == b).view(np.uint8))
     return out
 
 
@@ -39,13 +40,14 @@ def box_histograms(integral: np.ndarray, boxes: np.ndarray) -> np.ndarray:
 
     A box with no valid pixel gets an all-zero histogram (Bhattacharyya distance 1).
     """
-    hgt, wid = integral.shape[0] - 1, integral.shape[1] - 1
+    hgt, wid = integral.shape[1] - 1, integral.shape[2] - 1
     b = np.asarray(boxes, dtype=float).reshape(-1, 4)
     x1 = np.clip(np.round(b[:, 0]), 0, wid).astype(int)
     y1 = np.clip(np.round(b[:, 1]), 0, hgt).astype(int)
     x2 = np.clip(np.round(b[:, 0] + b[:, 2]), 0, wid).astype(int)
     y2 = np.clip(np.round(b[:, 1] + b[:, 3]), 0, hgt).astype(int)
-    counts = integral[y2, x2] - integral[y1, x2] - integral[y2, x1] + integral[y1, x1]
+    counts = (integral[:, y2, x2] - integral[:, y1, x2] - integral[:, y2, x1] + integral[:, y1, x1]).T
+    counts = counts.astype(float)
     total = counts.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(total > 0, counts / np.maximum(total, 1e-12), 0.0)

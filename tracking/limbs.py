@@ -2,11 +2,13 @@
 
 Per frame (``LimbTracker.step``):
 
-1. observations: skin pixels within the foreground, connected blobs (``tracking.skin``),
-   candidates with a prior that is a product of named terms (``tracking.limb_filter``);
-2. low layer: every active filter predicts, is weighted against all candidates and
-   its hue histogram (seed 000 eq. 17, seed 003 eq. 1-2), refined by mean shift on the
-   back-projection and resampled;
+1. observations: skin pixels (``tracking.skin``; with ``--init`` the skin model is refit
+   on the init boxes against the whole frame) within the foreground and the
+   neighbourhood of tracked targets, connected blobs, candidates with a prior that is a
+   product of named terms (``tracking.limb_filter``);
+2. low layer: every active filter predicts, is weighted against the candidates no other
+   target sits on and its hue histogram over skin pixels (seed 000 eq. 17, seed 003
+   eq. 1-2), refined by mean shift on the skin hue back-projection and resampled;
 3. high layer: the per-tracker state machine (``tracking.state_machine``) combines,
    splits, loses and recovers targets; this module acts on its transitions (one filter
    for a combined pair, one filter per mode after a split, labels by the direction
@@ -115,6 +117,7 @@ class LimbTracker:
                  face_detector: bool = True):
         self.params = params or LimbParams()
         self.rng = rng if rng is not None else np.random.default_rng(0)
+        # ``skin``: a trained model (e.g. from a model bundle); default: the YCrCb rule
         self.skin = skin or SkinModel.default()
         self.machine = LimbStateMachine(self.params)
         self.targets: dict[int, _Target] = {}
@@ -184,9 +187,7 @@ class LimbTracker:
         cands = candidate_terms(blobs, fg, skin_prob, p)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
         bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
-        if fg is not None:
-            bins = np.where(fg, bins, -1).astype(np.int16)
-        skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)
+        skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)  # skin_mask is within the support
         # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
         # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
         # The colour likelihood and the mean shift therefore run on the "skin-colour
@@ -194,7 +195,7 @@ class LimbTracker:
         integral = integral_histogram(skin_bins, p.hue_bins)
 
         for track_id, part, box in starting:
-            self._start(index, box, skin_bins, bins, track_id, part)
+            self._start(box, skin_bins, track_id, part)
         self._fill_references(skin_bins)
         for t, tgt in self.targets.items():  # started before their head was: anchor them now
             if tgt.anchor is None and tgt.last is not None and tgt.part != "head":
@@ -335,7 +336,7 @@ class LimbTracker:
     def _make_filter(self, tgt: _Target, centre) -> LimbFilter:
         return LimbFilter(centre, tgt.size, tgt.ref_hist, self.params, self.rng)
 
-    def _reference(self, box, skin_bins: np.ndarray, bins: np.ndarray) -> np.ndarray | None:
+    def _reference(self, box, skin_bins: np.ndarray) -> np.ndarray | None:
         """Hue reference of a box from its skin pixels; None when under a tenth of the box is
         skin (a hand hidden behind the body at its first frame)."""
         x, y, w, h = (int(round(v)) for v in box)
@@ -363,11 +364,11 @@ class LimbTracker:
             tgt.ref_hist = ref
             tgt.filter.ref_hist = ref.copy()
 
-    def _start(self, index: int, box, skin_bins, bins, track_id: int, part: str) -> None:
+    def _start(self, box, skin_bins: np.ndarray, track_id: int, part: str) -> None:
         """Start a labelled tracker from an INIT.csv box (state normal)."""
         box = np.asarray(box, float)
         tgt = _Target(track_id=track_id, part=part, size=(max(box[2], 2.0), max(box[3], 2.0)),
-                      ref_hist=self._reference(box, skin_bins, bins))
+                      ref_hist=self._reference(box, skin_bins))
         centre = box[:2] + box[2:] / 2
         tgt.filter = self._make_filter(tgt, centre)
         tgt.last = centre.copy()
@@ -542,7 +543,7 @@ class LimbTracker:
             box = tgt.candidate_box
             side = float(max(box[2], box[3], 4.0))
             tgt.size = (side, side)
-            tgt.ref_hist = self._reference(box, skin_bins, skin_bins)
+            tgt.ref_hist = self._reference(box, skin_bins)
             tgt.filter = self._make_filter(tgt, tgt.candidate)
             tgt.last = tgt.candidate.copy()
         elif tr.new == LimbState.COMBINED and not self.machine.is_leader(tr.tracker):
