@@ -465,7 +465,9 @@ class LimbTracker:
             cx, cy = tgt.filter.estimate
             on_face = any(fx <= cx <= fx + fw and fy <= cy <= fy + fh for fx, fy, fw, fh in faces)
             head = self._nearest_head(tgt.filter.estimate)
-            if on_face and head is None:
+            # a face that is not the nearby head's own is another person's head
+            if on_face and (head is None or np.hypot(*(head[1].filter.estimate - tgt.filter.estimate))
+                            > max(head[1].size)):
                 self._assign(t, self._next_person, "head")
                 self._next_person += 1
             elif head is not None:
