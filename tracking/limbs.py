@@ -107,7 +107,8 @@ class LimbTracker:
     """Head and hands of several people; implements ``tracking.frame_tracker.FrameTracker``.
 
     ``init``: a tracks table (INIT.csv) whose head/left_hand/right_hand rows start
-    tracks at their first listed frame with their ``track_id``; without it, trackers
+    tracks at their first listed frame with their ``track_id``; without it (or without
+    limb rows in it), trackers
     start from persistent skin blobs and are labelled by the face detector and by
     position relative to a head.
     """
@@ -126,17 +127,18 @@ class LimbTracker:
         self._next_person = 0
         self._last_frame = -1
         self._init: dict[int, list[tuple[int, str, np.ndarray]]] = {}
-        self.auto_start = init is None
-        if init is not None:
-            init = normalise_tracks(init)
-            rows = init[init["part"].isin(LIMB_PARTS)]
-            if rows.empty:
-                raise ValueError("the init table has no head/left_hand/right_hand rows for the limb tracker")
+        rows = None if init is None else normalise_tracks(init)
+        if rows is not None:
+            self._next_person = int(rows["track_id"].max()) + 1 if len(rows) else 0
+            rows = rows[rows["part"].isin(LIMB_PARTS)]
+        # an init table with only body rows (``--tracker all --init`` from the body tracker's
+        # boxes) starts the limbs automatically, with person ids after the table's
+        self.auto_start = rows is None or rows.empty
+        if not self.auto_start:
             first = rows.sort_values("frame", kind="stable").groupby(["track_id", "part"], sort=False).head(1)
             for r in first.itertuples(index=False):
                 self._init.setdefault(int(r.frame), []).append(
                     (int(r.track_id), str(r.part), np.array([r.x, r.y, r.w, r.h], float)))
-            self._next_person = int(init["track_id"].max()) + 1
 
     # -- public ----------------------------------------------------------------------------
     @property

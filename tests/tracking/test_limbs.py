@@ -104,11 +104,18 @@ def test_without_init_head_and_hands_start_and_are_labelled_by_position():
     assert (out.frame.min()) >= P.start_frames - 1  # nothing before a candidate was strong long enough
 
 
-def test_init_without_limb_rows_and_bad_frames_are_refused():
-    init = pd.DataFrame({"frame": [0], "track_id": [1], "part": ["torso"], "x": [0.0], "y": [0.0],
-                         "w": [5.0], "h": [5.0]})
-    with pytest.raises(ValueError, match="no head/left_hand/right_hand rows"):
-        LimbTracker(P, np.random.default_rng(0), init=init)
+def test_init_with_only_body_rows_starts_limbs_automatically_after_its_ids():
+    frames, _ = clap_scene(14)
+    init = pd.DataFrame({"frame": [0], "track_id": [4], "part": ["torso"], "x": [55.0], "y": [35.0],
+                         "w": [50.0], "h": [80.0]})
+    tr = LimbTracker(P, np.random.default_rng(2), init=init, face_detector=False)
+    assert tr.auto_start
+    out = run(tr, frames)
+    last = out[out.frame == 13]
+    assert sorted(last.part) == ["head", "left_hand", "right_hand"] and set(last.track_id) == {5}
+
+
+def test_bad_frames_are_refused():
     tr = LimbTracker(P, np.random.default_rng(0), face_detector=False)
     with pytest.raises(ValueError, match="BGR"):
         tr.step(0, np.zeros((10, 10), np.uint8), None)
