@@ -36,7 +36,8 @@ from tracking.limb_filter import Candidates, LimbFilter, candidate_modes, candid
 from tracking.params import LimbParams
 from tracking.parts import LIMB_PARTS
 from tracking.skin import SkinModel, find_blobs, train_skin_model
-from tracking.state_machine import JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction
+from tracking.state_machine import (JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction,
+                                    distance_threshold)
 from tracking.tracks import TrackRecord, normalise_tracks
 
 EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a",
@@ -224,7 +225,7 @@ class LimbTracker:
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
-                radius = p.mode_search * p.split_distance
+                radius = p.mode_search * distance_threshold(p.split_distance, p.split_size, self._side(t))
                 # a kernel as wide as the search: the particles sit on one mode, the other may be far
                 m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
                 modes = tuple(map(tuple, m[:2]))
@@ -238,7 +239,7 @@ class LimbTracker:
                 if state == LimbState.NORMAL:
                     tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
             observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
-                                          labelled=tgt.labelled, modes=modes)
+                                          labelled=tgt.labelled, modes=modes, size=self._side(t))
             self._place_pair(t, modes)
         # followers of a combined pair report the leader's estimate
         for t in self.machine.trackers():
@@ -246,7 +247,7 @@ class LimbTracker:
                 lead = observations.get(self.machine.partner(t))
                 if lead is not None:
                     observations[t] = Observation(position=lead.position, likelihood=lead.likelihood,
-                                                  labelled=self.targets[t].labelled)
+                                                  labelled=self.targets[t].labelled, size=self._side(t))
         if self.auto_start:
             self._propose(cands, observations)
         self._label(index, frame, observations)
@@ -257,6 +258,17 @@ class LimbTracker:
             self._apply(tr, index, skin_bins)
         self._fill_references(skin_bins)
         return self._records(index)
+
+    def _side(self, t: int) -> float:
+        """Box side of a target (mean of width and height), the unit of the state machine's
+        distances; a combined leader uses the mean of both members."""
+        tgt = self.targets[t]
+        side = (tgt.size[0] + tgt.size[1]) / 2
+        partner = self.machine.partner(t)
+        if self.machine.state(t) == LimbState.COMBINED and partner is not None:
+            other = self.targets[partner]
+            side = (side + (other.size[0] + other.size[1]) / 2) / 2
+        return side
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
@@ -488,7 +500,7 @@ class LimbTracker:
                 self._next_person += 1
             if tgt.labelled and t in observations:
                 o = observations[t]
-                observations[t] = Observation(o.position, o.likelihood, o.prior, True, o.modes)
+                observations[t] = Observation(o.position, o.likelihood, o.prior, True, o.modes, o.size)
 
     def _assign(self, t: int, track_id: int, part: str) -> None:
         tgt = self.targets[t]
@@ -538,7 +550,7 @@ class LimbTracker:
             tgt.last, tgt.low_frames = centres[j].copy(), 0
             o = observations[t]
             observations[t] = Observation(tuple(centres[j]), max(o.likelihood, p.recover_likelihood),
-                                          o.prior, o.labelled, o.modes)
+                                          o.prior, o.labelled, o.modes, o.size)
 
     # -- acting on transitions -----------------------------------------------------------------
     def _apply(self, tr, index: int, skin_bins: np.ndarray) -> None:

@@ -204,6 +204,11 @@ class LimbParams:
     # state machine thresholds (seed 000 sec. 5.2)
     combine_distance: float = 20.0
     split_distance: float = 30.0
+    # the same in units of the targets' box side, used when sizes are known (always in the
+    # tracker) so the thresholds hold at any resolution: hands combine when about touching
+    # (1.3 sides between centres) and split once a gap of most of a hand shows (1.8 sides).
+    combine_size: float = 1.3
+    split_size: float = 1.8
     lost_likelihood: float = 0.15
     # hysteresis: a lost target comes back only above this confidence.
     recover_likelihood: float = 0.3

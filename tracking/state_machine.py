@@ -9,10 +9,10 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   for ``start_frames`` frames;
 - unlabelled -> normal: a labelling cue gave the tracker its type;
 - normal -> combined (both trackers): their estimates come closer than
-  ``combine_distance`` while both are confident (likelihood at least
+  ``combine_size`` target sizes (``combine_distance`` pixels when no size is given) while both are confident (likelihood at least
   ``lost_likelihood``); the vector between them before joining is kept;
 - combined -> unlabelled (both): the combined posterior's two strongest modes lie
-  more than ``split_distance`` apart; each tracker receives the mode that keeps the
+  more than ``split_size`` target sizes (or ``split_distance`` pixels) apart; each tracker receives the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
 - normal / unlabelled / combined -> lost: the likelihood stays below
   ``lost_likelihood`` for ``lost_frames`` frames (sec. 5.2: "test the posterior
@@ -60,6 +60,8 @@ class Observation:
     prior: float = 0.0
     labelled: bool = False
     modes: tuple[tuple[float, float], ...] = ()
+    #: the target's box side (pixels); with it the combine/split distances scale with the target
+    size: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -109,12 +111,18 @@ def assign_by_direction(before: np.ndarray, modes: np.ndarray) -> tuple[np.ndarr
     return m[1], m[0]
 
 
+def distance_threshold(pixels: float, per_size: float, size: float) -> float:
+    """``per_size`` target sizes when the size is known and ``per_size > 0``, else ``pixels``."""
+    return per_size * size if per_size > 0 and size > 0 else pixels
+
+
 class LimbStateMachine:
     """Per-tracker states and the pairwise combine/split logic of seed 000 sec. 5.2."""
 
     def __init__(self, params: LimbParams | None = None):
         self.params = params or LimbParams()
         self._status: dict[int, _Status] = {}
+        self._sizes: dict[int, float] = {}
         self.events: list[JoinEvent] = []
 
     # -- queries ---------------------------------------------------------------------------
@@ -197,7 +205,8 @@ class LimbStateMachine:
                     self._end_join(frame, t, b, "lost")
                     move(t, LimbState.LOST, "combined target lost", b)
                     move(b, LimbState.LOST, "combined target lost", t)
-                elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > p.split_distance:
+                elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > distance_threshold(
+                        p.split_distance, p.split_size, obs.size):
                     pos_a, pos_b = assign_by_direction(s.before, modes[:2])
                     self._end_join(frame, t, b, "split")
                     move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
@@ -208,6 +217,8 @@ class LimbStateMachine:
             obs = observations.get(t, Observation())
             if obs.position is not None and s.state not in (LimbState.UNINITIALIZED,):
                 s.history.append(np.asarray(obs.position, float))
+            if obs.size > 0:
+                self._sizes[t] = obs.size
         return out
 
     def _end_join(self, frame: int, a: int, b: int, how: str) -> None:
@@ -228,7 +239,9 @@ class LimbStateMachine:
         for i, a in enumerate(ids):
             for b in ids[i + 1:]:
                 d = float(np.hypot(*(np.subtract(observations[a].position, observations[b].position))))
-                if d < p.combine_distance:
+                size = (observations[a].size + observations[b].size) / 2 if (
+                    observations[a].size > 0 and observations[b].size > 0) else 0.0
+                if d < distance_threshold(p.combine_distance, p.combine_size, size):
                     pairs.append((d, a, b))
         used: set[int] = set()
         for _, a, b in sorted(pairs):
@@ -247,7 +260,8 @@ class LimbStateMachine:
         n = min(len(ha), len(hb))
         pairs = list(zip(ha[len(ha) - n:], hb[len(hb) - n:]))
         for pa, pb in reversed(pairs):
-            if np.hypot(*(pa - pb)) >= self.params.combine_distance:
+            if np.hypot(*(pa - pb)) >= distance_threshold(self.params.combine_distance, self.params.combine_size,
+                                                       self._sizes.get(a, 0.0)):
                 return pa - pb
         if pairs:
             return pairs[0][0] - pairs[0][1]

@@ -143,3 +143,20 @@ def test_a_drifting_tracker_below_the_lost_threshold_is_not_combined():
     m.add(1, S.NORMAL)
     m.update(0, {0: ok(0, 0, lik=0.05), 1: ok(10, 0)})
     assert m.state(0) == S.NORMAL and m.state(1) == S.NORMAL
+
+
+def test_with_sizes_the_distances_scale_with_the_targets():
+    p = LimbParams(combine_distance=20.0, split_distance=30.0, combine_size=1.3, split_size=1.8,
+                   lost_likelihood=0.15, history_frames=10)
+    m = LimbStateMachine(p)
+    m.add(0, S.NORMAL)
+    m.add(1, S.NORMAL)
+    big = dict(likelihood=0.8, labelled=True, size=40.0)  # 40 px targets: combine < 52 px, split > 72 px
+    m.update(0, {0: Observation(position=(100, 0), **big), 1: Observation(position=(40, 0), **big)})
+    assert m.state(0) == S.NORMAL  # 60 px apart
+    m.update(1, {0: Observation(position=(90, 0), **big), 1: Observation(position=(45, 0), **big)})
+    assert m.state(0) == S.COMBINED  # 45 px < 52, although more than combine_distance
+    m.update(2, {0: Observation(position=(70, 0), modes=((100, 0), (40, 0)), **big)})
+    assert m.state(0) == S.COMBINED  # modes 60 px apart < 72
+    m.update(3, {0: Observation(position=(70, 0), modes=((110, 0), (30, 0)), **big)})
+    assert m.state(0) == S.UNLABELLED and m.state(1) == S.UNLABELLED
