@@ -1,0 +1,230 @@
+"""Variance parameters fitted by maximum likelihood from corrected trajectories.
+
+**Body parts** (seed 002 sec. 3, the constant-velocity particle filter; the
+``PartNoise`` of :mod:`tracking.params`). Per part, the box centre follows
+
+    x_t = x_{t-1} + v_{t-1} + a_t,    v_t = v_{t-1} + b_t,    a ~ N(0, s_x^2), b ~ N(0, s_vx^2)
+
+(same for y). On a corrected trajectory the velocity is not observed, but the
+second difference ``e_t = x_t - 2 x_{t-1} + x_{t-2}`` (the residual of
+``x_t - (x_{t-1} + v_{t-1})`` with ``v_{t-1} = x_{t-1} - x_{t-2}``) equals
+``b_{t-1} + a_t - a_{t-1}``: a moving average with variance ``s_v^2 + 2 s_x^2`` and
+lag-one covariance ``-s_x^2``. Its exact Gaussian likelihood (tridiagonal covariance,
+one block per contiguous segment) is maximised over ``(s_x, s_v)``, which separates
+position jitter (negatively correlated residuals) from velocity changes. Width and
+height are random walks, ``w_t = w_{t-1} + c_t``: the ML std is the RMS of ``w_t - w_{t-1}``.
+All in pixels per frame, on the box centre.
+
+``lam`` (the colour likelihood's sharpness) needs the tracker's histograms on the
+frames and is **not fitted here**: it keeps its default (say so in reports).
+
+**Limbs** (seed 000 eq. 25-27 in one camera). ``sigma_d`` (eq. 26, the distance error
+of a candidate) becomes the 2D error of a limb's constant-velocity prediction,
+``|p_t - (2 p_{t-1} - p_{t-2})|``, fitted as an isotropic 2D Gaussian (ML: ``mean |r|^2 / 2``);
+``sigma_v`` (eq. 25, agreement of the relative v coordinate) becomes the frame-to-frame
+change of the limb's v coordinate relative to the top of its person's box;
+``sigma_s`` (eq. 27, distance to the silhouette) becomes the distance of the limb's
+centre to its person's box (zero inside), half-normal ML ``sqrt(mean d^2)``. Terms
+need the ``person`` rows; without them the defaults stay. Every fitted std is floored
+at :data:`MIN_STD` = 1 px: corrected boxes are drawn to about a pixel, so smaller
+values are not measured, and a smooth synthetic path must not give a filter whose
+particles cannot spread.
+"""
+
+from __future__ import annotations
+
+from dataclasses import fields, replace
+
+import numpy as np
+import pandas as pd
+from scipy.linalg import cho_solve_banded, cholesky_banded
+from scipy.optimize import minimize
+
+from tracking.params import BodyParams, LimbParams, PartNoise
+
+MIN_STD: float = 1.0
+#: Fewer residuals than this and a parameter keeps its default.
+MIN_SAMPLES: int = 10
+BODY_NOISE_PARTS: tuple[str, ...] = ("head", "torso", "hipleg", "person")
+LIMB_PARTS: tuple[str, ...] = ("head", "left_hand", "right_hand")
+
+
+def _segments(frames: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
+    """Split ``values (T, ...)`` at gaps in the sorted ``frames``."""
+    if len(frames) == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(frames) != 1) + 1
+    return [s for s in np.split(values, breaks) if len(s)]
+
+
+def _ma1_negloglik(log_params: np.ndarray, residuals: list[np.ndarray]) -> float:
+    """Negative log-likelihood of second differences under the constant-velocity model:
+    tridiagonal covariance ``g0 = s_v^2 + 2 s_x^2`` on the diagonal, ``g1 = -s_x^2`` beside it."""
+    sx2, sv2 = np.exp(2 * log_params)
+    g0, g1 = sv2 + 2 * sx2, -sx2
+    total = 0.0
+    for e in residuals:
+        n = e.size
+        ab = np.empty((2, n))
+        ab[0, :] = g1
+        ab[1, :] = g0
+        try:
+            c = cholesky_banded(ab, lower=False)
+        except np.linalg.LinAlgError:
+            return 1e300
+        sol = cho_solve_banded((c, False), e)
+        logdet = 2.0 * np.sum(np.log(c[1]))
+        total += 0.5 * (logdet + float(e @ sol) + n * np.log(2 * np.pi))
+    return total
+
+
+def fit_constant_velocity(paths: list[np.ndarray]) -> tuple[float, float, int]:
+    """ML ``(s_pos, s_vel, n_residuals)`` of the constant-velocity model from 1D paths
+    (each a contiguous ``(T,)`` series; paths shorter than 4 are skipped)."""
+    residuals = [np.diff(np.asarray(p, dtype=np.float64), n=2) for p in paths if len(p) >= 4]
+    n = int(sum(r.size for r in residuals))
+    if n < MIN_SAMPLES:
+        return float("nan"), float("nan"), n
+    allr = np.concatenate(residuals)
+    g0 = float(np.mean(allr ** 2))
+    lag = [r[1:] * r[:-1] for r in residuals if r.size > 1]
+    g1 = float(np.mean(np.concatenate(lag))) if lag else 0.0
+    sx2 = min(max(-g1, 0.05 * g0), 0.45 * g0)  # method of moments as the starting point
+    sv2 = max(g0 - 2 * sx2, 0.05 * g0)
+    x0 = 0.5 * np.log(np.array([sx2, sv2]) + 1e-12)
+    res = minimize(_ma1_negloglik, x0, args=(residuals,), method="Nelder-Mead",
+                   options={"xatol": 1e-4, "fatol": 1e-6, "maxiter": 400})
+    sx, sv = np.exp(res.x)
+    return float(sx), float(sv), n
+
+
+def fit_random_walk(paths: list[np.ndarray]) -> tuple[float, int]:
+    """ML std of the steps of a zero-mean random walk, and the number of steps."""
+    steps = [np.diff(np.asarray(p, dtype=np.float64)) for p in paths if len(p) >= 2]
+    n = int(sum(s.size for s in steps))
+    if n < MIN_SAMPLES:
+        return float("nan"), n
+    return float(np.sqrt(np.mean(np.concatenate(steps) ** 2))), n
+
+
+def _part_paths(truths: list[pd.DataFrame], part: str) -> dict[str, list[np.ndarray]]:
+    """Contiguous per-track series of ``cx, cy, w, h`` of one part over all tables."""
+    out: dict[str, list[np.ndarray]] = {"cx": [], "cy": [], "w": [], "h": []}
+    for df in truths:
+        d = df[df["part"] == part]
+        for _, g in d.groupby("track_id"):
+            g = g.drop_duplicates("frame").sort_values("frame")
+            vals = np.stack([(g["x"] + g["w"] / 2).to_numpy(), (g["y"] + g["h"] / 2).to_numpy(),
+                          g["w"].to_numpy(), g["h"].to_numpy()], axis=1)
+            for seg in _segments(g["frame"].to_numpy(), vals):
+                for i, c in enumerate(("cx", "cy", "w", "h")):
+                    out[c].append(seg[:, i])
+    return out
+
+
+def _floor(v: float, default: float) -> float:
+    return default if not np.isfinite(v) else max(float(v), MIN_STD)
+
+
+def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = None) -> tuple[BodyParams, pd.DataFrame]:
+    """Fitted :class:`BodyParams` (``part_noise`` replaced) and a table of
+    ``tracker, part, parameter, default, fitted, n`` (``fitted`` NaN where kept)."""
+    defaults = defaults or BodyParams()
+    noise = dict(defaults.part_noise)
+    rows = []
+    for part in BODY_NOISE_PARTS:
+        base = noise.get(part, PartNoise())
+        paths = _part_paths(truths, part)
+        sx, svx, nx = fit_constant_velocity(paths["cx"])
+        sy, svy, ny = fit_constant_velocity(paths["cy"])
+        sw, nw = fit_random_walk(paths["w"])
+        sh, nh = fit_random_walk(paths["h"])
+        fitted = {"x": (sx, nx), "vx": (svx, nx), "y": (sy, ny), "vy": (svy, ny), "w": (sw, nw), "h": (sh, nh)}
+        new = {k: _floor(v, getattr(base, k)) for k, (v, _) in fitted.items()}
+        noise[part] = replace(base, **new)
+        for k in ("x", "y", "w", "h", "vx", "vy"):
+            v, n = fitted[k]
+            rows.append(dict(tracker="body", part=part, parameter=k, default=getattr(base, k),
+                             fitted=new[k] if np.isfinite(v) else np.nan, n=n))
+        rows.append(dict(tracker="body", part=part, parameter="lam", default=base.lam, fitted=np.nan, n=0))
+    return replace(defaults, part_noise=noise), pd.DataFrame(rows)
+
+
+def _limb_residuals(truths: list[pd.DataFrame]) -> dict[str, np.ndarray]:
+    pred, dv, ds = [], [], []
+    for df in truths:
+        person = df[df["part"] == "person"][["track_id", "frame", "x", "y", "w", "h"]]
+        for part in LIMB_PARTS:
+            d = df[df["part"] == part]
+            for tid, g in d.groupby("track_id"):
+                g = g.drop_duplicates("frame").sort_values("frame")
+                c = np.stack([(g["x"] + g["w"] / 2).to_numpy(), (g["y"] + g["h"] / 2).to_numpy()], axis=1)
+                for seg in _segments(g["frame"].to_numpy(), c):
+                    if len(seg) >= 3:
+                        pred.append(seg[2:] - (2 * seg[1:-1] - seg[:-2]))
+                p = g.merge(person[person["track_id"] == tid], on="frame", suffixes=("", "_p"))
+                if p.empty:
+                    continue
+                cx = (p["x"] + p["w"] / 2).to_numpy()
+                cy = (p["y"] + p["h"] / 2).to_numpy()
+                rel = cy - p["y_p"].to_numpy()
+                for seg in _segments(p["frame"].to_numpy(), rel):
+                    dv.append(np.diff(seg))
+                ox = np.maximum(p["x_p"].to_numpy() - cx, 0) + np.maximum(cx - (p["x_p"] + p["w_p"]).to_numpy(), 0)
+                oy = np.maximum(p["y_p"].to_numpy() - cy, 0) + np.maximum(cy - (p["y_p"] + p["h_p"]).to_numpy(), 0)
+                ds.append(np.hypot(ox, oy))
+    cat = lambda xs, shape: np.concatenate(xs) if xs else np.zeros(shape)  # noqa: E731
+    return {"d": cat(pred, (0, 2)), "v": cat(dv, (0,)), "s": cat(ds, (0,))}
+
+
+def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = None) -> tuple[LimbParams, pd.DataFrame]:
+    """Fitted :class:`LimbParams` (``sigma_d, sigma_v, sigma_s``) and the comparison table."""
+    defaults = defaults or LimbParams()
+    r = _limb_residuals(truths)
+    est = {
+        "sigma_d": (np.sqrt(np.mean(np.sum(r["d"] ** 2, axis=1)) / 2) if len(r["d"]) else np.nan, len(r["d"])),
+        "sigma_v": (np.sqrt(np.mean(r["v"] ** 2)) if len(r["v"]) else np.nan, len(r["v"])),
+        "sigma_s": (np.sqrt(np.mean(r["s"] ** 2)) if len(r["s"]) else np.nan, len(r["s"])),
+    }
+    known = {f.name for f in fields(defaults)}
+    new, rows = {}, []
+    for name, (v, n) in est.items():
+        if name not in known:
+            continue
+        ok = np.isfinite(v) and n >= MIN_SAMPLES
+        if ok:
+            new[name] = max(float(v), MIN_STD)
+        rows.append(dict(tracker="limbs", part="*", parameter=name, default=getattr(defaults, name),
+                         fitted=new.get(name, np.nan), n=n))
+    return replace(defaults, **new), pd.DataFrame(rows)
+
+
+def fit_variances(truths: list[pd.DataFrame], body: BodyParams | None = None,
+                  limb: LimbParams | None = None) -> tuple[BodyParams, LimbParams, pd.DataFrame]:
+    """Both fits at once: ``(BodyParams, LimbParams, table)``."""
+    b, tb = fit_body_noise(truths, body)
+    lp, tl = fit_limb_sigmas(truths, limb)
+    return b, lp, pd.concat([tb, tl], ignore_index=True)
+
+
+def comparison_table(table: pd.DataFrame) -> str:
+    """The fitted-vs-default table as aligned text (``-`` where the default was kept)."""
+    lines = [f"{'tracker':7} {'part':10} {'param':8} {'default':>8} {'fitted':>8} {'n':>6}"]
+    for r in table.itertuples(index=False):
+        fitted = f"{r.fitted:8.2f}" if np.isfinite(r.fitted) else f"{'-':>8}"
+        lines.append(f"{r.tracker:7} {r.part:10} {r.parameter:8} {r.default:8.2f} {fitted} {int(r.n):6d}")
+    return "\n".join(lines)
+
+
+def comparison_figure(table: pd.DataFrame):
+    """Plotly grouped bar chart of default vs fitted value per parameter."""
+    import plotly.graph_objects as go
+
+    label = table["tracker"] + "/" + table["part"] + "/" + table["parameter"]
+    fig = go.Figure([
+        go.Bar(name="default", x=label, y=table["default"]),
+        go.Bar(name="fitted", x=label, y=table["fitted"]),
+    ])
+    fig.update_layout(barmode="group", title="Variance parameters: fitted vs default",
+                      yaxis_title="std (pixels per frame) / sharpness", xaxis_tickangle=-45)
+    return fig
