@@ -235,12 +235,13 @@ class SVMFailureDetector:
     SVM are never flagged; without a ``multi`` SVM, two or more flags mean multi.
     """
 
-    def __init__(self, models: dict[str, SVMModel], dt: float = DEFAULT_DT):
+    def __init__(self, models: dict[str, SVMModel], dt: float = DEFAULT_DT, normalise: bool = True):
         unknown = set(models) - set(SVM_NAMES)
         if unknown:
             raise ValueError(f"unknown SVM name(s) {sorted(unknown)}; expected {', '.join(SVM_NAMES)}")
         self.models = dict(models)
         self.dt = float(dt)
+        self.normalise = bool(normalise)
 
     def part_scores(self, x: np.ndarray) -> np.ndarray:
         """``(N, 3)`` scores of head, torso, hip-leg (``+inf`` for a part without SVM)."""
@@ -264,4 +265,19 @@ class SVMFailureDetector:
 
     def detect(self, history: np.ndarray, fps: float) -> FailureVerdict:
         """Verdict for the newest frame of ``history`` ``(T, 3, 4)`` ``[cx, cy, w, h]``."""
-        return self.verdict_from_features(newest_features(history, fps, self.dt))
+        return self.verdict_from_features(newest_features(history, fps, self.dt, self.normalise))
+
+
+def report_table(reports: dict[str, SVMReport]) -> str:
+    """The cross-validation results as aligned text, one SVM a line."""
+    lines = [f"{'svm':7} {'pos':>5} {'neg':>5} {'kernel':6} {'C':>6} {'bal.acc':>7} {'thresh':>7} "
+             f"{'TNR':>5} {'TPR':>5}  confusion [[TN FP] [FN TP]]"]
+    for r in reports.values():
+        if not r.trained:
+            lines.append(f"{r.name:7} {r.n_positive:5d} {r.n_negative:5d}  {r.note}")
+            continue
+        (tn, fp), (fn, tp) = r.confusion
+        lines.append(f"{r.name:7} {r.n_positive:5d} {r.n_negative:5d} {r.kernel:6} {r.C:6g} "
+                     f"{r.cv_balanced_accuracy:7.3f} {r.threshold:7.3f} {r.tnr:5.3f} {r.tpr:5.3f}  "
+                     f"[[{tn} {fp}] [{fn} {tp}]]")
+    return "\n".join(lines)

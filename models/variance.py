@@ -25,8 +25,8 @@ of a candidate) becomes the 2D error of a limb's constant-velocity prediction,
 change of the limb's v coordinate relative to the top of its person's box;
 ``sigma_s`` (eq. 27, distance to the silhouette) becomes the distance of the limb's
 centre to its person's box (zero inside), half-normal ML ``sqrt(mean d^2)``. Terms
-need the ``person`` rows; without them the defaults stay. Every fitted std is floored
-at :data:`MIN_STD` = 1 px: corrected boxes are drawn to about a pixel, so smaller
+need the ``person`` rows; without them the defaults stay. Every fitted position or
+size std is floored at :data:`MIN_STD` = 1 px (velocity stds at 0.1 px/frame): corrected boxes are drawn to about a pixel, so smaller
 values are not measured, and a smooth synthetic path must not give a filter whose
 particles cannot spread.
 """
@@ -43,6 +43,8 @@ from scipy.optimize import minimize
 from tracking.params import BodyParams, LimbParams, PartNoise
 
 MIN_STD: float = 1.0
+#: Floor of velocity-noise stds (px/frame): labelling precision does not limit those.
+MIN_VEL_STD: float = 0.1
 #: Fewer residuals than this and a parameter keeps its default.
 MIN_SAMPLES: int = 10
 BODY_NOISE_PARTS: tuple[str, ...] = ("head", "torso", "hipleg", "person")
@@ -122,8 +124,8 @@ def _part_paths(truths: list[pd.DataFrame], part: str) -> dict[str, list[np.ndar
     return out
 
 
-def _floor(v: float, default: float) -> float:
-    return default if not np.isfinite(v) else max(float(v), MIN_STD)
+def _floor(v: float, default: float, floor: float = MIN_STD) -> float:
+    return default if not np.isfinite(v) else max(float(v), floor)
 
 
 def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = None) -> tuple[BodyParams, pd.DataFrame]:
@@ -140,7 +142,8 @@ def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = Non
         sw, nw = fit_random_walk(paths["w"])
         sh, nh = fit_random_walk(paths["h"])
         fitted = {"x": (sx, nx), "vx": (svx, nx), "y": (sy, ny), "vy": (svy, ny), "w": (sw, nw), "h": (sh, nh)}
-        new = {k: _floor(v, getattr(base, k)) for k, (v, _) in fitted.items()}
+        new = {k: _floor(v, getattr(base, k), MIN_VEL_STD if k.startswith("v") else MIN_STD)
+               for k, (v, _) in fitted.items()}
         noise[part] = replace(base, **new)
         for k in ("x", "y", "w", "h", "vx", "vy"):
             v, n = fitted[k]
