@@ -22,9 +22,11 @@ comes from the formats, which cannot carry code.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import math
 import re
+import zipfile
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from importlib import resources
@@ -68,6 +70,19 @@ def _sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+def _write_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """An ``.npz`` (deflated zip of ``.npy``) with fixed timestamps, so the same arrays
+    give the same bytes and the shipped bundle rebuilds identically."""
+    with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+        for name, arr in arrays.items():
+            buf = io.BytesIO()
+            np.lib.format.write_array(buf, np.ascontiguousarray(arr), allow_pickle=False)
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            zf.writestr(info, buf.getvalue())
+
+
 def _json_safe(obj):
     """NaN/inf -> None, numpy scalars -> Python, tuples -> lists (strict JSON)."""
     if isinstance(obj, dict):
@@ -105,7 +120,7 @@ def save_bundle(bundle: Bundle, path: str | PathLike) -> Path:
         svms = {}
         for name, model in det.models.items():
             fname = f"svm_{name}.npz"
-            np.savez_compressed(out / fname, **{k: np.asarray(v, dtype=np.float64) for k, v in model.arrays().items()})
+            _write_npz(out / fname, {k: np.asarray(v, dtype=np.float64) for k, v in model.arrays().items()})
             files[fname] = _sha256(out / fname)
             svms[name] = {**model.meta(), "file": fname}
         detector = {"dt": det.dt, "normalise": det.normalise, "svms": svms}

@@ -12,7 +12,9 @@ Samples for the four SVMs come from three sources:
 3. **perturbed truth** (:mod:`models.perturb`): simulated single and multi-part
    failures, so that a few clips give enough failures of every kind.
 
-The variance parameters are fitted from the truth (:mod:`models.variance`).
+The variance parameters are fitted from the truth (:mod:`models.variance`), the
+colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
+(:mod:`models.sharpness`; only where the body tracker's histograms are installed).
 """
 
 from __future__ import annotations
@@ -79,21 +81,55 @@ def tracker_samples(tracked: pd.DataFrame, truth: pd.DataFrame, fps: float,
     return x, labels
 
 
-def training_steps(n_clips: int, with_tracker: bool) -> int:
+def sharpness_available() -> bool:
+    """Whether ``lam`` can be fitted (it needs the body tracker's ``tracking.histogram``)."""
+    try:
+        import tracking.histogram  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None = None) -> int:
     """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
-    return n_clips * (2 if with_tracker else 1) + len(SVM_NAMES) + 1
+    if with_sharpness is None:
+        with_sharpness = sharpness_available()
+    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1
+
+
+def _apply_lam(body: BodyParams, table: pd.DataFrame, d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
+    """Put the ML ``lam`` of every part with enough distances into ``body`` and the table."""
+    from dataclasses import replace
+
+    from models.sharpness import fit_lam
+    from models.variance import MIN_SAMPLES
+
+    noise = dict(body.part_noise)
+    table = table.copy()
+    for part, chunks in d2.items():
+        values = np.concatenate(chunks) if chunks else np.zeros(0)
+        row = (table["tracker"] == "body") & (table["part"] == part) & (table["parameter"] == "lam")
+        table.loc[row, "n"] = len(values)
+        if len(values) < MIN_SAMPLES or part not in noise:
+            continue
+        lam = fit_lam(values)
+        noise[part] = replace(noise[part], lam=lam)
+        table.loc[row, "fitted"] = lam
+    return replace(body, part_noise=noise), table
 
 
 def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], None] | None = None,
                  tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
                  perturbed_per_person: int = 300, body: BodyParams | None = None,
-                 limb: LimbParams | None = None, dt: float = DEFAULT_DT) -> Bundle:
+                 limb: LimbParams | None = None, dt: float = DEFAULT_DT,
+                 fit_sharpness: bool | None = None) -> Bundle:
     """Fit the four failure SVMs and the variance parameters from corrected clips.
 
     ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
     ``(index, frame)``. Without ``tracker_runner`` (or where it fails on a clip) only
     perturbed-truth and hand-flag samples are used; the summary records how many of
     each. ``progress`` is called once per step with a short description.
+    ``fit_sharpness`` (default: when available) decodes each clip once more to fit ``lam``.
     """
     if not clips:
         raise ValueError("no clips to train from")
@@ -104,6 +140,9 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     step = progress or (lambda _msg: None)
     xs, ys, truths, clip_info = [], [], [], []
     counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
+    if fit_sharpness is None:
+        fit_sharpness = sharpness_available()
+    d2: dict[str, list[np.ndarray]] = {}
     for i, ((factory, fps, truth), name) in enumerate(zip(clips, names)):
         truth_clean, _ = split_human_flags(truth)
         truths.append(truth_clean)
@@ -117,6 +156,11 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
             counts["tracker"] += len(x)
             info["tracker_samples"] = len(x)
             info["tracker_failures"] = int(np.sum(np.any(y == NEGATIVE, axis=1)))
+        if fit_sharpness:
+            from models.sharpness import colour_distances
+            step(f"colours of {name}")
+            for part, values in colour_distances(factory, truth_clean, body or BodyParams()).items():
+                d2.setdefault(part, []).append(values)
         step(f"samples of {name}")
         x, y = human_flag_samples(truth, fps, dt)
         xs.append(x), ys.append(y)
@@ -135,6 +179,8 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
     step("variance parameters")
     body_p, limb_p, table = fit_variances(truths, body, limb)
+    if fit_sharpness:
+        body_p, table = _apply_lam(body_p, table, d2)
     detector = SVMFailureDetector(models, dt=dt) if models else None
     summary = {
         "seed": seed,
@@ -144,7 +190,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         "tnr_targets": dict(TNR_TARGETS),
         "thresholds": {n: r.threshold for n, r in reports.items()},
         "variances": table.to_dict(orient="records"),
-        "notes": ["lam (colour likelihood sharpness) is not fitted: defaults kept"],
+        "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
     }
     return Bundle(body_p, limb_p, detector, summary)
 

@@ -106,3 +106,11 @@ def test_bundle_without_detector(tmp_path):
     root = save_bundle(Bundle(), tmp_path / "empty")
     b = load_bundle(root)
     assert b.failure_detector is None and b.body_params == BodyParams()
+
+
+def test_same_bundle_gives_the_same_bytes(bundle, tmp_path):
+    import dataclasses
+    fixed = dataclasses.replace(bundle, created="2026-01-01T00:00:00+00:00")
+    a, b = save_bundle(fixed, tmp_path / "a"), save_bundle(fixed, tmp_path / "b")
+    for f in sorted(p.name for p in a.iterdir()):
+        assert (a / f).read_bytes() == (b / f).read_bytes(), f
