@@ -61,4 +61,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":  # python -m app.cli
-    sys.exit(main())
+    # dispatch through the imported module, so that commands' ``app.cli.CommandError``
+    # is the class caught here (under ``-m`` this file is ``__main__``, a second copy)
+    from app.cli import main as _main
+
+    sys.exit(_main())

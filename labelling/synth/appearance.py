@@ -1,0 +1,91 @@
+"""How a synthetic person looks: clothes, skin and hair colours, body height.
+
+Colours are BGR (OpenCV order), drawn from palettes of plausible clothes, skin tones
+and hair; every walker of a scene gets a different shirt and trousers (sampled
+without replacement), each jittered a little so that two seeds never look the same.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+SHIRTS: tuple[tuple[int, int, int], ...] = (
+    (45, 45, 185),  # red
+    (95, 45, 30),  # navy
+    (60, 135, 55),  # green
+    (222, 222, 215),  # white
+    (60, 195, 225),  # yellow
+    (215, 165, 115),  # light blue
+    (55, 30, 115),  # maroon
+    (35, 120, 225),  # orange
+    (125, 55, 110),  # purple
+    (135, 125, 25),  # teal
+    (150, 150, 150),  # grey
+    (175, 135, 225),  # pink
+)
+TROUSERS: tuple[tuple[int, int, int], ...] = (
+    (115, 75, 45),  # jeans
+    (75, 50, 35),  # dark jeans
+    (38, 36, 36),  # black
+    (125, 170, 190),  # khaki
+    (105, 102, 100),  # grey
+    (45, 65, 95),  # brown
+    (55, 95, 85),  # olive
+)
+SKINS: tuple[tuple[int, int, int], ...] = (
+    (160, 185, 228),
+    (130, 165, 215),
+    (105, 145, 195),
+    (85, 115, 165),
+    (60, 85, 125),
+    (175, 200, 238),
+)
+HAIRS: tuple[tuple[int, int, int], ...] = (
+    (25, 25, 30),  # black
+    (25, 40, 60),  # dark brown
+    (40, 70, 110),  # brown
+    (100, 165, 205),  # blonde
+    (150, 150, 152),  # grey
+    (30, 55, 125),  # auburn
+)
+SHOES: tuple[tuple[int, int, int], ...] = ((30, 30, 32), (205, 205, 205), (40, 55, 75))
+
+
+@dataclass(frozen=True)
+class Appearance:
+    """One person's colours (BGR uint8 triples) and size."""
+
+    shirt: tuple[int, int, int]
+    trousers: tuple[int, int, int]
+    skin: tuple[int, int, int]
+    hair: tuple[int, int, int]
+    shoes: tuple[int, int, int]
+    height_m: float = 1.75
+    short_sleeves: bool = False
+
+
+def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int, int]:
+    c = np.asarray(colour, int) + rng.integers(-amount, amount + 1, size=3)
+    return tuple(int(v) for v in np.clip(c, 0, 255))
+
+
+def sample_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
+    """``n`` people with distinct shirts and trousers (n <= 7)."""
+    if n > len(TROUSERS):
+        raise ValueError(f"at most {len(TROUSERS)} people have distinct clothes, asked for {n}")
+    shirts = rng.permutation(len(SHIRTS))[:n]
+    trousers = rng.permutation(len(TROUSERS))[:n]
+    out = []
+    for i in range(n):
+        out.append(Appearance(
+            shirt=_jitter(rng, SHIRTS[shirts[i]]),
+            trousers=_jitter(rng, TROUSERS[trousers[i]]),
+            skin=_jitter(rng, SKINS[rng.integers(len(SKINS))], 5),
+            hair=_jitter(rng, HAIRS[rng.integers(len(HAIRS))], 5),
+            shoes=_jitter(rng, SHOES[rng.integers(len(SHOES))], 5),
+            height_m=float(rng.uniform(1.62, 1.86)),
+            short_sleeves=bool(rng.random() < 0.4),
+        ))
+    return out
