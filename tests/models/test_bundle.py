@@ -114,3 +114,22 @@ def test_same_bundle_gives_the_same_bytes(bundle, tmp_path):
     a, b = save_bundle(fixed, tmp_path / "a"), save_bundle(fixed, tmp_path / "b")
     for f in sorted(p.name for p in a.iterdir()):
         assert (a / f).read_bytes() == (b / f).read_bytes(), f
+
+
+def test_default_bundle_ships_and_judges_a_synthetic_walker():
+    from labelling.synth import make_scene
+    from models.bundle import default_bundle
+    from models.features import person_histories
+
+    b = default_bundle()
+    assert set(b.failure_detector.models) == {"head", "torso", "hipleg", "multi"}
+    assert b.summary["svms"]["head"]["tnr"] >= 0.95
+    assert {c["name"] for c in b.summary["clips"]} >= {"single-101", "crowd-104"}
+    scene = make_scene("single", seed=7, n_frames=40, width=360, height=240)
+    frames, hist = person_histories(scene.truth)[1]
+    clean = [b.failure_detector.detect(hist[: t + 1], scene.fps) for t in range(13, 40)]
+    assert sum(bool(v.failed) for v in clean) <= 2      # truth is (almost) never flagged
+    bad = hist[:30].copy()
+    bad[-10:, 1, :2] = bad[-10, 1, :2] + [0.0, -1.2 * bad[-10, 1, 3]]   # torso stuck above the head
+    v = b.failure_detector.detect(bad, scene.fps)
+    assert v.failed and ("torso" in v.failed or v.multi)
