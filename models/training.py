@@ -138,7 +138,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
     rng = np.random.default_rng(seed)
     step = progress or (lambda _msg: None)
-    xs, ys, truths, clip_info = [], [], [], []
+    xs, ys, truths, tracks_out, clip_info = [], [], [], [], []
     counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
     if fit_sharpness is None:
         fit_sharpness = sharpness_available()
@@ -151,6 +151,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         if tracker_runner is not None:
             step(f"tracking {name}")
             tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
+            tracks_out.append(tracked)
             x, y = tracker_samples(tracked, truth_clean, fps, dt)
             xs.append(x), ys.append(y)
             counts["tracker"] += len(x)
@@ -178,7 +179,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
     models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
     step("variance parameters")
-    body_p, limb_p, table = fit_variances(truths, body, limb)
+    body_p, limb_p, table = fit_variances(truths, body, limb, tracks_out if tracker_runner is not None else None)
     if fit_sharpness:
         body_p, table = _apply_lam(body_p, table, d2)
     detector = SVMFailureDetector(models, dt=dt) if models else None

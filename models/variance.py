@@ -13,7 +13,12 @@ lag-one covariance ``-s_x^2``. Its exact Gaussian likelihood (tridiagonal covari
 one block per contiguous segment) is maximised over ``(s_x, s_v)``, which separates
 position jitter (negatively correlated residuals) from velocity changes. Width and
 height are random walks, ``w_t = w_{t-1} + c_t``: the ML std is the RMS of ``w_t - w_{t-1}``.
-All in pixels per frame, on the box centre.
+All in pixels per frame, on the box centre. When the tracker's own output on the
+training clips is given, position and size stds are instead fitted to how far the
+truth lands from the tracker's prediction (:func:`prediction_residuals`): on smooth
+synthetic walkers the truth-only fit gives ~1 px, with which the filter cannot keep
+up (measured: the ``single`` scene is lost), while the prediction error the filter
+really has to cover is several pixels.
 
 ``lam`` (the colour likelihood's sharpness) needs the tracker's histograms on the
 frames and is **not fitted here**: it keeps its default (say so in reports).
@@ -128,9 +133,52 @@ def _floor(v: float, default: float, floor: float = MIN_STD) -> float:
     return default if not np.isfinite(v) else max(float(v), floor)
 
 
-def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = None) -> tuple[BodyParams, pd.DataFrame]:
+def prediction_residuals(tracked: pd.DataFrame, truth: pd.DataFrame, part: str) -> dict[str, np.ndarray]:
+    """How far the truth lands from the tracker's own constant-velocity prediction.
+
+    For every frame ``t`` where the tracker had ``part`` right at ``t-1`` and ``t-2``
+    (:func:`models.labels.label_states`), ``truth_t - (2 est_{t-1} - est_{t-2})`` for the
+    centre and ``truth_t - est_{t-1}`` for the size. Returns arrays per ``cx, cy, w, h``.
+    """
+    from models.labels import POSITIVE, label_states
+
+    def centres(df):
+        d = df[df["part"] == part].drop_duplicates(["track_id", "frame"])
+        return pd.DataFrame({"track_id": d["track_id"], "frame": d["frame"], "cx": d["x"] + d["w"] / 2,
+                             "cy": d["y"] + d["h"] / 2, "w": d["w"], "h": d["h"]})
+
+    est, tru = centres(tracked), centres(truth)
+    both = est.merge(tru, on=["track_id", "frame"], suffixes=("", "_t"))
+    cols = ["cx", "cy", "w", "h"]
+    ok = label_states(both[cols].to_numpy(), both[[c + "_t" for c in cols]].to_numpy()) == POSITIVE
+    good = both.loc[ok, ["track_id", "frame"] + cols]
+    e1 = good.assign(frame=good["frame"] + 1)
+    e2 = good.assign(frame=good["frame"] + 2)
+    m = tru.merge(e1, on=["track_id", "frame"], suffixes=("", "_1")).merge(
+        e2, on=["track_id", "frame"], suffixes=("", "_2"))
+    if m.empty:
+        return {c: np.zeros(0) for c in cols}
+    return {
+        "cx": (m["cx"] - (2 * m["cx_1"] - m["cx_2"])).to_numpy(),
+        "cy": (m["cy"] - (2 * m["cy_1"] - m["cy_2"])).to_numpy(),
+        "w": (m["w"] - m["w_1"]).to_numpy(),
+        "h": (m["h"] - m["h_1"]).to_numpy(),
+    }
+
+
+def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = None,
+                   tracked: list[pd.DataFrame] | None = None) -> tuple[BodyParams, pd.DataFrame]:
     """Fitted :class:`BodyParams` (``part_noise`` replaced) and a table of
-    ``tracker, part, parameter, default, fitted, n`` (``fitted`` NaN where kept)."""
+    ``tracker, part, parameter, default, fitted, n, source`` (``fitted`` NaN where kept).
+
+    With ``tracked`` (the tracker's output on the same clips, one table per truth) the
+    position and size stds are the ML (Gaussian, mean removed: inner rectangles may sit
+    off the truth's centre or be smaller) spread of :func:`prediction_residuals`: the
+    noise the filter must add so that its prediction covers where the part really
+    goes, which includes the filter's own estimation error. The truth alone gives the
+    smooth motion of the part (much smaller on synthetic walkers, and too small for the
+    filter to keep up); velocity stds always come from the truth's MA(1) fit.
+    """
     defaults = defaults or BodyParams()
     noise = dict(defaults.part_noise)
     rows = []
@@ -142,14 +190,23 @@ def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = Non
         sw, nw = fit_random_walk(paths["w"])
         sh, nh = fit_random_walk(paths["h"])
         fitted = {"x": (sx, nx), "vx": (svx, nx), "y": (sy, ny), "vy": (svy, ny), "w": (sw, nw), "h": (sh, nh)}
+        source = {k: "truth" for k in fitted}
+        if tracked:
+            res = [prediction_residuals(t, tt, part) for t, tt in zip(tracked, truths)]
+            for k, c in (("x", "cx"), ("y", "cy"), ("w", "w"), ("h", "h")):
+                r = np.concatenate([d[c] for d in res])
+                if r.size >= MIN_SAMPLES:
+                    fitted[k] = (float(np.std(r)), int(r.size))
+                    source[k] = "tracker"
         new = {k: _floor(v, getattr(base, k), MIN_VEL_STD if k.startswith("v") else MIN_STD)
                for k, (v, _) in fitted.items()}
         noise[part] = replace(base, **new)
         for k in ("x", "y", "w", "h", "vx", "vy"):
             v, n = fitted[k]
             rows.append(dict(tracker="body", part=part, parameter=k, default=getattr(base, k),
-                             fitted=new[k] if np.isfinite(v) else np.nan, n=n))
-        rows.append(dict(tracker="body", part=part, parameter="lam", default=base.lam, fitted=np.nan, n=0))
+                             fitted=new[k] if np.isfinite(v) else np.nan, n=n, source=source[k]))
+        rows.append(dict(tracker="body", part=part, parameter="lam", default=base.lam, fitted=np.nan, n=0,
+                         source="frames"))
     return replace(defaults, part_noise=noise), pd.DataFrame(rows)
 
 
@@ -198,24 +255,26 @@ def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = No
         if ok:
             new[name] = max(float(v), MIN_STD)
         rows.append(dict(tracker="limbs", part="*", parameter=name, default=getattr(defaults, name),
-                         fitted=new.get(name, np.nan), n=n))
+                         fitted=new.get(name, np.nan), n=n, source="truth"))
     return replace(defaults, **new), pd.DataFrame(rows)
 
 
 def fit_variances(truths: list[pd.DataFrame], body: BodyParams | None = None,
-                  limb: LimbParams | None = None) -> tuple[BodyParams, LimbParams, pd.DataFrame]:
+                  limb: LimbParams | None = None,
+                  tracked: list[pd.DataFrame] | None = None) -> tuple[BodyParams, LimbParams, pd.DataFrame]:
     """Both fits at once: ``(BodyParams, LimbParams, table)``."""
-    b, tb = fit_body_noise(truths, body)
+    b, tb = fit_body_noise(truths, body, tracked)
     lp, tl = fit_limb_sigmas(truths, limb)
     return b, lp, pd.concat([tb, tl], ignore_index=True)
 
 
 def comparison_table(table: pd.DataFrame) -> str:
     """The fitted-vs-default table as aligned text (``-`` where the default was kept)."""
-    lines = [f"{'tracker':7} {'part':10} {'param':8} {'default':>8} {'fitted':>8} {'n':>6}"]
+    lines = [f"{'tracker':7} {'part':10} {'param':8} {'default':>8} {'fitted':>8} {'n':>6}  from"]
     for r in table.itertuples(index=False):
-        fitted = f"{r.fitted:8.2f}" if np.isfinite(r.fitted) else f"{'-':>8}"
-        lines.append(f"{r.tracker:7} {r.part:10} {r.parameter:8} {r.default:8.2f} {fitted} {int(r.n):6d}")
+        fitted = f"{r.fitted:8.2f}" if r.fitted is not None and np.isfinite(r.fitted) else f"{'-':>8}"
+        lines.append(f"{r.tracker:7} {r.part:10} {r.parameter:8} {r.default:8.2f} {fitted} {int(r.n):6d}  "
+                     f"{getattr(r, 'source', '')}")
     return "\n".join(lines)
 
 

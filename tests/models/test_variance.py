@@ -64,3 +64,27 @@ def test_limb_sigmas_from_known_residuals():
     assert limb.sigma_s == 1.0  # always inside its person box: floored
     assert set(table["parameter"]) == {"sigma_d", "sigma_v", "sigma_s"}
     assert LimbParams().sigma_d == 20.0
+
+
+def test_noise_from_the_trackers_prediction_errors():
+    from models.variance import prediction_residuals
+
+    rng = np.random.default_rng(4)
+    truth_rows, tracked_rows = [], []
+    for f in range(600):
+        cx, cy = 100 + 2.0 * f, 200.0
+        truth_rows.append(dict(frame=f, track_id=1, part="torso", x=cx - 20, y=cy - 30, w=40, h=60))
+        ex = rng.normal(0, 2.0)
+        tracked_rows.append(dict(frame=f, track_id=1, part="torso", x=cx + ex - 15, y=cy - 25, w=30, h=50))
+    truth, tracked = normalise_tracks(pd.DataFrame(truth_rows)), normalise_tracks(pd.DataFrame(tracked_rows))
+    r = prediction_residuals(tracked, truth, "torso")
+    assert r["cx"].size == 598
+    # truth moves exactly linearly: residual = -(2 e_{t-1} - e_{t-2}), std 2 * sqrt(5)
+    assert abs(np.std(r["cx"]) - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
+    body, table = fit_body_noise([truth], tracked=[tracked])
+    n = body.part_noise["torso"]
+    assert abs(n.x - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
+    assert n.w == 1.0 and n.y == 1.0           # constant offsets are not noise: floored
+    assert n.vx == 0.1                         # the truth's velocity never changes: floored
+    src = table.set_index(["part", "parameter"])["source"]
+    assert src[("torso", "x")] == "tracker" and src[("torso", "vx")] == "truth" and src[("head", "x")] == "truth"
