@@ -115,6 +115,7 @@ def _apply_lam(body: BodyParams, table: pd.DataFrame, d2: dict[str, list[np.ndar
         lam = fit_lam(values)
         noise[part] = replace(noise[part], lam=lam)
         table.loc[row, "fitted"] = lam
+        table.loc[row, "applied"] = lam
     return replace(body, part_noise=noise), table
 
 
@@ -138,7 +139,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
     rng = np.random.default_rng(seed)
     step = progress or (lambda _msg: None)
-    xs, ys, truths, tracks_out, clip_info = [], [], [], [], []
+    xs, ys, truths, clip_info = [], [], [], []
     counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
     if fit_sharpness is None:
         fit_sharpness = sharpness_available()
@@ -151,7 +152,6 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         if tracker_runner is not None:
             step(f"tracking {name}")
             tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
-            tracks_out.append(tracked)
             x, y = tracker_samples(tracked, truth_clean, fps, dt)
             xs.append(x), ys.append(y)
             counts["tracker"] += len(x)
@@ -179,7 +179,8 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
     models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
     step("variance parameters")
-    body_p, limb_p, table = fit_variances(truths, body, limb, tracks_out if tracker_runner is not None else None)
+    # the tracker's prediction errors are not used for the noise (measured worse, see models.variance)
+    body_p, limb_p, table = fit_variances(truths, body, limb)
     if fit_sharpness:
         body_p, table = _apply_lam(body_p, table, d2)
     detector = SVMFailureDetector(models, dt=dt) if models else None

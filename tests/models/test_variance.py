@@ -1,5 +1,6 @@
 import numpy as np
 import pandas as pd
+import pytest
 
 from models.variance import comparison_figure, comparison_table, fit_body_noise, fit_constant_velocity, fit_limb_sigmas
 from tracking.params import BodyParams, LimbParams
@@ -34,7 +35,8 @@ def test_body_fit_from_a_tracks_table_recovers_noise_and_size_steps():
             if f == 200:
                 continue  # a gap: segments are split there
             rows.append(dict(frame=f, track_id=tid, part="torso", x=cx[f] - w[f] / 2, y=cy[f] - 30, w=w[f], h=60.0))
-    body, table = fit_body_noise([normalise_tracks(pd.DataFrame(rows))])
+    truth = normalise_tracks(pd.DataFrame(rows))
+    body, table = fit_body_noise([truth], keep_defaults_as_floor=False)
     n = body.part_noise["torso"]
     assert abs(n.x - 2.0) / 2.0 < 0.1 and abs(n.vx - 0.5) / 0.5 < 0.1
     assert abs(n.y - 1.5) / 1.5 < 0.1 and abs(n.vy - 0.3) / 0.3 < 0.1
@@ -47,7 +49,13 @@ def test_body_fit_from_a_tracks_table_recovers_noise_and_size_steps():
     assert np.isnan(t.loc[("head", "x"), "fitted"]) and t.loc[("torso", "x"), "n"] == 3 * (198 + 197)
     assert "torso" in comparison_table(table)
     fig = comparison_figure(table)
-    assert len(fig.data) == 2 and len(fig.data[0].x) == len(table)
+    assert len(fig.data) == 3 and len(fig.data[0].x) == len(table)
+    # default policy: a fit only widens the defaults (torso default x = 4, vx = 1, w = 1)
+    body2, table2 = fit_body_noise([truth])
+    n2 = body2.part_noise["torso"]
+    assert n2.x == 4.0 and n2.vx == 1.0 and n2.w == pytest.approx(n.w)
+    t2 = table2.set_index(["part", "parameter"])
+    assert t2.loc[("torso", "x"), "fitted"] == pytest.approx(n.x) and t2.loc[("torso", "x"), "applied"] == 4.0
 
 
 def test_limb_sigmas_from_known_residuals():
@@ -81,7 +89,7 @@ def test_noise_from_the_trackers_prediction_errors():
     assert r["cx"].size == 598
     # truth moves exactly linearly: residual = -(2 e_{t-1} - e_{t-2}), std 2 * sqrt(5)
     assert abs(np.std(r["cx"]) - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
-    body, table = fit_body_noise([truth], tracked=[tracked])
+    body, table = fit_body_noise([truth], tracked=[tracked], keep_defaults_as_floor=False)
     n = body.part_noise["torso"]
     assert abs(n.x - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
     assert n.w == 1.0 and n.y == 1.0           # constant offsets are not noise: floored
