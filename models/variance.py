@@ -249,8 +249,14 @@ def _limb_residuals(truths: list[pd.DataFrame]) -> dict[str, np.ndarray]:
     return {"d": cat(pred, (0, 2)), "v": cat(dv, (0,)), "s": cat(ds, (0,))}
 
 
-def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = None) -> tuple[LimbParams, pd.DataFrame]:
-    """Fitted :class:`LimbParams` (``sigma_d, sigma_v, sigma_s``) and the comparison table."""
+def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = None,
+                    keep_defaults_as_floor: bool = True) -> tuple[LimbParams, pd.DataFrame]:
+    """Fitted :class:`LimbParams` (``sigma_d, sigma_v, sigma_s``) and the comparison table.
+
+    As for the body noise, the tracker gets ``max(default, fitted)`` unless
+    ``keep_defaults_as_floor`` is false: corrected boxes are cleaner than the skin blobs
+    and foreground the priors are applied to (on synthetic truth every hand lies inside
+    its person's box, so the ML ``sigma_s`` is the 1 px floor)."""
     defaults = defaults or LimbParams()
     r = _limb_residuals(truths)
     est = {
@@ -266,9 +272,12 @@ def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = No
         ok = np.isfinite(v) and n >= MIN_SAMPLES
         if ok:
             new[name] = max(float(v), MIN_STD)
+        applied = new.get(name, getattr(defaults, name))
+        if keep_defaults_as_floor:
+            applied = max(applied, getattr(defaults, name))
         rows.append(dict(tracker="limbs", part="*", parameter=name, default=getattr(defaults, name),
-                         fitted=new.get(name, np.nan), applied=new.get(name, getattr(defaults, name)), n=n,
-                         source="truth"))
+                         fitted=new.get(name, np.nan), applied=applied, n=n, source="truth"))
+        new[name] = applied
     return replace(defaults, **new), pd.DataFrame(rows)
 
 

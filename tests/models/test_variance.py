@@ -66,12 +66,14 @@ def test_limb_sigmas_from_known_residuals():
         hx, hy = 100 + 2 * f + rng.normal(0, 3), 200 + rng.normal(0, 3)
         rows.append(dict(frame=f, track_id=1, part="left_hand", x=hx - 5, y=hy - 5, w=10, h=10))
         rows.append(dict(frame=f, track_id=1, part="person", x=hx - 40, y=100, w=60, h=200))
-    limb, table = fit_limb_sigmas([normalise_tracks(pd.DataFrame(rows))])
+    limb, table = fit_limb_sigmas([normalise_tracks(pd.DataFrame(rows))], keep_defaults_as_floor=False)
     assert abs(limb.sigma_d - 3 * np.sqrt(6)) / (3 * np.sqrt(6)) < 0.1
     assert abs(limb.sigma_v - 3 * np.sqrt(2)) / (3 * np.sqrt(2)) < 0.1
     assert limb.sigma_s == 1.0  # always inside its person box: floored
     assert set(table["parameter"]) == {"sigma_d", "sigma_v", "sigma_s"}
     assert LimbParams().sigma_d == 20.0
+    floored, _ = fit_limb_sigmas([normalise_tracks(pd.DataFrame(rows))])
+    assert (floored.sigma_d, floored.sigma_v, floored.sigma_s) == (20.0, 12.0, 8.0)
 
 
 def test_noise_from_the_trackers_prediction_errors():
