@@ -4,7 +4,7 @@ Layout (format ``partlab-model-bundle``, version 1)::
 
     BUNDLE_DIR/
       bundle.json      format, version, created, body_params, limb_params,
-                       detector (dt, normalise, per-SVM kernel/intercept/gamma/threshold),
+                       detector (dt, normalise, persist, per-SVM kernel/intercept/gamma/threshold),
                        summary (clips, sample counts, CV scores, thresholds, fitted variances),
                        files {name: sha256}, manifest_sha256
       svm_head.npz     scaler mean/scale, support vectors, dual coefficients (float64)
@@ -123,7 +123,7 @@ def save_bundle(bundle: Bundle, path: str | PathLike) -> Path:
             _write_npz(out / fname, {k: np.asarray(v, dtype=np.float64) for k, v in model.arrays().items()})
             files[fname] = _sha256(out / fname)
             svms[name] = {**model.meta(), "file": fname}
-        detector = {"dt": det.dt, "normalise": det.normalise, "svms": svms}
+        detector = {"dt": det.dt, "normalise": det.normalise, "persist": det.persist, "svms": svms}
     manifest = _json_safe({
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
@@ -237,7 +237,8 @@ def load_bundle(path: str | PathLike) -> Bundle:
                     **{k: arrays[k] for k in _ARRAY_NAMES},
                 )
             detector = SVMFailureDetector(models, dt=float(det.get("dt", DEFAULT_DT)),
-                                          normalise=bool(det.get("normalise", True)))
+                                          normalise=bool(det.get("normalise", True)),
+                                          persist=int(det.get("persist", 1)))
         except (KeyError, TypeError) as exc:
             raise BundleError(f"{root / MANIFEST}: bad detector description ({exc})") from None
         except ValueError as exc:

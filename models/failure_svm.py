@@ -35,7 +35,7 @@ from typing import Callable
 
 import numpy as np
 
-from models.features import BODY_PARTS, DEFAULT_DT, N_FEATURES, newest_features
+from models.features import BODY_PARTS, DEFAULT_DT, N_FEATURES, dt_frames, features_from_history
 from models.labels import SVM_NAMES, svm_targets
 from tracking.frame_tracker import FailureVerdict
 
@@ -233,15 +233,25 @@ class SVMFailureDetector:
     (the part SVMs become unreliable when several parts are lost): multi-part, or a
     single part, which is then the one with the lowest score. Parts without a trained
     SVM are never flagged; without a ``multi`` SVM, two or more flags mean multi.
+
+    ``persist``: a part counts as failed only when its score has been negative on each
+    of the last ``persist`` frames. A per-frame false-alarm rate of a few percent (the
+    price of a 95 % true-negative rate) would otherwise trigger several needless
+    adjustments per person in 105 frames, while a real failure lasts (a box stuck on
+    a distractor stays stuck), so waiting two more frames costs little.
     """
 
-    def __init__(self, models: dict[str, SVMModel], dt: float = DEFAULT_DT, normalise: bool = True):
+    def __init__(self, models: dict[str, SVMModel], dt: float = DEFAULT_DT, normalise: bool = True,
+                 persist: int = 3):
         unknown = set(models) - set(SVM_NAMES)
         if unknown:
             raise ValueError(f"unknown SVM name(s) {sorted(unknown)}; expected {', '.join(SVM_NAMES)}")
         self.models = dict(models)
         self.dt = float(dt)
         self.normalise = bool(normalise)
+        if int(persist) < 1:
+            raise ValueError(f"persist must be at least 1 frame, got {persist}")
+        self.persist = int(persist)
 
     def part_scores(self, x: np.ndarray) -> np.ndarray:
         """``(N, 3)`` scores of head, torso, hip-leg (``+inf`` for a part without SVM)."""
@@ -250,9 +260,15 @@ class SVMFailureDetector:
         return np.stack(cols, axis=1)
 
     def verdict_from_features(self, x: np.ndarray) -> FailureVerdict:
-        s = self.part_scores(x)[0]
+        """Verdict from feature rows of the most recent frames, newest last (``(P, 24)``;
+        a part fails when its score is negative in every row)."""
+        x = np.atleast_2d(x)
+        all_scores = self.part_scores(x)
+        s = all_scores[-1]
         scores = {p: float(v) for p, v in zip(BODY_PARTS, s)}
-        failed = [p for p, v in scores.items() if v < 0]
+        persistent = np.all(all_scores < 0, axis=0)
+        failed = [p for p, bad in zip(BODY_PARTS, persistent) if bad]
+        x = x[-1:]
         if not failed:
             return FailureVerdict((), False, scores)
         if "multi" in self.models:
@@ -265,7 +281,13 @@ class SVMFailureDetector:
 
     def detect(self, history: np.ndarray, fps: float) -> FailureVerdict:
         """Verdict for the newest frame of ``history`` ``(T, 3, 4)`` ``[cx, cy, w, h]``."""
-        return self.verdict_from_features(newest_features(history, fps, self.dt, self.normalise))
+        history = np.asarray(history, dtype=np.float64)
+        if history.ndim != 3 or history.shape[1:] != (3, 4) or history.shape[0] < 1:
+            raise ValueError(f"history must have shape (T >= 1, 3, 4), got {history.shape}")
+        k = dt_frames(fps, self.dt)
+        window = history[-(k + self.persist):]
+        x = features_from_history(window, fps, dt=self.dt, normalise=self.normalise)[-self.persist:]
+        return self.verdict_from_features(x)
 
 
 def report_table(reports: dict[str, SVMReport]) -> str:

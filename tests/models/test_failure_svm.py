@@ -58,3 +58,17 @@ def test_detector_flags_a_displaced_head(trained_svms):
     bad[-8:, 0, 0] += 1.5 * bad[-8:, 0, 2]
     v = det.detect(bad, 25.0)
     assert "head" in v.failed and v.scores["head"] < 0
+
+
+def test_a_one_frame_glitch_needs_persistence(trained_svms):
+    _x, _y, models, _r = trained_svms
+    from walkers import walking_truth
+    _frames, hist = person_histories(walking_truth(1, 40, seed=5))[1]
+    glitch = hist[:20].copy()
+    glitch[-1, 0, 1] += 2.5 * glitch[-1, 0, 3]      # head far below for the newest frame only
+    glitch[-1, 0, 0] += 1.5 * glitch[-1, 0, 2]
+    assert "head" in SVMFailureDetector(models, persist=1).detect(glitch, 25.0).failed
+    v = SVMFailureDetector(models, persist=3).detect(glitch, 25.0)
+    assert v.failed == () and v.scores["head"] < 0    # the score still shows it
+    with pytest.raises(ValueError, match="persist"):
+        SVMFailureDetector(models, persist=0)
