@@ -70,13 +70,22 @@ def _failed_box(hist: np.ndarray, truth_hist: np.ndarray, part: int, onset: int,
 
 def perturbed_samples(frames: np.ndarray, history: np.ndarray, fps: float, n_samples: int,
                       rng: np.random.Generator, cfg: PerturbConfig = PerturbConfig(),
-                      rule: LabelRule = LabelRule(), dt: float = DEFAULT_DT) -> tuple[np.ndarray, np.ndarray]:
-    """``n_samples`` feature vectors with part labels from one person's true trajectory.
+                      rule: LabelRule = LabelRule(), dt: float = DEFAULT_DT,
+                      truth: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """``n_samples`` feature vectors with part labels from one person's trajectory.
 
-    ``frames``: ``(T,)`` increasing indices; ``history``: ``(T, 3, 4)`` true ``[cx, cy, w, h]``.
+    ``frames``: ``(T,)`` increasing indices; ``history``: ``(T, 3, 4)`` ``[cx, cy, w, h]``,
+    the truth itself or the tracker's output. ``truth``: ``(T, 3, 4)`` true states at the
+    same frames to label against (NaN where unknown: dropped); default ``history``.
+    Perturbing the tracker's own boxes keeps its geometry (inner rectangles are smaller
+    and sit differently from tight truth boxes): trained on perturbed truth alone, the
+    head SVM flagged ~40 % of correctly tracked heads of the body tracker.
     Returns ``X (n, 24)`` and ``labels (n, 3)`` (1 on, 0 off, -1 dropped).
     """
     history = np.asarray(history, dtype=np.float64)
+    truth = history if truth is None else np.asarray(truth, dtype=np.float64)
+    if truth.shape != history.shape:
+        raise ValueError(f"truth {truth.shape} and history {history.shape} must have the same shape")
     frames = np.asarray(frames)
     t_len = history.shape[0]
     if t_len == 0 or n_samples <= 0:
@@ -87,7 +96,7 @@ def perturbed_samples(frames: np.ndarray, history: np.ndarray, fps: float, n_sam
         t = int(rng.integers(0, t_len))
         start = int(np.searchsorted(frames, frames[t] - k, side="left"))
         # a failure that began up to 1.5 dt before t0 (onset index inside the window)
-        truth_w = history[start:t + 1]
+        truth_w = history[start:t + 1]   # the reference trajectory the failures depart from
         win = truth_w.copy()
         w = win.shape[0]
         u = rng.uniform()
@@ -98,10 +107,10 @@ def perturbed_samples(frames: np.ndarray, history: np.ndarray, fps: float, n_sam
                 onset = int(rng.integers(0, w))
                 mode = FAILURE_MODES[int(rng.integers(0, len(FAILURE_MODES)))]
                 win[:, p] = _failed_box(win, truth_w, int(p), onset, mode, rng, cfg)
-        sizes = np.maximum(truth_w[..., 2:4], 1.0)
+        sizes = np.nan_to_num(np.maximum(truth_w[..., 2:4], 1.0), nan=1.0)
         noise = rng.normal(0.0, cfg.jitter, size=win.shape) * np.concatenate([sizes, sizes], axis=-1)
         win = win + noise
         win[..., 2:] = np.maximum(win[..., 2:], 1.0)
         xs.append(features_from_history(win, fps, frames[start:t + 1], dt)[-1])
-        ys.append(label_states(win[-1], truth_w[-1], rule))
+        ys.append(label_states(win[-1], truth[t], rule))
     return np.asarray(xs), np.asarray(ys, dtype=np.int8)

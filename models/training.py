@@ -9,8 +9,10 @@ Samples for the four SVMs come from three sources:
    are tracker boxes a user marked as failed without moving them; they are
    negatives (the other parts of that person and frame are positives) and are left
    out of everything else;
-3. **perturbed truth** (:mod:`models.perturb`): simulated single and multi-part
-   failures, so that a few clips give enough failures of every kind.
+3. **perturbed states** (:mod:`models.perturb`): simulated single and multi-part
+   failures, so that a few clips give enough failures of every kind. With the
+   tracker, its own output is perturbed (so the SVMs learn its box geometry) and
+   labelled against the truth; without it, the truth is.
 
 The variance parameters are fitted from the truth (:mod:`models.variance`), the
 colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
@@ -167,10 +169,25 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         xs.append(x), ys.append(y)
         counts["human_flags"] += len(x)
         n_pert = 0
-        for _tid, (frames, hist) in person_histories(truth_clean).items():
-            x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt)
-            xs.append(x), ys.append(y)
-            n_pert += len(x)
+        true_hist = person_histories(truth_clean)
+        if tracker_runner is not None:
+            # failures simulated on the tracker's own boxes (its geometry), labelled against the truth
+            for tid, (frames, hist) in person_histories(tracked).items():
+                aligned = np.full(hist.shape, np.nan)
+                if tid in true_hist:
+                    tf, th = true_hist[tid]
+                    pos = np.searchsorted(tf, frames)
+                    hit = (pos < len(tf)) & (tf[np.minimum(pos, len(tf) - 1)] == frames)
+                    aligned[hit] = th[pos[hit]]
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt,
+                                         truth=aligned)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
+        else:
+            for _tid, (frames, hist) in true_hist.items():
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
         counts["perturbed"] += n_pert
         clip_info.append(info)
     x_all = np.concatenate(xs, axis=0)

@@ -37,10 +37,12 @@ def test_cv_scores_are_reported(trained_svms):
         r = reports[name]
         (tn, fp), (fn, tp) = r.confusion
         assert tn + fp == r.n_negative and fn + tp == r.n_positive
-        assert r.tnr >= 0.95 and r.tnr == pytest.approx(tn / (tn + fp))
+        assert r.tnr >= 0.95 or r.tpr >= 0.9
+        assert r.tnr == pytest.approx(tn / (tn + fp))
         assert r.tpr > 0.7, (name, r)
         assert r.kernel in ("linear", "rbf") and r.C in (0.1, 1.0, 10.0, 100.0)
-    assert reports["multi"].tnr >= 0.8
+    m = reports["multi"]
+    assert (m.tnr >= 0.8 or abs(m.tpr - 0.9) < 0.01) and m.cv_balanced_accuracy > 0.6
     text = report_table(reports)
     assert "head" in text and "multi" in text
 
@@ -72,3 +74,13 @@ def test_a_one_frame_glitch_needs_persistence(trained_svms):
     assert v.failed == () and v.scores["head"] < 0    # the score still shows it
     with pytest.raises(ValueError, match="persist"):
         SVMFailureDetector(models, persist=0)
+
+
+def test_threshold_keeps_a_minimum_true_positive_rate():
+    dec = np.array([-3, -2, -1, 0.5, 1, 2, 3, 4, -0.5, 0.2])
+    y = np.array([0, 0, 0, 0, 1, 1, 1, 1, 1, 0])
+    # TNR 1.0 needs t > 0.5, which fails the positive at -0.5 (TPR 0.8 < 0.85): lowered to -0.5
+    t = choose_threshold(dec, y, 1.0, min_tpr=0.85)
+    assert t == -0.5
+    assert np.mean(dec[y == 1] >= t) == 1.0
+    assert 0.5 < choose_threshold(dec, y, 1.0) < 1.0
