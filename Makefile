@@ -21,6 +21,9 @@ $(VENV)/.installed: pyproject.toml | $(VENV)/bin/python
 
 $(VENV)/.installed-test: pyproject.toml $(VENV)/.installed
 	$(PY) -m pip install --quiet -e '.[test]'
+	# HOTA (optional): trackeval's metadata pins opencv-python, which would overwrite our headless
+	# OpenCV in cv2/; its metrics only need numpy and scipy, so install it without dependencies.
+	$(PY) -m pip install --quiet --no-deps 'trackeval==1.3.0'
 	touch $@
 
 venv: $(VENV)/.installed

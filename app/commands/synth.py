@@ -33,7 +33,12 @@ def run(args) -> int:
         raise CommandError(f"--size {width}x{height}: width and height must be even and at least 64x48")
     if args.frames < 1:
         raise CommandError(f"--frames must be at least 1, got {args.frames}")
-    out = render_scenario(args.scenario, args.outdir, seed=args.seed, n_frames=args.frames,
-                          width=width, height=height, progress=True)
+    if args.seed < 0:
+        raise CommandError(f"--seed must be a non-negative integer, got {args.seed}")
+    try:
+        out = render_scenario(args.scenario, args.outdir, seed=args.seed, n_frames=args.frames,
+                              width=width, height=height, progress=True)
+    except (ValueError, OSError) as exc:  # e.g. OUTDIR is a file, or the disk is full
+        raise CommandError(f"cannot write the scene to {args.outdir}: {exc}") from exc
     print(f"partlab synth: wrote {args.scenario} (seed {args.seed}, {args.frames} frames, {width}x{height}) to {out}")
     return 0

@@ -64,6 +64,7 @@ class Appearance:
     shoes: tuple[int, int, int]
     height_m: float = 1.75
     short_sleeves: bool = False
+    long_hair: bool = False
 
 
 def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int, int]:
@@ -71,12 +72,28 @@ def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int
     return tuple(int(v) for v in np.clip(c, 0, 255))
 
 
+def _distinct(rng: np.random.Generator, palette, n: int, min_dist: float) -> list[int]:
+    """``n`` palette indices in random order, each at least ``min_dist`` (BGR distance) from the others
+    when the palette allows it (else the farthest remaining ones)."""
+    cols = np.asarray(palette, float)
+    chosen: list[int] = []
+    for i in rng.permutation(len(palette)):
+        if len(chosen) == n:
+            break
+        if all(np.linalg.norm(cols[i] - cols[j]) >= min_dist for j in chosen):
+            chosen.append(int(i))
+    while len(chosen) < n:  # relax: add the colour farthest from those already chosen
+        rest = [i for i in range(len(palette)) if i not in chosen]
+        chosen.append(max(rest, key=lambda i: min(np.linalg.norm(cols[i] - cols[j]) for j in chosen)))
+    return chosen
+
+
 def sample_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
-    """``n`` people with distinct shirts and trousers (n <= 7)."""
+    """``n`` people with clearly different shirts and different trousers (n <= 7)."""
     if n > len(TROUSERS):
         raise ValueError(f"at most {len(TROUSERS)} people have distinct clothes, asked for {n}")
-    shirts = rng.permutation(len(SHIRTS))[:n]
-    trousers = rng.permutation(len(TROUSERS))[:n]
+    shirts = _distinct(rng, SHIRTS, n, 90.0)
+    trousers = _distinct(rng, TROUSERS, n, 50.0)
     out = []
     for i in range(n):
         out.append(Appearance(
@@ -87,5 +104,6 @@ def sample_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
             shoes=_jitter(rng, SHOES[rng.integers(len(SHOES))], 5),
             height_m=float(rng.uniform(1.62, 1.86)),
             short_sleeves=bool(rng.random() < 0.4),
+            long_hair=bool(rng.random() < 0.35),
         ))
     return out

@@ -5,7 +5,8 @@ person's left, forward ``f``, up ``u``; metres, the origin on the floor between 
 feet), projected with the :class:`~labelling.synth.camera.LocalView` around the person:
 
 - head: an ellipsoid of skin (the face, on the side the head faces) under a cap of
-  hair (top and back); the head part is hair + face (no neck);
+  hair (top and back; long hair falls behind the head to the shoulders); the head
+  part is hair + face (the neck, in the chin's shadow, belongs to the person only);
 - torso: a box from the top of the shoulders (0.83 H) to the waist (0.53 H), drawn as
   the convex hull of its projected corners; the torso part does NOT include the arms;
 - hip-leg: the pelvis box (0.53 H .. 0.45 H) plus two two-segment legs (thigh, shin,
@@ -40,8 +41,9 @@ ONE = 1 << SHIFT
 FIGURE_PARTS: tuple[str, ...] = ("head", "torso", "hipleg", "left_hand", "right_hand")
 
 # Label values of the label image (colour index); 0 = nothing drawn.
-HAIR, FACE, SHIRT, SLEEVE, SLEEVE_FAR, TROUSERS, TROUSERS_FAR, SHOES, HAND_LEFT, HAND_RIGHT, FOREARM = range(1, 12)
-N_LABELS = 12
+(HAIR, FACE, SHIRT, SLEEVE, SLEEVE_FAR, TROUSERS, TROUSERS_FAR, SHOES, HAND_LEFT, HAND_RIGHT, FOREARM,
+ NECK) = range(1, 13)
+N_LABELS = 13
 #: The labels each part is drawn with (its pixels the person's own other parts leave visible).
 PART_LABELS: dict[str, tuple[int, ...]] = {
     "head": (HAIR, FACE),
@@ -145,7 +147,8 @@ def _box_corners(u_top, hw_top, hd_top, u_bot, hw_bot, hd_bot) -> np.ndarray:
     return np.array(corners, float)
 
 
-def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False) -> list[_Solid]:
+def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False,
+                  long_hair: bool = False) -> list[_Solid]:
     """The solids of the figure in image coordinates, sorted far to near."""
     H = height_m
     F = np.array([np.cos(pose.facing), np.sin(pose.facing)])  # forward on the floor (X, Z)
@@ -174,7 +177,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         swing = pose.gait * LEG_SWING * np.sin(pose.phase)
         for side, sign in ((1, 1.0), (-1, -1.0)):  # left leg swings with +sin(phase)
             a = sign * swing
-            flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))  # knee bends while the leg swings forward
+            # the knee bends most while the leg swings forward
+            flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))
             hip = np.array([side * HIP_L * H, 0.0, HIP_U * H])
             knee = hip + THIGH * H * np.array([0.0, np.sin(a), -np.cos(a)])
             ankle = knee + SHIN * H * np.array([0.0, np.sin(a - flex), -np.cos(a - flex)])
@@ -199,7 +203,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         pelvis = _box_corners(PELVIS_TOP_U * H - drop, PELVIS_HALF_W * H, PELVIS_HALF_D * H,
                               PELVIS_BOTTOM_U * H - drop, PELVIS_HALF_W * H * 0.95, PELVIS_HALF_D * H)
         solids.append(_Solid("poly", project(pelvis), TROUSERS, "hipleg", depth(pelvis) + 0.035))
-        leg_depths = [depth(leg[1]) for leg in legs]
+        leg_depths = [depth(np.stack(leg[1:])) for leg in legs]  # the leg stepping towards the camera is in front
         far = int(np.argmax(leg_depths)) if abs(leg_depths[0] - leg_depths[1]) > 0.02 else -1
         for i, (side, hip, knee, ankle) in enumerate(legs):
             hip, knee, ankle = (p - np.array([0.0, 0.0, drop]) for p in (hip, knee, ankle))
@@ -228,6 +232,13 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
     hc, hax, hdz = head_ellipse(-0.012, 0.010, HEAD_RL * 1.06, HEAD_RF * 1.07, HEAD_RU * 0.9)
     head_depth = depth(head_c)
     solids.append(_Solid("ellipse", (hc, hax), HAIR, "head", head_depth + 0.001))
+    if long_hair:  # hair falling behind the head to the shoulders: behind the torso when facing the camera
+        lc, lax, ldz = head_ellipse(-0.025, -0.04, HEAD_RL * 1.12, HEAD_RF * 0.9, HEAD_RU * 1.2)
+        solids.append(_Solid("ellipse", (lc, lax), HAIR, "head", float(ldz) + 0.002))
+    # the neck (person only, like the arms): under the chin, in front of the torso's top
+    neck = np.array([[0.0, 0.0, (HEAD_U - 0.03) * H - drop], [0.0, 0.0, (SHOULDER_TOP_U - 0.01) * H - drop]])
+    neck = _pitch(neck, pivot_u, pose.bend)
+    solids.append(_Solid("limb", (project(neck), np.full(2, view.s * H * 0.027)), NECK, None, head_depth + 0.003))
     if Fh[1] < 0.45:  # the face is on the camera's side or in profile
         fc, fax, _ = head_ellipse(0.014, -0.012, HEAD_RL * 0.9, HEAD_RF * 0.86, HEAD_RU * 0.8)
         solids.append(_Solid("ellipse", (fc, fax), FACE, "head", head_depth))
@@ -262,8 +273,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         r = view.s * H * np.array([ARM_R * 1.15, ARM_R, WRIST_R])
         hand_px = project(hand)[0]
         solids.append(_Solid("arm", (pts, r, short_sleeves), SLEEVE, None, d))
-        solids.append(_Solid("circle", (hand_px, view.s * H * HAND_R), HAND_LEFT if side == 1 else HAND_RIGHT, hand_part,
-                             d - 0.001))
+        hand_label = HAND_LEFT if side == 1 else HAND_RIGHT
+        solids.append(_Solid("circle", (hand_px, view.s * H * HAND_R), hand_label, hand_part, d - 0.001))
     if abs(arm_depths[0] - arm_depths[1]) > 0.03:
         for s in solids:
             if s.kind == "arm" and s.depth == max(arm_depths):
@@ -336,7 +347,7 @@ def _extent(solid: _Solid) -> np.ndarray:
 
 def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView) -> Figure:
     """Draw one person: the label image and the part masks over its bounding region."""
-    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves)
+    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair)
     ext = np.array([_extent(s) for s in solids])
     x1, y1 = np.floor(ext[:, :2].min(0)).astype(int) - 2
     x2, y2 = np.ceil(ext[:, 2:].max(0)).astype(int) + 2
@@ -368,4 +379,5 @@ def colour_table(appearance: Appearance) -> np.ndarray:
     lut[HAND_LEFT] = appearance.skin
     lut[HAND_RIGHT] = appearance.skin
     lut[FOREARM] = np.asarray(appearance.skin) * 0.95
+    lut[NECK] = np.asarray(appearance.skin) * 0.85  # in the chin's shadow
     return np.clip(np.round(lut), 0, 255).astype(np.uint8)

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Walking: one full gait cycle (two steps) per this many body heights travelled.
-STRIDE_PER_HEIGHT = 0.78
+#: Walking: one full gait cycle (two steps of about 0.4 H each) per this many body heights travelled.
+STRIDE_PER_HEIGHT = 0.8
 #: Speed (metres per frame) at which the gait reaches its full amplitude.
 FULL_GAIT_SPEED = 0.035
 
@@ -103,7 +103,7 @@ def walk(camera, n_frames: int, keys, height_m: float = 1.75, smooth: int = 7) -
         kernel = np.ones(smooth) / smooth
         facing = np.convolve(np.pad(facing, pad, mode="edge"), kernel, mode="valid")
     dist = np.concatenate([[0.0], np.cumsum(speed[1:])]) if n_frames > 1 else np.zeros(1)
-    phase = 2 * np.pi * dist / (STRIDE_PER_HEIGHT * height_m * 2)
+    phase = 2 * np.pi * dist / (STRIDE_PER_HEIGHT * height_m)
     gait = np.clip(speed / FULL_GAIT_SPEED, 0, 1)
     zeros = np.zeros(n_frames)
     return Motion(x, z, facing, phase, gait, zeros.copy(), zeros.copy(), zeros.copy(),

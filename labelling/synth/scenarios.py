@@ -8,14 +8,14 @@ differently. Depths 5.5 .. 12 m give people 220 .. 100 px tall in a 720x480 fram
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from labelling.synth.appearance import Appearance, sample_appearances
 from labelling.synth.background import WALL_DEPTH, Prop
 from labelling.synth.camera import Camera, LocalView
-from labelling.synth.figure import HAND_R
+from labelling.synth.figure import HAND_R, WAIST_HALF_D
 from labelling.synth.motion import Motion, bump, clip_time, walk, with_changes
 from tracking.box import Box
 
@@ -49,11 +49,6 @@ def _j(rng: np.random.Generator, scale: float) -> float:
     return float(rng.uniform(-scale, scale))
 
 
-def _wave(t: np.ndarray, start: float, end: float, n_frames: int, fps: float) -> tuple[np.ndarray, np.ndarray]:
-    frames = np.arange(len(t))
-    return bump(t, start, end), 2 * np.pi * 2.2 * frames / fps
-
-
 def _glances(rng: np.random.Generator, n_frames: int, fps: float, amount: float = 0.35) -> np.ndarray:
     """Head yaw of a walker looking around now and then: a slow smooth random signal (radians)."""
     frames = np.arange(n_frames) / fps
@@ -69,14 +64,17 @@ def _single(rng, camera, n_frames, fps) -> Script:
     m = walk(camera, n_frames, [(0.0, -0.8, z1), (0.63, 0.6, z2), (0.76, 0.6, z2), (1.0, 0.05, z3)],
              app.height_m)
     t = clip_time(n_frames)
-    wave, _ = _wave(t, 0.68, 0.73, n_frames, fps)
+    wave = bump(t, 0.68, 0.73)  # the right hand waves (about 2 Hz) while facing the camera
     return Script([Actor(app, with_changes(m, wave=wave, head_yaw=_glances(rng, n_frames, fps)))])
 
 
 def _pair_cross(rng, camera, n_frames, fps) -> Script:
     a, b = sample_appearances(rng, 2)
+    # a tall near walker and a short far one: seen from 3.1 m up, the far head then stays behind the near one
+    a = replace(a, height_m=float(rng.uniform(1.80, 1.86)))
+    b = replace(b, height_m=float(rng.uniform(1.60, 1.64)))
     za = 7.0 + _j(rng, 0.2)
-    zb = za + 0.75 + _j(rng, 0.1)  # close behind: at the crossing little more than the far head shows
+    zb = za + 0.55 + _j(rng, 0.05)  # close behind: at the crossing little more than the far head shows
     xa = 0.85 + _j(rng, 0.05)
     ma = walk(camera, n_frames, [(0.0, -xa, za), (1.0, xa, za)], a.height_m)
     mb = walk(camera, n_frames, [(0.0, xa, zb), (1.0, -xa, zb)], b.height_m)
@@ -114,7 +112,8 @@ def _distractors(rng, camera, n_frames, fps) -> Script:
     props = []
     s_wall = float(camera.scale(WALL_DEPTH))
     _, wall_y = camera.floor_point(0.0, WALL_DEPTH)
-    for xr, kind in ((-0.55, "poster_person"), (-0.1, "rect"), (0.35, "poster_person"), (0.7, "rect")):
+    # posters on the back wall, clear of the door
+    for xr, kind in ((-0.28, "poster_person"), (0.02, "rect"), (0.32, "poster_person"), (0.62, "rect")):
         x = float(camera.x_from_fraction(xr + _j(rng, 0.05), WALL_DEPTH))
         fx, _ = camera.floor_point(x, WALL_DEPTH)
         w, h = 0.9 * s_wall, 1.3 * s_wall
@@ -136,13 +135,13 @@ def _distractors(rng, camera, n_frames, fps) -> Script:
 def _crowd(rng, camera, n_frames, fps) -> Script:
     apps = sample_appearances(rng, 4)
     t = clip_time(n_frames)
-    ma = walk(camera, n_frames, [(0.0, -0.9, 6.6 + _j(rng, 0.2)), (1.0, 0.8, 6.9)], apps[0].height_m)
+    ma = walk(camera, n_frames, [(0.0, -0.84, 6.6 + _j(rng, 0.2)), (1.0, 0.8, 6.9)], apps[0].height_m)
     mb = walk(camera, n_frames, [(0.0, 0.9, 8.4 + _j(rng, 0.2)), (1.0, -0.85, 8.0)], apps[1].height_m)
     mc = walk(camera, n_frames, [(0.0, -0.55, 9.6), (0.6, 0.45, 9.0 + _j(rng, 0.3)), (1.0, 0.85, 9.4)],
               apps[2].height_m)
     md = walk(camera, n_frames, [(0.0, 0.55, 9.6), (0.35, 0.3, 9.4), (0.6, 0.3, 9.4), (1.0, -0.55, 8.8)],
               apps[3].height_m)
-    wave, _ = _wave(t, 0.4, 0.55, n_frames, fps)
+    wave = bump(t, 0.4, 0.55)
     md = with_changes(md, wave=wave)
     motions = [with_changes(m, head_yaw=_glances(rng, n_frames, fps)) for m in (ma, mb, mc, md)]
     return Script([Actor(a, m) for a, m in zip(apps, motions)])
@@ -162,14 +161,14 @@ def _desk(rng, camera, n_frames, fps) -> Script:
     (app,) = sample_appearances(rng, 1)
     H = app.height_m
     W, Hi = camera.width, camera.height
-    s = 0.66 * Hi  # pixels per metre: head and torso about 180 px tall at 480 rows
+    s = 0.62 * Hi  # pixels per metre: head, torso and arms about 200-230 px tall at 480 rows
     k = 0.3
     head_top = (1.0 - 0.24) * H
     y0 = 0.2 * Hi + s * head_top
     x0 = W / 2 + _j(rng, 0.05 * W)
     view = LocalView(x0, y0, s, k)
     desk_h, desk_far, desk_near = 0.75, 0.25, 0.95  # metres: height, near/far edge in front of the person
-    seat_cut = desk_h - k * (desk_far - 0.06 * H)
+    seat_cut = desk_h - k * (desk_far - WAIST_HALF_D * H)  # the torso's front ends at the desk's far edge
     # the desk seen from the camera: far edge row, near edge row
     far_y = y0 - s * desk_h + s * k * desk_far
     near_y = y0 - s * desk_h + s * k * desk_near
@@ -196,7 +195,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
             hands[:, i, d] += amp * 0.5 * (np.sin(2 * np.pi * fr[0] * frames / fps + ph[0])
                                            + np.sin(2 * np.pi * fr[1] * frames / fps + ph[1]))
     # clap around frames 40-60 of 150: hands meet in front of the chest three times
-    t0, t1 = 40 / 150, 60 / 150
+    t0, t1 = 40 / 149, 60 / 149  # clip time of frames 40 and 60 of a 150-frame clip
     c = bump(t, t0, t1, ramp=0.04)
     u = np.clip((t - t0) / (t1 - t0), 0, 1)
     sep = hr * 1.05 + 0.11 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))
@@ -204,7 +203,7 @@ def _desk(rng, camera, n_frames, fps) -> Script:
                      np.stack([-sep, np.full(n, 0.3), np.full(n, 0.98)], 1)], 1)
     hands = hands * (1 - c)[:, None, None] + clap * c[:, None, None]
     # reach around frames 80-110: the right hand goes to the cup and back
-    r = bump(t, 85 / 150, 105 / 150, ramp=0.035)
+    r = bump(t, 85 / 149, 105 / 149, ramp=0.035)
     target = obj + np.array([0.0, 0.0, 0.06])
     hands[:, 1] = hands[:, 1] * (1 - r)[:, None] + target[None] * r[:, None]
     yaw = 0.3 * np.sin(2 * np.pi * frames / (fps * 3.5) + rng.uniform(0, 6.3)) * (1 - r) - 0.55 * r

@@ -21,7 +21,6 @@ from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
@@ -29,14 +28,17 @@ from tqdm import tqdm
 from labelling.synth.appearance import Appearance
 from labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from labelling.synth.camera import Camera
-from labelling.synth.figure import FIGURE_PARTS, PART_LABELS, FigurePose, colour_table, draw_figure
+from labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
+                                    colour_table, draw_figure)
 from labelling.synth.scenarios import BUILDERS, Script
 from tracking.box import Box
+from tracking.parts import PART_NAMES
 from tracking.tracks import normalise_tracks
 
 SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
 FPS = 25.0
 OCCLUDER_ID = 255
+SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,7 +49,9 @@ class Scene:
     (``source = "truth"``) with rows for every person and part at every frame;
     ``init``: the rows of each track's first frame; ``occluders``: fixed occluder boxes
     (the pillar), else empty; ``fps``: frame rate; ``appearances``: each track's
-    colours (track ``k`` is ``appearances[k - 1]``).
+    colours (track ``k`` is ``appearances[k - 1]``); ``background``: the empty room;
+    ``owners``: per-pixel visibility maps (only with ``make_scene(..., owners=True)``),
+    e.g. the true foreground for testing a background model is ``owners[t] % 255 > 0``.
     """
 
     frames: np.ndarray
@@ -56,11 +60,15 @@ class Scene:
     occluders: list[Box]
     fps: float
     appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
+    background: np.ndarray | None = None  # (H, W, 3) uint8: the empty room (no shadows, flicker or noise)
+    owners: np.ndarray | None = None  # (T, H, W) uint8 who is seen where: 0 room, k track k, 255 occluder
 
 
-def _check(name: str, n_frames: int, width: int, height: int) -> None:
+def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
     if name not in SCENARIOS:
         raise ValueError(f"unknown scenario {name!r}; expected one of {', '.join(SCENARIOS)}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
     if n_frames < 1:
         raise ValueError(f"n_frames must be at least 1, got {n_frames}")
     if width < 64 or height < 48:
@@ -102,21 +110,27 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
 
 
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
-               *, clean: bool = False, progress: bool = False) -> Scene:
+               *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
 
-    ``clean`` leaves out flicker and sensor noise (for tests that check drawn colours).
+    ``clean`` leaves out every photometric effect (cloth shading, flicker, sensor noise)
+    so that each pixel has its label's exact colour (for tests that check drawn colours);
+    ``owners`` keeps every frame's visibility map in :attr:`Scene.owners`.
     """
-    _check(name, n_frames, width, height)
+    _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.for_frame(width, height)
     script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
-    background = draw_props(room(rng, camera), script.props, rng)
+    background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
     luts = [colour_table(a.appearance) for a in script.actors]
+    # cloth folds and lighting: a gain field per person that moves with them (none when clean)
+    folds = [None if clean else 0.045 * smooth_noise(rng, height + 64, width + 64, max(3, height // 40))
+             for _ in script.actors]
     frames = np.empty((n_frames, height, width, 3), np.uint8)
     owner = np.zeros((height, width), np.uint8)
+    owner_maps = np.zeros((n_frames, height, width), np.uint8) if owners else None
     rows: list[tuple] = []
     for i in tqdm(range(n_frames), desc=f"synth {name}", unit="frame", disable=not progress):
         frame = background.copy()
@@ -139,7 +153,16 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             crop = (slice(cy1 - y0, cy2 - y0), slice(cx1 - x0, cx2 - x0))
             lab = fig.labels[crop]
             on = lab > 0
-            frame[cy1:cy2, cx1:cx2][on] = luts[a][lab[on]]
+            colours = luts[a][lab[on]]
+            if folds[a] is not None:  # lit from above: brighter shoulders, darker feet, plus folds
+                ry = (np.arange(cy1 - y0, cy2 - y0, dtype=np.float32) / max(fh, 1))[:, None]
+                fold = folds[a]
+                if fold.shape[0] < fh or fold.shape[1] < fw:  # a figure larger than the frame
+                    fold = np.pad(fold, ((0, max(0, fh - fold.shape[0])), (0, max(0, fw - fold.shape[1]))), "wrap")
+                cloth = ~np.isin(lab, SKIN_LABELS)  # folds in clothes and hair, smooth skin
+                gain = (1.06 - 0.14 * ry) * (1.0 + fold[: fh, : fw][crop] * cloth)
+                colours = np.clip(colours * gain[on][:, None], 0, 255).astype(np.uint8)
+            frame[cy1:cy2, cx1:cx2][on] = colours
             owner[cy1:cy2, cx1:cx2][on] = a + 1
             drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
         for o, tex in zip(script.occluders, occ_tex):
@@ -165,13 +188,17 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
                 rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
                              rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
         frames[i] = frame if effects is None else effects.apply(frame, i)
+        if owner_maps is not None:
+            owner_maps[i] = owner
     truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded"])
     truth["source"] = "truth"
-    truth = normalise_tracks(truth)
+    order = {p: k for k, p in enumerate(PART_NAMES)}
+    truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
+    truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
     init = truth[truth["frame"] == first].reset_index(drop=True)
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
-                 tuple(a.appearance for a in script.actors))
+                 tuple(a.appearance for a in script.actors), background, owner_maps)
 
 
 def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,
@@ -192,8 +219,11 @@ def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: 
             occ, index=False, lineterminator="\n")
     elif occ.exists():
         occ.unlink()
-    meta = {"name": name, "seed": seed, "fps": scene.fps, "width": width, "height": height,
-            "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
-            "occluders": [list(b.as_tuple()) for b in scene.occluders]}
+    meta = {"name": name, "seed": seed, "fps": scene.fps, "size": f"{width}x{height}", "width": width,
+            "height": height, "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
+            "occluders": [list(b.as_tuple()) for b in scene.occluders],
+            "people": [{"track_id": k + 1, "shirt": list(p.shirt), "trousers": list(p.trousers), "skin": list(p.skin),
+                        "hair": list(p.hair), "height_m": round(p.height_m, 3)}
+                       for k, p in enumerate(scene.appearances)]}
     (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
     return out

@@ -74,7 +74,8 @@ def test_part_boxes_nest_in_the_person_and_stack_head_torso_hipleg(clean_single)
     assert (wide["y"]["head"] < wide["y"]["torso"]).all() and (wide["y"]["torso"] < wide["y"]["hipleg"]).all()
     assert (wide["y"]["hipleg"] + wide["h"]["hipleg"] == wide["y"]["person"] + wide["h"]["person"]).all()
     ratio = wide["h"]["head"] / wide["h"]["person"]
-    assert ratio.between(0.09, 0.16).all()  # a head is about 1/7.5 of the body
+    top = 0.22 if clean_single.appearances[0].long_hair else 0.16  # long hair falls to the shoulders
+    assert ratio.between(0.09, top).all()  # a head is about 1/7.5 of the body
 
 
 def test_lone_walker_is_never_occluded(clean_single):
@@ -83,14 +84,15 @@ def test_lone_walker_is_never_occluded(clean_single):
 
 
 def test_hidden_walker_at_the_middle_of_the_crossing():
-    n = 41
+    n = 75
     scene = make_scene("pair_cross", seed=2, n_frames=n, width=360, height=240)
     t = scene.truth
     mid = t[(t.frame == n // 2) & (t.part == "person")].set_index("track_id")["occluded"]
-    assert mid.max() > 0.5 and mid.min() == 0.0
+    assert mid.max() > 0.7 and mid.min() == 0.0
     far = int(mid.idxmax())
     # the far walker's torso and hip-leg are mostly hidden; at the start nobody is
-    assert _row(t, n // 2, far, "torso").occluded > 0.6 and _row(t, n // 2, far, "hipleg").occluded > 0.5
+    assert _row(t, n // 2, far, "torso").occluded > 0.8 and _row(t, n // 2, far, "hipleg").occluded > 0.5
+    assert _row(t, n // 2, far, "head").occluded > 0.5  # a short walker behind a tall one
     assert t[t.frame == 0]["occluded"].max() == 0.0
 
 
@@ -116,8 +118,9 @@ def test_same_seed_same_scene_other_seed_other_scene():
     pd.testing.assert_frame_equal(a.truth, b.truth)
     assert np.abs(a.frames.astype(int) - c.frames.astype(int)).mean() > 3
     assert a.appearances != c.appearances
-    shirts = [p.shirt for p in a.appearances]
-    assert len(set(shirts)) == 4
+    shirts = np.array([p.shirt for p in a.appearances], float)
+    gaps = [np.linalg.norm(shirts[i] - shirts[j]) for i in range(4) for j in range(i + 1, 4)]
+    assert min(gaps) > 70  # clearly different shirts (BGR distance)
 
 
 @pytest.mark.parametrize("name", SCENARIOS)
@@ -196,6 +199,8 @@ def test_bad_names_and_sizes_are_refused():
         make_scene("nobody")
     with pytest.raises(ValueError, match="too small"):
         make_scene("single", width=20, height=20)
+    with pytest.raises(ValueError, match="seed"):
+        make_scene("single", seed=-1)
 
 
 def test_cli_writes_the_files(tmp_path, capsys):
@@ -212,3 +217,82 @@ def test_cli_writes_the_files(tmp_path, capsys):
     assert "parade" in err and "pillar" in err and "desk" in err
     assert main(["synth", str(tmp_path / "x"), "--size", "big"]) == 2
     assert not (tmp_path / "x").exists()
+    (tmp_path / "afile").write_text("not a directory")
+    assert main(["synth", str(tmp_path / "afile"), "--frames", "2", "--size", "96x64"]) == 2
+    assert "cannot write" in capsys.readouterr().err
+
+
+def test_decoded_clip_frames_match_the_truth_frames(tmp_path):
+    """Frame i of the mp4 as OpenCV decodes it is truth frame i (no codec off-by-one)."""
+    from labelling.video import open_video
+
+    n = 10
+    out = render_scenario("single", tmp_path, seed=2, n_frames=n, width=240, height=160)
+    scene = make_scene("single", seed=2, n_frames=n, width=240, height=160)
+    person = scene.truth[scene.truth.part == "person"].set_index("frame")
+    clip = open_video(out / "clip.mp4")
+    for i in (1, 5, 8):
+        near = person.loc[i - 1:i + 1]
+        x1, y1 = int(near.x.min()), int(near.y.min())
+        x2, y2 = int((near.x + near.w).max()), int((near.y + near.h).max())
+        decoded = clip.read(i)[y1:y2, x1:x2].astype(int)
+        diffs = [np.abs(decoded - scene.frames[j][y1:y2, x1:x2]).mean() for j in (i - 1, i, i + 1)]
+        assert int(np.argmin(diffs)) == 1 and diffs[1] < 0.7 * min(diffs[0], diffs[2]), (i, diffs)
+
+
+def test_owner_maps_agree_with_the_truth_and_the_background():
+    scene = make_scene("pillar", seed=0, n_frames=30, width=240, height=160, owners=True)
+    assert scene.owners.shape == (30, 160, 240) and scene.background.shape == (160, 240, 3)
+    (pillar,) = scene.occluders
+    x, y, w, h = (int(v) for v in pillar.as_tuple())
+    assert (scene.owners[:, y:y + h, x:x + w] == 255).all()
+    person = scene.truth[scene.truth.part == "person"].set_index("frame")
+    for t in range(0, 30, 5):
+        ys, xs = np.nonzero(scene.owners[t] == 1)
+        r = person.loc[t]
+        if r.occluded == 1.0:
+            assert len(ys) == 0
+            continue
+        # every visible pixel of the walker is inside its box, and it is a sizeable share of the box
+        assert xs.min() >= r.x and xs.max() < r.x + r.w and ys.min() >= r.y and ys.max() < r.y + r.h
+        assert len(ys) / (r.w * r.h) * 1.0 > 0.25 * (1 - r.occluded)
+    assert make_scene("single", n_frames=2, width=96, height=64).owners is None
+
+
+def test_single_walker_turns_back_through_facing_the_camera_and_waves(clean_single):
+    from labelling.synth.camera import Camera
+    from labelling.synth.motion import walk
+
+    camera = Camera.for_frame(480, 320)
+    m = walk(camera, 100, [(0.0, -0.8, 8.0), (0.6, 0.6, 7.0), (0.8, 0.6, 7.0), (1.0, 0.0, 8.5)])
+    assert np.cos(m.facing[10]) > 0.95  # walking right (and a little towards the camera), side-on
+    assert (np.sin(m.facing[62:74]) < -0.45).all() and np.sin(m.facing[62:74]).min() < -0.98  # turns facing the camera
+    assert np.cos(m.facing[95]) < -0.5  # walking back left
+    assert m.gait[70] == 0 and m.gait[10] == 1  # standing while turning
+    t = clean_single.truth
+    T = t.frame.max() + 1
+    hand = t[t.part == "right_hand"].set_index("frame")
+    head = t[t.part == "head"].set_index("frame")
+    left = t[t.part == "left_hand"].set_index("frame")
+    waving = [f for f in range(T) if 0.69 * T <= f <= 0.72 * T]
+    assert waving and all(hand.y[f] < head.y[f] + head.h[f] for f in waving)  # the right hand is up by the head
+    assert all(left.y[f] > head.y[f] + head.h[f] for f in waving)  # the left one is not
+    assert all(hand.y[f] > head.y[f] + head.h[f] for f in range(0, int(0.5 * T)))  # walking: hands down
+
+
+def test_left_hand_is_the_persons_own_left():
+    from labelling.synth.appearance import Appearance
+    from labelling.synth.camera import LocalView
+    from labelling.synth.figure import FigurePose, draw_figure
+
+    app = Appearance((0, 0, 200), (100, 50, 0), (150, 180, 220), (20, 20, 20), (30, 30, 30))
+    view = LocalView(200.0, 300.0, 100.0, 0.4)
+
+    def hand_x(facing):
+        fig = draw_figure(FigurePose(facing=facing), app, view)
+        return [fig.origin[0] + np.nonzero(fig.masks[p].any(axis=0))[0].mean() for p in ("left_hand", "right_hand")]
+
+    left, right = hand_x(-np.pi / 2)  # facing the camera: the own left hand is on the image right
+    assert left - right > 30
+    left, right = hand_x(np.pi / 2)  # facing away: on the image left
+    assert right - left > 30

@@ -1,0 +1,187 @@
+import json
+
+import motmetrics as mm
+import numpy as np
+import pandas as pd
+import pytest
+
+from labelling.evaluation import (EvaluationError, box_correct, evaluate, iou_distance, match_tracks,
+                                  rate_curve_figure)
+from tracking.tracks import normalise_tracks
+
+
+def tracks(rows):
+    return normalise_tracks(pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"]))
+
+
+def test_box_correct_on_hand_made_boxes():
+    truth = [0, 0, 10, 10]
+    cases = {
+        (0, 0, 10, 10): True,  # the same box
+        (5, 0, 10, 10): True,  # exactly half on the truth, centre on its edge
+        (6, 0, 10, 10): False,  # 40 % on the truth
+        (-5, -5, 20, 20): False,  # covers the truth but only a quarter of it lies on it
+        (2, 2, 4, 4): True,  # small box inside
+        (0, 0, 0, 0): False,  # empty box
+        (np.nan, 0, 10, 10): False,  # no tracked box
+    }
+    got = box_correct(np.array(list(cases), float), np.array([truth] * len(cases), float))
+    assert got.tolist() == list(cases.values())
+
+
+def _two_people():
+    """A is initialised at frame 0 (frames 0..3), B at frame 2 (frames 2..4), head only."""
+    truth = [(f, 1, "head", 10 * f, 0, 10, 10) for f in range(4)] + \
+            [(f, 2, "head", 100, 50, 10, 10) for f in range(2, 5)]
+    tr = [(0, 1, "head", 0, 0, 10, 10), (1, 1, "head", 12, 0, 10, 10),  # right, right (80 %)
+          (2, 1, "head", 27, 0, 10, 10), (3, 1, "head", 60, 0, 10, 10),  # wrong (30 %), wrong
+          (2, 2, "head", 100, 50, 10, 10), (4, 2, "head", 101, 51, 10, 10)]  # right, missing, right
+    return tracks(truth), tracks(tr)
+
+
+def test_tracking_rate_by_frame_offset_known_by_hand():
+    truth, tr = _two_people()
+    r = evaluate(truth, tr, at=1, hota=False)
+    assert r.matching == "track_id"
+    assert r.rates["head"].tolist() == [1.0, 0.5, 0.5, 0.0]  # offsets 0..3
+    assert r.counts["head"].tolist() == [2, 2, 2, 1]
+    assert r.summary.loc["head", "rate_at"] == 0.5
+    assert r.summary.loc["head", "rate_mean"] == pytest.approx(0.5)
+    # IoU: 1, 8/12, 3/17, 0 for A; 1, 0, 81/119 for B
+    assert r.summary.loc["head", "mean_iou"] == pytest.approx((1 + 8 / 12 + 3 / 17 + 1 + 81 / 119) / 7)
+    assert r.summary.loc["head", "rate_at"] == r.rate_at("head")
+    assert list(r.rates.columns) == ["head"]  # no body parts, no person box: no person_mbr
+
+
+def test_person_mbr_rate_uses_the_rectangle_around_the_three_parts():
+    body = {"head": (4, 0, 4, 4), "torso": (2, 4, 8, 8), "hipleg": (2, 12, 8, 10)}  # MBR (2, 0, 8, 22)
+    truth = tracks([(0, 0, p, *b) for p, b in body.items()] + [(1, 0, p, *b) for p, b in body.items()])
+    shifted = {"head": (4, 0, 4, 4), "torso": (2, 4, 8, 8), "hipleg": (2, 12, 8, 40)}  # MBR (2, 0, 8, 52)
+    tr = tracks([(0, 0, p, *b) for p, b in body.items()] + [(1, 0, p, *b) for p, b in shifted.items()])
+    r = evaluate(truth, tr, at=1, hota=False)
+    assert r.rates["person_mbr"].tolist() == [1.0, 0.0]  # 22/52 of the tracked MBR on the true one
+    assert r.rates["hipleg"].tolist() == [1.0, 0.0]  # 10/40 of the tracked hip-leg on the truth
+    # a tracked MBR 8 x 42 would still be right: 22/42 >= 1/2 and its centre (6, 21) is inside
+    longer = tr.copy()
+    longer.loc[(longer.frame == 1) & (longer.part == "hipleg"), "h"] = 30
+    assert evaluate(truth, longer, hota=False).rates["person_mbr"].tolist() == [1.0, 1.0]
+    assert r.rates["head"].tolist() == [1.0, 1.0]
+
+
+def test_ids_that_differ_are_matched_by_mean_iou():
+    truth, tr = _two_people()
+    renamed = tr.assign(track_id=tr["track_id"].map({1: 2, 2: 1}))  # same boxes, swapped ids
+    how, pairs = match_tracks(truth, renamed)
+    assert how == "iou" and pairs[["truth_id", "track_id"]].values.tolist() == [[1, 2], [2, 1]]
+    r = evaluate(truth, renamed, at=1, hota=False)
+    assert "Hungarian" in r.note and r.rates["head"].tolist() == [1.0, 0.5, 0.5, 0.0]
+    assert evaluate(truth, tr, hota=False).rates.equals(r.rates)
+    with pytest.raises(EvaluationError, match="matching must be"):
+        match_tracks(truth, tr, "name")
+
+
+def test_mota_and_idf1_known_by_hand():
+    # objects 1 and 2 over 4 frames (8 boxes). Tracker 10 follows 1 but misses frame 1 (1 miss),
+    # 20 then 30 follow 2 (1 switch), 40 is a false positive at frame 3.
+    truth = tracks([(f, 1, "torso", 0, 0, 10, 10) for f in range(4)]
+                   + [(f, 2, "torso", 50, 0, 10, 10) for f in range(4)])
+    tr = tracks([(f, 10, "torso", 1, 0, 10, 10) for f in (0, 2, 3)] + [(f, 20, "torso", 50, 0, 10, 10) for f in (0, 1)]
+                + [(f, 30, "torso", 50, 0, 10, 10) for f in (2, 3)] + [(3, 40, "torso", 100, 0, 10, 10)])
+    m = evaluate(truth, tr, hota=False).mot.loc["torso"]
+    assert (m.num_misses, m.num_false_positives, m.num_switches, m.num_objects) == (1, 1, 1, 8)
+    assert m.mota == pytest.approx(1 - 3 / 8)
+    assert m.idf1 == pytest.approx(2 * 5 / (8 + 8))  # IDTP: 3 (1<->10) + 2 (2<->20)
+    assert m.motp == pytest.approx(1 - 9 / 11 * 3 / 7 - 4 / 7)  # 3 boxes at IoU 9/11, 4 at 1
+
+
+def test_eval_agrees_with_motmetrics_own_pipeline(tmp_path, monkeypatch):
+    """Export truth and a noisy run as MOTChallenge files, let motmetrics load and match them."""
+    from labelling.formats import export_dataset
+    from labelling.formats.mot import mot_id
+    from labelling.video import VideoInfo
+    from tracking.parts import PART_NAMES
+
+    rng = np.random.default_rng(4)
+    rows = []
+    for tid in range(3):
+        for f in range(30):
+            for k, part in enumerate(("head", "torso", "hipleg")):
+                rows.append((f, tid, part, 20 + 40 * tid + f, 10 + 25 * k, 16, 22))
+    truth = tracks(rows)
+    noisy = truth.copy()
+    noisy[["x", "y"]] += rng.normal(0, 1.5, (len(noisy), 2))
+    noisy = noisy.drop(index=rng.choice(len(noisy), 20, replace=False))
+    noisy.loc[(noisy.track_id == 1) & (noisy.frame >= 15), "track_id"] = 7  # an identity switch
+    info = VideoInfo(tmp_path / "v.avi", 25.0, 200, 120, 30)
+    ours = evaluate(truth, noisy, hota=False).mot
+    monkeypatch.setattr(np, "asfarray", lambda a, dtype=float: np.asarray(a, dtype=dtype), raising=False)
+    gt_dir = export_dataset(truth, "mot", tmp_path / "gt", info, frames=False)
+    dt_dir = export_dataset(noisy, "mot", tmp_path / "dt", info, frames=False)
+    gt = mm.io.loadtxt(str(gt_dir / "gt" / "gt.txt"), fmt="mot15-2D")
+    dt = mm.io.loadtxt(str(dt_dir / "gt" / "gt.txt"), fmt="mot15-2D")
+    for part in ("head", "torso", "hipleg"):
+        c = PART_NAMES.index(part) + 1
+        acc = mm.utils.compare_to_groundtruth(gt[gt.ClassId == c], dt[dt.ClassId == c], "iou", distth=0.5)
+        theirs = mm.metrics.create().compute(acc, metrics=["mota", "idf1", "num_switches"], name=part)
+        assert ours.loc[part, "mota"] == pytest.approx(theirs.loc[part, "mota"], abs=1e-12)
+        assert ours.loc[part, "idf1"] == pytest.approx(theirs.loc[part, "idf1"], abs=1e-12)
+        assert ours.loc[part, "num_switches"] == theirs.loc[part, "num_switches"]
+    assert ours.loc["torso", "num_switches"] >= 1 and 0.5 < ours.loc["overall", "mota"] < 1.0
+    assert mot_id(1, 2) == 13
+
+
+def test_iou_distance_is_nan_below_half():
+    d = iou_distance(np.array([[0, 0, 10, 10]]), np.array([[0, 0, 10, 10], [5, 0, 10, 10], [2, 0, 10, 10]]))
+    assert d[0, 0] == 0.0 and np.isnan(d[0, 1]) and d[0, 2] == pytest.approx(1 - 80 / 120)
+
+
+def test_json_and_figure():
+    truth, tr = _two_people()
+    r = evaluate(truth, tr, at=1, hota=False)
+    d = json.loads(r.to_json())
+    assert d["matching"] == "track_id" and d["summary"]["head"]["rate_at"] == 0.5
+    assert d["rates"]["head"] == {"0": 1.0, "1": 0.5, "2": 0.5, "3": 0.0}
+    assert d["mot"]["head"]["num_objects"] == 7
+    r_far = evaluate(truth, tr, at=50, hota=False)
+    assert json.loads(r_far.to_json())["summary"]["head"]["rate_at"] is None  # no one tracked that long
+    fig = rate_curve_figure(r)
+    assert [t.name for t in fig.data] == ["head"] and list(fig.data[0].y) == [1.0, 0.5, 0.5, 0.0]
+
+
+def test_bad_input():
+    truth, tr = _two_people()
+    with pytest.raises(EvaluationError, match="the truth has no boxes"):
+        evaluate(truth.iloc[:0], tr)
+    with pytest.raises(EvaluationError, match="tracks: 1 repeated"):
+        evaluate(truth, pd.concat([tr, tr.iloc[[0]]]))
+
+
+def test_eval_matches_motmetrics_published_numbers_on_tud():
+    """motmetrics ships TUD-Campus/Stadtmitte truth and a tracker's output with the MOTChallenge
+    devkit's numbers in its own tests; our MOT importer and evaluate must reproduce them."""
+    from pathlib import Path
+
+    from labelling.formats import import_dataset
+
+    data = Path(mm.__file__).parent / "data"
+    published = {"TUD-Campus": (0.526462, 0.557659, 0.277201, 7, 13, 150),
+                 "TUD-Stadtmitte": (0.564014, 0.644619, 0.345904, 7, 45, 452)}
+    for seq, (mota, idf1, motp, switches, fp, fn) in published.items():
+        gt = import_dataset(data / seq / "gt.txt", "mot")
+        test = import_dataset(data / seq / "test.txt", "mot")
+        m = evaluate(gt, test, hota=False).mot.loc["person"]
+        assert (m.mota, m.idf1, m.motp) == pytest.approx((mota, idf1, motp), abs=1e-6)
+        assert (m.num_switches, m.num_false_positives, m.num_misses) == (switches, fp, fn)
+
+
+def test_hota_known_by_hand():
+    pytest.importorskip("trackeval")
+    # one person tracked perfectly but under id 5 for frames 0-1 and id 6 for frames 2-3:
+    # DetA = 1, AssA = 2 / (2 + 2 + 0) = 0.5, HOTA = sqrt(DetA * AssA)
+    truth = tracks([(f, 1, "head", 0, 0, 10, 10) for f in range(4)])
+    tr = tracks([(f, 5 if f < 2 else 6, "head", 0, 0, 10, 10) for f in range(4)])
+    m = evaluate(truth, tr).mot
+    assert m.loc["head", "deta"] == pytest.approx(1.0)
+    assert m.loc["head", "assa"] == pytest.approx(0.5)
+    assert m.loc["head", "hota"] == pytest.approx(np.sqrt(0.5))
+    assert evaluate(truth, truth).mot.loc["overall", "hota"] == pytest.approx(1.0)
