@@ -42,7 +42,7 @@ def test_cv_scores_are_reported(trained_svms):
         assert r.tpr > 0.7, (name, r)
         assert r.kernel in ("linear", "rbf") and r.C in (0.1, 1.0, 10.0, 100.0)
     m = reports["multi"]
-    assert (m.tnr >= 0.8 or abs(m.tpr - 0.9) < 0.01) and m.cv_balanced_accuracy > 0.6
+    assert (m.tnr >= 0.8 or abs(m.tpr - 0.95) < 0.01) and m.cv_balanced_accuracy > 0.6
     text = report_table(reports)
     assert "head" in text and "multi" in text
 
