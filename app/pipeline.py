@@ -1,0 +1,124 @@
+"""Run the trackers over a clip: one decode, one background model, every tracker fed.
+
+``track_video`` is what ``partlab track`` and the app's "track" button call. Frames are
+decoded once (``labelling.video.VideoClip.frames``, the decoder's numbering), the
+foreground mask is computed once per frame (``tracking.background``), and each
+tracker's ``step`` gets both. ``start``/``stop`` re-track a stretch of the clip, e.g.
+from a frame a user corrected (``init`` then holds the boxes at ``start``).
+"""
+
+from __future__ import annotations
+
+from os import PathLike
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from app.cli import CommandError
+from labelling.video import VideoClip, VideoError
+from tracking.background import BackgroundModel
+from tracking.params import BodyParams, LimbParams
+from tracking.tracks import TracksCSVError, empty_tracks, normalise_tracks, records_to_frame
+
+TRACKERS = ("body", "limbs", "all", "whole")
+
+
+def _limb_tracker(params: LimbParams, rng: np.random.Generator, init: pd.DataFrame | None):
+    try:
+        from tracking.limbs import LimbTracker
+    except ImportError:
+        raise CommandError("the limb tracker is not available yet") from None
+    return LimbTracker(params, rng, init=init)
+
+
+def _split_model(model) -> tuple[BodyParams, LimbParams, object]:
+    """``model``: None, a BodyParams, a LimbParams, or a bundle with ``.body_params``,
+    ``.limb_params`` and ``.failure_detector``."""
+    if model is None:
+        return BodyParams(), LimbParams(), None
+    if isinstance(model, BodyParams):
+        return model, LimbParams(), None
+    if isinstance(model, LimbParams):
+        return BodyParams(), model, None
+    body = getattr(model, "body_params", None) or BodyParams()
+    limb = getattr(model, "limb_params", None) or LimbParams()
+    return body, limb, getattr(model, "failure_detector", None)
+
+
+def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.DataFrame | None = None,
+                model=None, occluders=(), seed: int = 0,
+                progress: Callable[[int, int], None] | None = None, failure_detector=None,
+                start: int = 0, stop: int | None = None) -> pd.DataFrame:
+    """Track ``video_path`` and return the tracks table (frame indexes of the whole clip).
+
+    ``tracker``: body (head/torso/hip-leg + person MBR), whole (one box per person),
+    limbs (head and hands) or all (body and limbs). Limb track ids are offset when
+    ``all`` runs both without ``init`` so the two never share an id. The same ``seed``
+    gives the same output. Raises :class:`app.cli.CommandError` with a clear message
+    for an unreadable clip, a bad ``init`` table or an unknown tracker.
+    """
+    from tracking.body import BodyTracker  # heavy imports only when tracking
+
+    if tracker not in TRACKERS:
+        raise CommandError(f"unknown tracker {tracker!r}; expected one of {', '.join(TRACKERS)}")
+    try:
+        clip = VideoClip(video_path)
+    except VideoError as exc:
+        raise CommandError(str(exc)) from None
+    n = clip.frame_count
+    if start < 0 or start >= n:
+        raise CommandError(f"start frame {start} is outside the clip (0..{n - 1})")
+    stop = n if stop is None else min(int(stop), n)
+    if stop <= start:
+        raise CommandError(f"stop frame {stop} is not after start frame {start}")
+    if init is not None:
+        try:
+            init = normalise_tracks(init)
+        except (TracksCSVError, ValueError, KeyError) as exc:
+            raise CommandError(f"bad init table: {exc}") from None
+        init = init[init["frame"] >= start]
+
+    body_params, limb_params, bundle_detector = _split_model(model)
+    detector = failure_detector if failure_detector is not None else bundle_detector
+    rng = np.random.default_rng(seed)
+    # independent, repeatable streams per tracker (adding the limb tracker never changes body output)
+    body_rng, limb_rng = (np.random.default_rng(s) for s in rng.bit_generator.seed_seq.spawn(2))
+    trackers = []
+    if tracker in ("body", "all", "whole"):
+        try:
+            trackers.append(BodyTracker(body_params, body_rng, init=init, occluders=occluders,
+                                        failure_detector=detector, whole=tracker == "whole", fps=clip.fps))
+        except ValueError as exc:
+            raise CommandError(f"bad init table: {exc}") from None
+    if tracker in ("limbs", "all"):
+        trackers.append(_limb_tracker(limb_params, limb_rng, init))
+
+    background = BackgroundModel(body_params)
+    records = []
+    total = stop - start
+    done = 0
+    try:
+        for index, frame in clip.frames(start, stop):
+            mask = background.apply(frame)
+            for k, t in enumerate(trackers):
+                out = t.step(index, frame, mask)
+                if k > 0 and tracker == "all" and init is None:
+                    out = [_offset(r, 100000) for r in out]
+                records.extend(out)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    except VideoError as exc:
+        raise CommandError(str(exc)) from None
+    finally:
+        clip.close()
+    if not records:
+        return empty_tracks()
+    return records_to_frame(records)
+
+
+def _offset(record, by: int):
+    from dataclasses import replace
+
+    return replace(record, track_id=record.track_id + by)

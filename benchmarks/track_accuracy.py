@@ -1,0 +1,197 @@
+"""Tracking rates of the body tracker (seed 002 sec. 5.3's measure), printed as tables.
+
+A box is correct when at least half of it lies on the true box and its centre is inside
+the true box. The rate at frame i counts the people tracked correctly i frames after
+their initialisation; the mean rate averages over every (person, frame) pair.
+
+    python benchmarks/track_accuracy.py                       # synthetic suite + PETS09-S2L1
+    python benchmarks/track_accuracy.py --skip-pets --scenarios single,pillar
+    python benchmarks/track_accuracy.py --skip-synth --pets-video V.avi --pets-truth gt.csv
+
+Synthetic scenes come from ``labelling.synth.make_scene`` (started from their ``init``);
+PETS09-S2L1 (``../shared/data/pets09_s2l1_vtest``; PETS 2009, University of Reading, truth by
+A. Milan via OpenTraj) is tracked from each person's first truth box, and with automatic
+detection (no init) where each truth box counts as found when some tracked person box is
+correct for it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from tracking.background import BackgroundModel  # noqa: E402
+from tracking.body import BodyTracker  # noqa: E402
+from tracking.params import BodyParams  # noqa: E402
+from tracking.tracks import records_to_frame  # noqa: E402
+
+DATA = ROOT.parent.parent / "shared" / "data"
+if not DATA.exists():
+    DATA = Path("/work/shared/data")
+PETS = DATA / "pets09_s2l1_vtest"
+SUITE = ("single", "pillar", "distractors", "pair_cross", "crowd", "bend", "desk")
+AT = 105
+
+
+def correct(boxes: np.ndarray, truth: np.ndarray) -> np.ndarray:
+    """Row-wise: box ``(N, 4)`` correct for truth ``(N, 4)`` (x, y, w, h)?"""
+    b = np.asarray(boxes, float)
+    t = np.asarray(truth, float)
+    ix = np.clip(np.minimum(b[:, 0] + b[:, 2], t[:, 0] + t[:, 2]) - np.maximum(b[:, 0], t[:, 0]), 0, None)
+    iy = np.clip(np.minimum(b[:, 1] + b[:, 3], t[:, 1] + t[:, 3]) - np.maximum(b[:, 1], t[:, 1]), 0, None)
+    area = b[:, 2] * b[:, 3]
+    cx, cy = b[:, 0] + b[:, 2] / 2, b[:, 1] + b[:, 3] / 2
+    inside = (cx >= t[:, 0]) & (cx <= t[:, 0] + t[:, 2]) & (cy >= t[:, 1]) & (cy <= t[:, 1] + t[:, 3])
+    return (area > 0) & (ix * iy >= 0.5 * area) & inside
+
+
+def rates(tracks: pd.DataFrame, truth: pd.DataFrame, starts: pd.Series, part: str, at: int = AT):
+    """(rate at ``at`` frames after start, mean rate, people at ``at``) for one part; a truth
+    box without a tracked box counts as a miss."""
+    t = truth[truth.part == part][["frame", "track_id", "x", "y", "w", "h"]]
+    k = tracks[tracks.part == part][["frame", "track_id", "x", "y", "w", "h"]]
+    m = t.merge(k, on=["frame", "track_id"], how="left", suffixes=("_t", ""))
+    ok = correct(m[["x", "y", "w", "h"]].fillna(0).to_numpy(), m[["x_t", "y_t", "w_t", "h_t"]].to_numpy())
+    age = m["frame"].to_numpy() - m["track_id"].map(starts).to_numpy()
+    valid = age >= 0
+    at_mask = age == at
+    r_at = ok[at_mask].mean() if at_mask.any() else float("nan")
+    return r_at, ok[valid].mean(), int(at_mask.sum())
+
+
+def run_tracker(frames, init, whole=False, occluders=(), seed=0, params=None, fps=25.0):
+    params = params or BodyParams()
+    tracker = BodyTracker(params, np.random.default_rng(seed), init=init, occluders=occluders, whole=whole, fps=fps)
+    bg = BackgroundModel(params)
+    records = []
+    t0 = time.perf_counter()
+    n = 0
+    for index, frame in frames:
+        records.extend(tracker.step(index, frame, bg.apply(frame)))
+        n += 1
+    return records_to_frame(records), (time.perf_counter() - t0) / max(n, 1)
+
+
+def synth_suite(names, seed, n_frames):
+    try:
+        from labelling.synth import make_scene
+    except ImportError:
+        print("labelling.synth is not available: synthetic suite skipped")
+        return
+    rows = []
+    for name in names:
+        scene = make_scene(name, seed=seed, n_frames=n_frames, width=720, height=480)
+        truth = scene.truth
+        init = scene.init
+        starts = init.groupby("track_id")["frame"].min()
+        frames = list(enumerate(scene.frames))
+        for mode in ("body", "whole"):
+            tracks, spf = run_tracker(frames, init, whole=mode == "whole", occluders=scene.occluders, seed=seed,
+                                      fps=scene.fps)
+            row = {"scene": name, "tracker": mode, "ms/frame": 1000 * spf}
+            parts = ("person",) if mode == "whole" else ("head", "torso", "hipleg", "person")
+            for part in parts:
+                r_at, r_mean, n = rates(tracks, truth, starts, part)
+                row[f"{part}@{AT}"] = r_at
+                row[f"{part} mean"] = r_mean
+            row["people"] = n
+            rows.append(row)
+    df = pd.DataFrame(rows)
+    print(f"\nSynthetic scenes (720x480, {n_frames} frames, seed {seed}); rate at frame {AT} after start / mean:")
+    print(df.to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+    for mode in ("body", "whole"):
+        sub = df[df.tracker == mode]
+        print(f"suite mean person rate, {mode}: at {AT} {sub[f'person@{AT}'].mean():.3f}, "
+              f"mean {sub['person mean'].mean():.3f}")
+
+
+#: the fire-assembly-point sign and its post in PETS09-S2L1 view 1 (x, y, w, h; read off frame 0)
+PETS_OCCLUDERS = ((413, 203, 31, 40), (425, 150, 12, 242))
+
+
+def pets(video: Path, truth_csv: Path, stop: int | None):
+    from labelling.video import VideoClip
+
+    gt = pd.read_csv(truth_csv)
+    if stop:
+        gt = gt[gt.frame < stop]
+    gt = gt.assign(part="person")
+    first = gt.sort_values("frame").groupby("track_id").head(1)
+    starts = first.set_index("track_id")["frame"]
+    init = first[["frame", "track_id", "part", "x", "y", "w", "h"]]
+    clip = VideoClip(video)
+    frames = list(clip.frames(0, stop))
+    print(f"\nPETS09-S2L1 ({video.name}, {len(frames)} frames, {gt.track_id.nunique()} people):")
+    rows = []
+    for mode, occluders in (("body", ()), ("whole", ()), ("body", PETS_OCCLUDERS)):
+        tracks, spf = run_tracker(frames, init, whole=mode == "whole", occluders=occluders, fps=clip.fps)
+        r_at, r_mean, n = rates(tracks, gt, starts, "person")
+        start = "first truth box" + (", sign post as occluder" if occluders else "")
+        rows.append({"tracker": mode, "start": start, f"person@{AT}": r_at, "person mean": r_mean,
+                     f"people@{AT}": n, "ms/frame": 1000 * spf})
+    tracks, spf = run_tracker(frames, None, fps=clip.fps)
+    found, precise = detection_rates(tracks[tracks.part == "person"], gt)
+    try:  # the project's evaluation (labelling/evaluation.py): MOT metrics of the person boxes
+        from labelling.evaluation import evaluate
+
+        rep = evaluate(gt, tracks[tracks.part == "person"], hota=False)
+        mot = rep.mot.loc["person"]
+        print("automatic detection, MOT metrics of person boxes (labelling.evaluation): "
+              + ", ".join(f"{k} {mot[k]:.3f}" for k in mot.index if k in ("mota", "motp", "idf1", "num_switches")))
+    except ImportError:
+        pass
+    rows.append({"tracker": "body", "start": "automatic", f"person@{AT}": float("nan"), "person mean": found,
+                 f"people@{AT}": 0, "ms/frame": 1000 * spf})
+    print(pd.DataFrame(rows).to_string(index=False, float_format=lambda v: f"{v:.2f}"))
+    print(f"automatic detection: {found:.2f} of truth boxes have a correct tracked person box; "
+          f"{precise:.2f} of tracked person boxes are correct for some truth box; "
+          f"{tracks.track_id.nunique()} tracks started for {gt.track_id.nunique()} people")
+
+
+def detection_rates(tracks: pd.DataFrame, gt: pd.DataFrame) -> tuple[float, float]:
+    found = 0
+    good = 0
+    for frame, t in gt.groupby("frame"):
+        k = tracks[tracks.frame == frame]
+        if k.empty:
+            continue
+        tb = t[["x", "y", "w", "h"]].to_numpy()
+        kb = k[["x", "y", "w", "h"]].to_numpy()
+        ok = np.zeros((len(kb), len(tb)), bool)
+        for j in range(len(tb)):
+            ok[:, j] = correct(kb, np.repeat(tb[j:j + 1], len(kb), axis=0))
+        found += int(ok.any(axis=0).sum())
+        good += int(ok.any(axis=1).sum())
+    return found / max(len(gt), 1), good / max(len(tracks), 1)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--scenarios", default=",".join(SUITE))
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--frames", type=int, default=150, help="frames per synthetic scene")
+    ap.add_argument("--pets-video", type=Path, default=PETS / "vtest.avi")
+    ap.add_argument("--pets-truth", type=Path, default=PETS / "gt.csv")
+    ap.add_argument("--pets-frames", type=int, default=None, help="only the first N frames of PETS")
+    ap.add_argument("--skip-synth", action="store_true")
+    ap.add_argument("--skip-pets", action="store_true")
+    a = ap.parse_args()
+    if not a.skip_synth:
+        synth_suite([s for s in a.scenarios.split(",") if s], a.seed, a.frames)
+    if not a.skip_pets:
+        if a.pets_video.exists() and a.pets_truth.exists():
+            pets(a.pets_video, a.pets_truth, a.pets_frames)
+        else:
+            print(f"PETS09-S2L1 not found at {a.pets_video}; skipped")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,94 @@
+"""``partlab track`` and ``app.pipeline.track_video`` on a small drawn clip."""
+
+from __future__ import annotations
+
+import importlib.util
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from app.cli import CommandError, main
+from app.pipeline import track_video
+from labelling.video import write_video
+from tests.tracking.walkers import background, correct, draw_walker
+from tracking.box import Box
+from tracking.tracks import read_tracks_csv, write_tracks_csv
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    rng = np.random.default_rng(0)
+    d = tmp_path_factory.mktemp("clip")
+    bg = background(rng, 320, 200)
+    frames, truths = [], []
+    for t in range(24):
+        f = bg.copy()
+        truths.append(draw_walker(f, 60 + 3 * t, 50, 110, (40, 40, 160), (120, 60, 30), phase=t / 3))
+        frames.append(f)
+    path = write_video(d / "walk.avi", frames, 25)
+    b = truths[0]["person"]
+    init = pd.DataFrame([dict(frame=0, track_id=4, part="person", x=b.x, y=b.y, w=b.w, h=b.h)])
+    write_tracks_csv(init, d / "init.csv")
+    return d, path, truths
+
+
+def test_track_command_writes_tracks_from_init(clip, capsys):
+    d, path, truths = clip
+    out = d / "tracks.csv"
+    assert main(["track", str(path), "-o", str(out), "--init", str(d / "init.csv"), "--no-progress"]) == 0
+    tracks = read_tracks_csv(out)
+    assert set(tracks["track_id"]) == {4}
+    assert sorted(set(tracks["part"])) == ["head", "hipleg", "person", "torso"]
+    assert len(tracks) == 24 * 4
+    torso = tracks[tracks.part == "torso"]
+    hits = [correct(Box(r.x, r.y, r.w, r.h), truths[r.frame]["torso"]) for r in torso.itertuples()]
+    assert np.mean(hits) >= 0.9
+    assert "wrote 96 boxes of 1 track(s)" in capsys.readouterr().out
+
+
+def test_pipeline_same_seed_same_output_and_start_stop(clip):
+    d, path, truths = clip
+    init = read_tracks_csv(d / "init.csv")
+    a = track_video(path, init=init, seed=3)
+    b = track_video(path, init=init, seed=3)
+    pd.testing.assert_frame_equal(a, b)
+    # re-track from a corrected frame: init boxes at frame 10, frames 10..19 only
+    at10 = a[(a.frame == 10) & (a.part != "person")].copy()
+    seen = []
+    part = track_video(path, init=at10, start=10, stop=20, progress=lambda done, total: seen.append((done, total)))
+    assert part["frame"].min() == 10 and part["frame"].max() == 19
+    assert seen[-1] == (10, 10)
+    whole = track_video(path, tracker="whole", init=init)
+    assert set(whole["part"]) == {"person"}
+
+
+@pytest.mark.parametrize("argv_extra, message", [
+    (["--tracker", "limbs"], "limb tracker is not available yet"),
+    (["--model", "nowhere"], "model bundle"),
+    (["--occluders", "missing.csv"], "no such occluders file"),
+])
+def test_track_command_refuses_with_clear_messages(clip, capsys, argv_extra, message):
+    d, path, _ = clip
+    if "limbs" in argv_extra and importlib.util.find_spec("tracking.limbs") is not None:
+        pytest.skip("the limb tracker exists")
+    if "--model" in argv_extra and importlib.util.find_spec("models.bundle") is not None:
+        argv_extra = ["--model", str(d / "not-a-bundle")]
+    assert main(["track", str(path), "-o", str(d / "x.csv"), "--no-progress"] + argv_extra) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_bad_inputs_are_reported(clip, tmp_path, capsys):
+    d, path, _ = clip
+    assert main(["track", str(tmp_path / "none.mp4"), "-o", str(tmp_path / "x.csv")]) == 2
+    assert "no such file" in capsys.readouterr().err
+    bad = tmp_path / "init.csv"
+    bad.write_text("frame,track_id,part,x,y,w,h\n0,1,person,10,10,abc,40\n")
+    assert main(["track", str(path), "-o", str(tmp_path / "x.csv"), "--init", str(bad)]) == 2
+    assert "line 2, column 'w'" in capsys.readouterr().err
+    occ = tmp_path / "occ.csv"
+    occ.write_text("x,y,w\n1,2,3\n")
+    assert main(["track", str(path), "-o", str(tmp_path / "x.csv"), "--occluders", str(occ)]) == 2
+    assert "missing column(s) h" in capsys.readouterr().err
+    with pytest.raises(CommandError, match="outside the clip"):
+        track_video(path, start=500)

@@ -1,0 +1,171 @@
+"""The three-part body tracker on small drawn scenes (seed 002 sec. 4)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from tests.tracking.walkers import background, correct, draw_walker
+from tracking.background import BackgroundModel
+from tracking.box import Box
+from tracking.body import BodyTracker, init_starts
+from tracking.decomposition import decompose
+from tracking.histogram import to_ycc
+from tracking.params import BodyParams
+from tracking.tracks import records_to_frame
+
+W, H = 320, 200
+
+
+def _scene(n=60, walkers=(dict(x0=40, vx=2.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),), seed=0):
+    """Frames and truth of walkers drawn in list order (later ones in front)."""
+    rng = np.random.default_rng(seed)
+    bg = background(rng, W, H)
+    frames, truths = [], []
+    for t in range(n):
+        f = bg.copy()
+        tr = {}
+        for k, w in enumerate(walkers, start=1):
+            tr[k] = draw_walker(f, w["x0"] + w["vx"] * t, 50, 110, w["shirt"], w["trousers"], phase=t / 3)
+        f = np.clip(f.astype(np.int16) + rng.integers(-6, 7, f.shape), 0, 255).astype(np.uint8)
+        frames.append(f)
+        truths.append(tr)
+    return frames, truths
+
+
+def _init(truth, ids=(1,)):
+    return pd.DataFrame([dict(frame=0, track_id=i, part="person", x=b.x, y=b.y, w=b.w, h=b.h)
+                         for i in ids for b in [truth[i]["person"]]])
+
+
+def _run(tracker, frames):
+    bgm = BackgroundModel(tracker.params)
+    out = []
+    for i, f in enumerate(frames):
+        out.extend(tracker.step(i, f, bgm.apply(f)))
+    return records_to_frame(out)
+
+
+def _rate(tracks, truths, track_id, part, tid_truth=None):
+    tid_truth = tid_truth or track_id
+    rows = tracks[(tracks.track_id == track_id) & (tracks.part == part)]
+    hits = [correct(Box(r.x, r.y, r.w, r.h), truths[r.frame][tid_truth][part]) for r in rows.itertuples()]
+    return np.mean(hits), len(hits)
+
+
+def test_decomposition_finds_the_three_parts_of_a_drawn_person():
+    frames, truths = _scene(n=1)
+    ycc = to_ycc(frames[0])
+    t = truths[0][1]
+    mask = np.zeros((H, W), np.uint8)
+    p = t["person"]
+    # the foreground of the drawn walker: every pixel that differs from the background
+    bg = background(np.random.default_rng(0), W, H)
+    mask[np.abs(frames[0].astype(int) - bg).sum(axis=2) > 40] = 255
+    parts = decompose(ycc, mask, p, BodyParams())
+    for name in ("head", "torso", "hipleg"):
+        assert correct(parts[name], t[name]), (name, parts[name], t[name])
+    assert parts["head"].y2 <= parts["torso"].y + 1 <= parts["hipleg"].y + 1
+    # the hip-leg rectangle is the upper half of its section only
+    assert parts["hipleg"].y2 < p.y2 - 0.2 * p.h
+
+
+def test_decomposition_without_a_mask_uses_colour_contrast():
+    """First frames: no background model yet; the person is told from its surroundings."""
+    frames, truths = _scene(n=1, walkers=(dict(x0=150, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    t = truths[0][1]
+    loose = Box(t["person"].x - 20, t["person"].y - 6, t["person"].w + 24, t["person"].h + 12)  # more room left
+    parts = decompose(to_ycc(frames[0]), None, loose, BodyParams())
+    for name in ("head", "torso", "hipleg"):
+        assert correct(parts[name], t[name]), (name, parts[name], t[name])
+    # (with the whole loose box as foreground the head box takes in the background on the left)
+    assert abs(parts["torso"].centre[0] - t["torso"].centre[0]) < 5
+
+
+def test_boxes_stay_on_a_walker_and_person_row_is_the_mbr():
+    frames, truths = _scene(n=60)
+    tracks = _run(BodyTracker(BodyParams(), np.random.default_rng(1), init=_init(truths[0])), frames)
+    for part in ("head", "torso", "hipleg", "person"):
+        rate, n = _rate(tracks, truths, 1, part)
+        assert n == 60
+        assert rate >= 0.9, part
+    f30 = tracks[tracks.frame == 30].set_index("part")
+    assert f30.loc["person", "x"] == pytest.approx(f30.loc[["head", "torso", "hipleg"], "x"].min())
+    bottom = (f30.loc[["head", "torso", "hipleg"], "y"] + f30.loc[["head", "torso", "hipleg"], "h"]).max()
+    assert f30.loc["person", "y"] + f30.loc["person", "h"] == pytest.approx(bottom)
+    assert set(tracks["state"]) <= {"init", "tracked"}
+
+
+def test_same_seed_same_output_and_whole_mode():
+    frames, truths = _scene(n=15)
+    a = _run(BodyTracker(BodyParams(), np.random.default_rng(5), init=_init(truths[0])), frames)
+    b = _run(BodyTracker(BodyParams(), np.random.default_rng(5), init=_init(truths[0])), frames)
+    pd.testing.assert_frame_equal(a, b)
+    whole = _run(BodyTracker(BodyParams(), np.random.default_rng(5), init=_init(truths[0]), whole=True), frames)
+    assert set(whole["part"]) == {"person"} and len(whole) == 15
+    assert _rate(whole, truths, 1, "person")[0] >= 0.9
+
+
+def test_people_are_found_without_init_and_tracks_end_when_they_leave():
+    frames, truths = _scene(n=90, walkers=(dict(x0=-10, vx=4.5, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    tracks = _run(BodyTracker(BodyParams(), np.random.default_rng(2)), frames)
+    assert tracks["track_id"].nunique() == 1
+    first = int(tracks["frame"].min())
+    assert first <= 12                       # background learnt, blob stable for start_frames
+    rate, n = _rate(tracks, truths, int(tracks["track_id"].iloc[0]), "torso", 1)
+    assert rate >= 0.85
+    # the walker leaves (centre beyond 320 + 10) around t = 76: the track ends before the last frame
+    assert tracks["frame"].max() < 89
+
+
+def test_occluded_person_is_predicted_through_the_occlusion():
+    """Sec. 4.3.1: B walks behind A; B's parts follow its dynamics while hidden and B is
+    tracked again after they separate (without it B's filters would lock onto A)."""
+    walkers = (dict(x0=90, vx=1.0, shirt=(40, 140, 40), trousers=(60, 60, 60)),      # B, behind
+               dict(x0=170, vx=-1.0, shirt=(40, 40, 160), trousers=(120, 60, 30)))  # A, in front
+    frames, truths = _scene(n=80, walkers=walkers)
+    tracker = BodyTracker(BodyParams(), np.random.default_rng(3), init=_init(truths[0], ids=(1, 2)))
+    tracks = _run(tracker, frames)
+    b = tracks[(tracks.track_id == 1) & (tracks.part == "torso")].set_index("frame")
+    states = tracks[(tracks.track_id == 1) & (tracks.part == "person")].set_index("frame")["state"]
+    assert (states == "occluded").sum() >= 5
+    # while occluded, B's predicted torso keeps moving right at about its speed (1 px/frame)
+    occ = states[states == "occluded"].index
+    xs = b.loc[occ, "x"].to_numpy()
+    assert np.all(np.diff(xs) > 0.3)
+    assert np.mean(np.diff(xs)) == pytest.approx(1.0, abs=0.4)
+    # after the crossing both are on their own torsos again
+    for tid in (1, 2):
+        late = tracks[(tracks.track_id == tid) & (tracks.part == "torso") & (tracks.frame >= 65)]
+        hits = [correct(Box(r.x, r.y, r.w, r.h), truths[r.frame][tid]["torso"]) for r in late.itertuples()]
+        assert np.mean(hits) >= 0.8, tid
+
+
+def test_parts_behind_an_occluder_follow_the_visible_parts():
+    """Sec. 4.3.2: a pillar hides the walker's hip-leg; it is carried along by the head and
+    torso and the walker is still tracked when the hip-leg reappears."""
+    frames, truths = _scene(n=70)
+    pillar = Box(120, 100, 40, 100)  # low wall: covers legs only
+    for f in frames:
+        f[100:200, 120:160] = (30, 200, 200)
+    tracker = BodyTracker(BodyParams(), np.random.default_rng(4), init=_init(truths[0]), occluders=[pillar])
+    tracks = _run(tracker, frames)
+    hip = tracks[(tracks.track_id == 1) & (tracks.part == "hipleg")]
+    assert (hip["occluded"] > 0).sum() >= 5
+    late = hip[hip.frame >= 60]
+    hits = [correct(Box(r.x, r.y, r.w, r.h), truths[r.frame][1]["hipleg"]) for r in late.itertuples()]
+    assert np.mean(hits) >= 0.8
+
+
+def test_init_rows_of_other_parts_are_ignored_and_bad_boxes_refused():
+    init = pd.DataFrame([
+        dict(frame=3, track_id=7, part="torso", x=10, y=10, w=20, h=30),
+        dict(frame=3, track_id=7, part="left_hand", x=0, y=0, w=5, h=5),
+        dict(frame=5, track_id=7, part="torso", x=12, y=10, w=20, h=30),
+    ])
+    starts = init_starts(init)
+    assert list(starts) == [7] and starts[7].frame == 3 and set(starts[7].boxes) == {"torso"}
+    bad = pd.DataFrame([dict(frame=0, track_id=1, part="person", x=0, y=0, w=1, h=30)])
+    with pytest.raises(ValueError, match="too small"):
+        init_starts(bad)

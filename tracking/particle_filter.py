@@ -1,0 +1,216 @@
+"""One body part's colour particle filter (seed 002 sec. 3, 3.1, 3.2; Nummiaro et al.).
+
+State of a particle: ``(N, 6) float32 [X, Y, W, H, dX, dY]``, (X, Y) the centre of the
+rectangle, (W, H) its size and (dX, dY) the centre's velocity in pixels per frame.
+Dynamics are constant velocity, ``X_t = X_{t-1} + dX_{t-1}`` plus Gaussian process
+noise per component (``tracking.params.PartNoise``: the "variance parameters" that
+retraining fits). Weights are ``exp(-lam (1 - rho))`` of the Bhattacharyya
+coefficient ``rho`` between a particle's equalized histogram and the target's
+(sec. 3.1); the estimate is the weighted mean; particles are then resampled
+systematically to the count of eq. (2) (entropy-adaptive, C = 1.2, 200..1000).
+
+A frame is ``predict()`` then ``measure(ycc)`` (or ``coast()`` when the part is
+occluded: dynamics only, appearance frozen, sec. 4.3), then ``update_model(ycc)`` and
+``resample()``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tracking.box import Box
+from tracking.histogram import (
+    binned_histogram,
+    bhattacharyya,
+    bhattacharyya_counts,
+    equalization_map,
+    fused_lut,
+    level_histogram,
+    likelihood,
+    update_reference,
+)
+from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
+from tracking.params import BodyParams, PartNoise
+from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
+
+
+def box_to_state(box: Box) -> np.ndarray:
+    """``Box`` (top-left, size) -> ``(6,) float64 [X, Y, W, H, 0, 0]`` (centre, size, no velocity)."""
+    return np.array([box.x + box.w / 2.0, box.y + box.h / 2.0, box.w, box.h, 0.0, 0.0])
+
+
+def state_to_box(state: np.ndarray) -> Box:
+    """``[X, Y, W, H, ...]`` -> ``Box`` with its top-left corner."""
+    x, y, w, h = (float(v) for v in state[:4])
+    return Box(x - w / 2.0, y - h / 2.0, max(w, 0.0), max(h, 0.0))
+
+
+class PartFilter:
+    """The particle filter and appearance model of one tracked rectangle."""
+
+    def __init__(self, box: Box, ycc: np.ndarray, params: BodyParams, noise: PartNoise,
+                 rng: np.random.Generator, n: int | None = None):
+        if box.w < 2 or box.h < 2:
+            raise ValueError(f"a tracked part needs a box of at least 2 x 2 pixels, got {box}")
+        self.params = params
+        self.noise = noise
+        self.rng = rng
+        self._sigma = np.array([noise.x, noise.y, noise.w, noise.h, noise.vx, noise.vy], dtype=np.float32)
+        self.reseed(box, ycc, n=n)
+
+    # -- initialisation -------------------------------------------------------------
+    def reseed(self, box: Box, ycc: np.ndarray, n: int | None = None, keep_velocity: bool = False) -> None:
+        """Restart at ``box``: new particles around it and a new appearance model from it
+        (initialisation, and the adjustment of sec. 4.3)."""
+        velocity = self.state[4:6].copy() if keep_velocity and hasattr(self, "state") else np.zeros(2)
+        self.state = box_to_state(box)
+        self.state[4:6] = velocity
+        self.base_size = np.array([box.w, box.h], dtype=np.float64)
+        n = int(n or self.params.particles_initial)
+        spread = self._sigma * np.float32(self.params.init_spread)
+        self.particles = (self.state.astype(np.float32)
+                          + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
+        self._clip_sizes()
+        self.weights = np.full(n, 1.0 / n)
+        self.reference = level_histogram(ycc, _int_box(box))
+        self._refresh_map()
+        self.similarity = 1.0
+
+    def _refresh_map(self) -> None:
+        p = self.params
+        self.mapping = equalization_map(self.reference, p.bins_per_channel, p.equalization_smoothing,
+                                        p.equalization_floor)
+        self.lut = fused_lut(self.mapping, p.bins_per_channel)
+        self.target = binned_histogram(self.reference, self.mapping, p.bins_per_channel)
+        per_channel = self.target.reshape(3, -1)
+        per_channel = per_channel / np.maximum(per_channel.sum(axis=1, keepdims=True), 1e-12)
+        self.sqrt_target = np.sqrt(per_channel).reshape(-1)
+
+    def _clip_sizes(self) -> None:
+        lo, hi = self.params.size_range
+        wh = self.particles[:, 2:4]
+        np.maximum(wh, (lo * self.base_size).astype(np.float32), out=wh)
+        np.minimum(wh, (hi * self.base_size).astype(np.float32), out=wh)
+
+    # -- one frame --------------------------------------------------------------------
+    @property
+    def n(self) -> int:
+        return len(self.particles)
+
+    @property
+    def box(self) -> Box:
+        """The estimate as a ``Box`` (cached while the estimate's X, Y, W, H do not change)."""
+        key = self.state[:4].tobytes()
+        if key != getattr(self, "_box_key", None):
+            x, y, w, h = self.state[:4].tolist()
+            self._box = Box(x - w / 2.0, y - h / 2.0, max(w, 0.0), max(h, 0.0))
+            self._box_key = key
+        return self._box
+
+    def predict(self) -> None:
+        """Constant-velocity motion plus process noise (seed 002 sec. 3)."""
+        p = self.particles
+        p[:, 0] += p[:, 4]
+        p[:, 1] += p[:, 5]
+        p += self.rng.standard_normal(p.shape, dtype=np.float32) * self._sigma
+        self._clip_sizes()
+
+    def predicted_box(self) -> Box:
+        """Where dynamics alone put the part this frame (the previous estimate moved by its velocity)."""
+        s = self.state.copy()
+        s[0:2] += s[4:6]
+        return state_to_box(s)
+
+    def measure(self, ycc: np.ndarray, anchor_x: float | None = None, anchor_sigma: float = 0.0,
+                anchor_y: float | None = None, anchor_sigma_y: float = 0.0) -> None:
+        """Weigh every particle by its colour likelihood (one integral histogram) and take
+        the weighted mean as the estimate.
+
+        With ``anchor_x`` and ``anchor_sigma > 0`` the weights are also multiplied by
+        ``exp(-0.5 ((X - anchor_x) / anchor_sigma)^2)``: a part of a body stays near the
+        body's axis (the torso's centre line) instead of following a look-alike part of
+        someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
+        relative to the torso near the one it started with."""
+        H, W = ycc.shape[:2]
+        rects = particle_rectangles(self.particles, W, H)
+        stride = self._stride()
+        counts = rectangle_histograms(ycc, self.lut, rects, stride)
+        areas = sampled_areas(rects, stride)
+        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        weights = likelihood(rho, self.noise.lam)
+        weights[areas * (stride * stride) < 4] = 0.0
+        if anchor_x is not None and anchor_sigma > 0:
+            weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
+        if anchor_y is not None and anchor_sigma_y > 0:
+            weights *= np.exp(-0.5 * ((self.particles[:, 1] - anchor_y) / anchor_sigma_y) ** 2)
+        self.weights = normalise_weights(weights)
+        self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
+
+    def probe(self, ycc: np.ndarray, spread: float, n: int = 200) -> tuple[np.ndarray, float]:
+        """Look for the part around the current estimate without changing the filter: ``n``
+        candidate centres within ``spread`` pixels (Gaussian), the one whose histogram matches
+        the (frozen) model best. Returns ``(state (6,), rho)``; used to end an occlusion when the
+        hidden person shows again away from where its dynamics put it."""
+        cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
+        cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
+        H, W = ycc.shape[:2]
+        rects = particle_rectangles(cand, W, H)
+        stride = self._stride()
+        counts = rectangle_histograms(ycc, self.lut, rects, stride)
+        areas = sampled_areas(rects, stride)
+        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        rho[full < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
+        k = int(np.argmax(rho))
+        return cand[k].astype(np.float64), float(rho[k])
+
+    def shift(self, delta: np.ndarray) -> None:
+        """Move the estimate and every particle by ``delta`` (dx, dy)."""
+        self.state[0:2] += delta
+        self.particles[:, 0:2] += np.asarray(delta, dtype=np.float32)
+
+    def _stride(self) -> int:
+        """2 (every second pixel) for parts at least ``histogram_stride_min`` wide and tall."""
+        m = self.params.histogram_stride_min
+        return 2 if m > 0 and min(self.state[2], self.state[3]) >= m else 1
+
+    def coast(self) -> None:
+        """Dynamics only (occlusion, sec. 4.3.1-4.3.2): the estimate moves by its velocity and
+        the particles are re-centred on it, so the cloud does not drift or spread."""
+        self.state[0:2] += self.state[4:6]
+        self.particles[:, :] = self.state.astype(np.float32)
+        self.particles += self.rng.standard_normal(self.particles.shape, dtype=np.float32) * self._sigma
+        self._clip_sizes()
+        self.weights = np.full(self.n, 1.0 / self.n)
+
+    def set_velocity(self, velocity: np.ndarray) -> None:
+        """Replace the velocity of the estimate and of every particle (e.g. an occluded part
+        follows the visible parts of its person)."""
+        self.state[4:6] = velocity
+        self.particles[:, 4:6] = np.asarray(velocity, dtype=np.float32)
+
+    def appearance(self, ycc: np.ndarray) -> np.ndarray:
+        """``Q_t``: the 256-level histogram ``(3, 256)`` of the current estimate's rectangle."""
+        return level_histogram(ycc, _int_box(self.box))
+
+    def score(self, observed: np.ndarray) -> float:
+        """Bhattacharyya coefficient of a 256-level histogram with this part's model."""
+        b = self.params.bins_per_channel
+        return float(bhattacharyya(binned_histogram(observed, self.mapping, b), self.target, b))
+
+    def update_model(self, observed: np.ndarray) -> None:
+        """Seed 002 eq. (1) on the 256-level reference, then a new equalization map."""
+        self.reference = update_reference(self.reference, observed, self.params.model_update)
+        self._refresh_map()
+
+    def resample(self) -> None:
+        """Systematic resampling to the entropy-adaptive count of seed 002 eq. (2)."""
+        p = self.params
+        n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
+        idx = systematic_resample(self.weights, n, self.rng)
+        self.particles = self.particles[idx]
+        self.weights = np.full(n, 1.0 / n)
+
+
+def _int_box(box: Box) -> tuple[int, int, int, int]:
+    return (int(round(box.x)), int(round(box.y)), max(int(round(box.w)), 1), max(int(round(box.h)), 1))
