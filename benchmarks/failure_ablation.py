@@ -40,6 +40,12 @@ AT = 105
 PARTS = ("head", "torso", "hipleg")
 
 
+def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
+    """``(N, 4)`` ``[cx, cy, w, h]`` from columns ``x, y, w, h`` (+ suffix)."""
+    return np.stack([d["x" + sfx] + d["w" + sfx] / 2, d["y" + sfx] + d["h" + sfx] / 2, d["w" + sfx], d["h" + sfx]],
+                    axis=1)
+
+
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame, at: int = AT) -> dict[str, tuple[int, int, float]]:
     """Per part ``(right at at, people with truth at at, mean rate over offsets 1..at)``,
     offsets counted from each truth track's first frame."""
@@ -56,9 +62,7 @@ def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame, at: int = AT) -> dict[
         ok = np.zeros(len(m), bool)
         if have.any():
             mm = m[have]
-            box = lambda d, sfx: np.stack([d["x" + sfx] + d["w" + sfx] / 2, d["y" + sfx] + d["h" + sfx] / 2,  # noqa: E731
-                                           d["w" + sfx], d["h" + sfx]], axis=1)
-            ok[have] = label_states(box(mm, ""), box(mm, "_t")) == POSITIVE
+            ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
         last = (m.frame == m.f0 + at).to_numpy()
         out[part] = (int(ok[last].sum()), int(last.sum()), float(ok.mean()) if len(ok) else float("nan"))
     return out
@@ -80,7 +84,8 @@ def main(argv=None) -> int:
 
     t0 = time.time()
     default = default_bundle()
-    print(f"retraining on {len(RETRAIN_SCENES)} other clips ({'perturbed truth only' if args.fast else 'with tracker runs'})...")
+    how = "perturbed truth only" if args.fast else "with tracker runs"
+    print(f"retraining on {len(RETRAIN_SCENES)} other clips ({how})...")
     clips, names, _ = scene_clips(RETRAIN_SCENES)
     retrained = train_bundle(clips, seed=1, tracker_runner=None if args.fast else body_tracker_runner, names=names)
     print(f"  done in {time.time() - t0:.0f} s")

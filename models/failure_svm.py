@@ -224,7 +224,8 @@ def fit_svm(name: str, x: np.ndarray, y: np.ndarray, seed: int, tnr_target: floa
 
 def train_failure_svms(x: np.ndarray, labels: np.ndarray, seed: int = 0, tnr_targets: dict[str, float] | None = None,
                        max_samples: int = 1500,
-                       progress: Callable[[str], None] | None = None) -> tuple[dict[str, SVMModel], dict[str, SVMReport]]:
+                       progress: Callable[[str], None] | None = None,
+                       ) -> tuple[dict[str, SVMModel], dict[str, SVMReport]]:
     """Train the four SVMs from features ``(N, 24)`` and part labels ``(N, 3)``."""
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 2 or x.shape[1] != N_FEATURES:

@@ -72,7 +72,8 @@ def colour_distances(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], tru
                 continue
             if index % stride == 0:
                 mapping = H.equalization_map(ref, bins)
-                rho = H.bhattacharyya(H.binned_histogram(obs, mapping, bins), H.binned_histogram(ref, mapping, bins), bins)
+                rho = H.bhattacharyya(H.binned_histogram(obs, mapping, bins),
+                                      H.binned_histogram(ref, mapping, bins), bins)
                 out[key[1]].append(float(1.0 - rho))
             refs[key] = H.update_reference(ref, obs, params.model_update)
     return {p: np.asarray(v) for p, v in out.items()}

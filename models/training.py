@@ -86,7 +86,7 @@ def tracker_samples(tracked: pd.DataFrame, truth: pd.DataFrame, fps: float,
 def sharpness_available() -> bool:
     """Whether ``lam`` can be fitted (it needs the body tracker's ``tracking.histogram``)."""
     try:
-        import tracking.histogram  # noqa: F401
+        import tracking.histogram  # noqa: F401  (only whether it imports)
     except ImportError:
         return False
     return True
@@ -99,7 +99,8 @@ def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None
     return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1
 
 
-def _apply_lam(body: BodyParams, table: pd.DataFrame, d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
+def _apply_lam(body: BodyParams, table: pd.DataFrame,
+               d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
     """Put the ML ``lam`` of every part with enough distances into ``body`` and the table."""
     from dataclasses import replace
 

@@ -31,7 +31,8 @@ change of the limb's v coordinate relative to the top of its person's box;
 ``sigma_s`` (eq. 27, distance to the silhouette) becomes the distance of the limb's
 centre to its person's box (zero inside), half-normal ML ``sqrt(mean d^2)``. Terms
 need the ``person`` rows; without them the defaults stay. Every fitted position or
-size std is floored at :data:`MIN_STD` = 1 px (velocity stds at 0.1 px/frame): corrected boxes are drawn to about a pixel, so smaller
+size std is floored at :data:`MIN_STD` = 1 px (velocity stds at 0.1 px/frame):
+corrected boxes are drawn to about a pixel, so smaller
 values are not measured, and a smooth synthetic path must not give a filter whose
 particles cannot spread.
 """

@@ -17,7 +17,8 @@ def bundle(trained_svms):
     noise = dict(body.part_noise, head=PartNoise(x=1.5, y=1.25, w=1.0, h=1.0, vx=0.3, vy=0.2, lam=20.0))
     from dataclasses import replace
     return Bundle(replace(body, part_noise=noise), replace(LimbParams(), sigma_d=7.5),
-                  SVMFailureDetector(models), {"svms": {n: r.to_dict() for n, r in reports.items()}, "nan": float("nan")})
+                  SVMFailureDetector(models),
+                  {"svms": {n: r.to_dict() for n, r in reports.items()}, "nan": float("nan")})
 
 
 def test_round_trip_gives_identical_decisions(bundle, trained_svms, tmp_path):

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from models.failure_svm import SVMFailureDetector, SVMModel, choose_threshold, report_table
-from models.features import features_from_history, person_histories
+from models.features import person_histories
 
 
 def test_numpy_decision_matches_sklearn():
