@@ -18,6 +18,8 @@ def add_arguments(p) -> None:
     p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
     p.add_argument("--model", metavar="BUNDLE_DIR", help="model bundle (default: the one shipped with partlab)")
     p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
+    p.add_argument("--events", metavar="EVENTS.csv",
+                   help="limbs/all: write the limbs' join and separation events (claps, handshakes, ...)")
     p.add_argument("--occluders", metavar="FILE",
                    help="CSV with columns x,y,w,h: fixed regions (pillars, doors) that can hide people")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
@@ -78,6 +80,7 @@ def run(args) -> int:
             raise CommandError(f"{args.init}: no boxes to start from")
     occluders = read_occluders(args.occluders) if args.occluders else ()
     model = load_model(args.model) if args.model else None
+    events: list = []
     bar = None
 
     def progress(done: int, total: int) -> None:
@@ -88,7 +91,7 @@ def run(args) -> int:
 
     try:
         tracks = track_video(args.video, tracker=args.tracker, init=init, model=model, occluders=occluders,
-                             seed=args.seed, progress=progress if args.progress else None)
+                             seed=args.seed, progress=progress if args.progress else None, events_out=events)
     finally:
         if bar is not None:
             bar.close()
@@ -98,4 +101,11 @@ def run(args) -> int:
         raise CommandError(f"{args.output}: cannot write: {exc}") from None
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
+    if args.events:
+        if args.tracker not in ("limbs", "all"):
+            raise CommandError("--events needs --tracker limbs or all (events are the limbs' joins)")
+        from tracking.limbs import write_events
+
+        write_events(events[0], args.events)
+        print(f"wrote {len(events[0])} event(s) to {args.events}")
     return 0
