@@ -27,7 +27,7 @@ import json
 import math
 import re
 import zipfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import datetime, timezone
 from importlib import resources
 from os import PathLike
@@ -210,14 +210,30 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
     return arrays
 
 
+#: What training fits; a loaded bundle applies these over the installed defaults. The
+#: manifest records every parameter as it was at training time (for the record), but the
+#: hand-set tunables follow the installed partlab, so improving a default never needs every
+#: bundle to be retrained.
+LEARNED_BODY_FIELDS: tuple[str, ...] = ("part_noise", "output_extent")
+LEARNED_LIMB_FIELDS: tuple[str, ...] = ("sigma_v", "sigma_d", "sigma_s")
+
+
+def learned_body_params(saved: BodyParams) -> BodyParams:
+    return replace(BodyParams(), **{k: getattr(saved, k) for k in LEARNED_BODY_FIELDS})
+
+
+def learned_limb_params(saved: LimbParams) -> LimbParams:
+    return replace(LimbParams(), **{k: getattr(saved, k) for k in LEARNED_LIMB_FIELDS})
+
+
 def load_bundle(path: str | PathLike) -> Bundle:
     """Read and verify a bundle written by :func:`save_bundle`."""
     root = Path(path)
     manifest = _read_manifest(root)
     _verify_files(root, manifest)
     try:
-        body = BodyParams.from_dict(manifest["body_params"])
-        limb = LimbParams.from_dict(manifest["limb_params"])
+        body = learned_body_params(BodyParams.from_dict(manifest["body_params"]))
+        limb = learned_limb_params(LimbParams.from_dict(manifest["limb_params"]))
     except (KeyError, TypeError, ValueError) as exc:
         raise BundleError(f"{root / MANIFEST}: bad parameters ({exc})") from None
     detector = None

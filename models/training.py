@@ -21,6 +21,7 @@ colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Callable, Iterable, Iterator
 
 import numpy as np
@@ -102,8 +103,6 @@ def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None
 def _apply_lam(body: BodyParams, table: pd.DataFrame,
                d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
     """Put the ML ``lam`` of every part with enough distances into ``body`` and the table."""
-    from dataclasses import replace
-
     from models.sharpness import fit_lam
     from models.variance import MIN_SAMPLES
 
@@ -142,7 +141,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
     rng = np.random.default_rng(seed)
     step = progress or (lambda _msg: None)
-    xs, ys, truths, clip_info = [], [], [], []
+    xs, ys, truths, clip_info, tracked_runs = [], [], [], [], []
     counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
     if fit_sharpness is None:
         fit_sharpness = sharpness_available()
@@ -155,6 +154,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         if tracker_runner is not None:
             step(f"tracking {name}")
             tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
+            tracked_runs.append((tracked, truth_clean))
             x, y = tracker_samples(tracked, truth_clean, fps, dt)
             xs.append(x), ys.append(y)
             counts["tracker"] += len(x)
@@ -201,6 +201,13 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     body_p, limb_p, table = fit_variances(truths, body, limb)
     if fit_sharpness:
         body_p, table = _apply_lam(body_p, table, d2)
+    if tracked_runs:
+        from models.extent import fit_output_extent
+
+        step("output extent")
+        current = (body or BodyParams()).output_extent
+        body_p = replace(body_p, output_extent=fit_output_extent([t for t, _ in tracked_runs],
+                                                                 [g for _, g in tracked_runs], current))
     detector = SVMFailureDetector(models, dt=dt) if models else None
     summary = {
         "seed": seed,
@@ -210,6 +217,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         "tnr_targets": dict(TNR_TARGETS),
         "thresholds": {n: r.threshold for n, r in reports.items()},
         "variances": table.to_dict(orient="records"),
+        "output_extent": {k: list(v) for k, v in body_p.output_extent.items()},
         "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
     }
     return Bundle(body_p, limb_p, detector, summary)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import importlib
 from pathlib import Path
 
 from app.cli import CommandError
@@ -16,7 +15,10 @@ def add_arguments(p) -> None:
     p.add_argument("--tracker", choices=["body", "limbs", "all", "whole"], default="body",
                    help="body: head/torso/hip-leg; limbs: head and hands; all: both; whole: one box per person")
     p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
-    p.add_argument("--model", metavar="BUNDLE_DIR", help="model bundle (default: the one shipped with partlab)")
+    p.add_argument("--model", metavar="BUNDLE_DIR",
+                   help="model bundle from partlab train, or 'default' for the one shipped with partlab "
+                        "(failure detection and adjustment on); without it: the built-in parameters, no "
+                        "failure detection")
     p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
     p.add_argument("--events", metavar="EVENTS.csv",
                    help="limbs/all: write the limbs' join and separation events (claps, handshakes, ...)")
@@ -54,11 +56,12 @@ def read_occluders(path: str | Path):
 
 
 def load_model(path: str | Path):
+    """A model bundle by directory, or the shipped one by the name ``default``."""
+    from models import bundle
+
     try:
-        bundle = importlib.import_module("models.bundle")
-    except ImportError:
-        raise CommandError("model bundles are not available yet (models.bundle is missing)") from None
-    try:
+        if str(path) == "default" and not Path(path).exists():
+            return bundle.default_bundle()
         return bundle.load_bundle(path)
     except (OSError, ValueError) as exc:
         raise CommandError(f"{path}: cannot load model bundle: {exc}") from None

@@ -80,4 +80,12 @@ def run(args) -> int:
     print(report_table(reports))
     print("\nvariance parameters (fitted vs default; '-' = default kept):")
     print(comparison_table(pd.DataFrame(bundle.summary["variances"])))
+    if "output_extent" in bundle.summary:
+        from models.extent import extent_table
+        from tracking.params import BodyParams
+
+        print("\nreported box extent per part (fitted vs default: scale of the tracked inner rectangle, "
+              "shift in its size):")
+        table = extent_table(bundle.body_params.output_extent, BodyParams().output_extent)
+        print(table.pivot(index="part", columns="term", values="fitted").round(3).to_string())
     return 0

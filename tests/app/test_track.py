@@ -104,3 +104,11 @@ def test_all_trackers_write_one_head_per_person_and_the_events(tmp_path, capsys)
     assert {"head", "torso", "left_hand", "right_hand"} <= set(tracks.part)
     events = pd.read_csv(ev)
     assert (events.kind == "clap").sum() >= 1   # the desk scene claps around frames 40-60 (scaled to 70 frames)
+
+
+def test_model_default_names_the_shipped_bundle(clip, tmp_path):
+    d, path, init = clip
+    out = tmp_path / "t.csv"
+    assert main(["track", str(path), "-o", str(out), "--model", "default", "--init", str(d / "init.csv"),
+                 "--no-progress"]) == 0
+    assert len(pd.read_csv(out)) > 0

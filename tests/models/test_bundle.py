@@ -145,3 +145,23 @@ def test_default_bundle_ships_and_judges_the_body_trackers_output():
     bad[-10:, 1, :2] = bad[-10, 1, :2] + [0.0, -1.2 * bad[-10, 1, 3]]   # torso stuck above the head
     v = b.failure_detector.detect(bad, scene.fps)
     assert v.failed and ("torso" in v.failed or v.multi)
+
+
+def test_a_bundle_applies_what_was_learned_over_the_installed_defaults(tmp_path):
+    """Hand-set tunables follow the installed partlab; fitted ones come from the bundle."""
+    from dataclasses import replace
+
+    from models.bundle import Bundle, load_bundle, save_bundle
+    from tracking.params import BodyParams, LimbParams, PartNoise
+
+    noise = dict(BodyParams().part_noise, head=PartNoise(x=9.0, y=8.0, w=1.0, h=1.0, vx=1.0, vy=1.0, lam=7.0))
+    body = replace(BodyParams(), part_noise=noise, output_extent={"head": (2.0, 2.0, 0.0, 0.0)},
+                   particles_initial=321)
+    limb = replace(LimbParams(), sigma_d=33.0, particles=77)
+    save_bundle(Bundle(body, limb, None, {}), tmp_path / "b")
+    loaded = load_bundle(tmp_path / "b")
+    assert loaded.body_params.part_noise["head"].x == 9.0 and loaded.body_params.part_noise["head"].lam == 7.0
+    assert loaded.body_params.output_extent == {"head": (2.0, 2.0, 0.0, 0.0)}
+    assert loaded.limb_params.sigma_d == 33.0
+    assert loaded.body_params.particles_initial == BodyParams().particles_initial  # not learned
+    assert loaded.limb_params.particles == LimbParams().particles
