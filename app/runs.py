@@ -44,6 +44,29 @@ def _load_model(bundle_path: str | Path | None):
     return bundle.load_bundle(bundle_path)
 
 
+BUILTIN = "built-in parameters"
+SHIPPED = "partlab's shipped bundle"
+
+
+def bundle_choices(store: Store, project) -> dict[str, str | None]:
+    """Model bundles to track with, label -> directory (None: the trackers' built-in
+    parameters); the project's default first, then built-in, the shipped bundle
+    (what ``partlab track --model default`` uses) and the project's other bundles."""
+    bundles = store.bundles(project.id)
+    default = next((b for b in bundles if b.id == project.default_bundle_id), None)
+    out: dict[str, str | None] = {}
+    if default is not None:
+        out[f"{default.name} (project default)"] = str(default.path)
+    out[BUILTIN] = None
+    bundle_mod = optional("models.bundle")
+    if bundle_mod is not None and (bundle_mod.default_bundle_path() / bundle_mod.MANIFEST).is_file():
+        out[SHIPPED] = str(bundle_mod.default_bundle_path())
+    for b in bundles:
+        if b is not default:
+            out[b.name] = str(b.path)
+    return out
+
+
 def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
     """The first human-corrected frame after ``after`` (re-tracking stops there)."""
     later = [f for f in store.human_frames(clip_id) if f > after]

@@ -10,7 +10,7 @@ from app import jobs, state
 from app.box_editor import track_colour
 from app.demo import demo_files
 from app.pages.common import pick_clip, require_project
-from app.runs import first_boxes, missing, optional, start_comparison_run, training_truth
+from app.runs import bundle_choices, first_boxes, missing, optional, start_comparison_run, training_truth
 from tracking.tracks import read_tracks_csv
 
 s = state.store()
@@ -40,8 +40,7 @@ if truth is None:
     st.caption(f"Truth: {truth.frame.nunique()} corrected frames of this clip.")
 
 # ---- two bundles, each tracked fresh (not stored)
-bundles = s.bundles(project.id)
-options = {"built-in parameters": None, **{b.name: b.path for b in bundles}}
+options = bundle_choices(s, project)
 c1, c2, c3 = st.columns(3)
 a = c1.selectbox("Bundle A", list(options), index=0)
 b = c2.selectbox("Bundle B", list(options), index=min(1, len(options) - 1))

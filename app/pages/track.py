@@ -8,7 +8,8 @@ import streamlit as st
 from app import state
 from app.pages.common import job_panel, pick_clip, require_project
 from app.demo import demo_files
-from app.runs import TRACKERS, missing, start_tracking
+from app.runs import TRACKERS, bundle_choices, missing, start_tracking
+from labelling.store import Store
 from tracking.tracks import read_tracks_csv
 
 s = state.store()
@@ -16,20 +17,24 @@ st.title("Track")
 project = require_project(s)
 clip = pick_clip(s, project.id)
 
-bundles = s.bundles(project.id)
-choices = [None] + [b.id for b in bundles]
-names = {None: "built-in parameters", **{b.id: b.name + (" (default)" if b.id == project.default_bundle_id else "")
-                                          for b in bundles}}
-default = choices.index(project.default_bundle_id) if project.default_bundle_id in choices else 0
+choices = bundle_choices(s, project)
+
+
+@st.cache_data(max_entries=32, show_spinner=False)
+def first_frame_with_boxes(url: str, clip_id: int, n_runs: int, n_human: int) -> int | None:
+    """Cached until a run or a correction changes it (reading every box is slow on long clips)."""
+    tracks = Store(url).tracks(clip_id)
+    return int(tracks.frame.min()) if len(tracks) else None
+
 
 lacking = missing("app.pipeline")
 with st.form("track"):
     c1, c2, c3 = st.columns(3)
     tracker = c1.radio("Tracker", TRACKERS, horizontal=True,
                        help="body: head/torso/hip-leg; limbs: head and hands; all: both")
-    bundle_id = c2.selectbox("Model bundle", choices, index=default, format_func=names.get)
+    bundle = c2.selectbox("Model bundle", list(choices))
     seed = c3.number_input("Seed", min_value=0, value=0, step=1)
-    first = int(s.tracks(clip.id).frame.min()) if len(s.tracks(clip.id)) else None
+    first = first_frame_with_boxes(s.url, clip.id, len(s.runs(clip.id)), len(s.human_frames(clip.id)))
     demo_init = demo_files(clip.name).get("init")
     starts = ["detect people automatically"] + ([f"the stored boxes of frame {first}"] if first is not None else []) \
         + (["the synthetic scene's init boxes"] if demo_init else [])
@@ -40,7 +45,7 @@ if lacking:
     st.warning("Tracking is not available yet: the tracker pipeline (app.pipeline) has not landed. "
                "You can import boxes from a tracks CSV below meanwhile.")
 if go:
-    path = next((b.path for b in bundles if b.id == bundle_id), None)
+    path = choices[bundle]
     try:
         from_boxes = start_from == starts[1] if len(starts) > 1 and first is not None else False
         init = read_tracks_csv(demo_init) if start_from == "the synthetic scene's init boxes" else None

@@ -174,9 +174,12 @@ def test_evaluate_page_compares_two_runs_against_the_truth(store, tracked_clip, 
     at.file_uploader[0].upload("truth.csv", boxes.to_csv(index=False).encode(), "text/csv").run()
     [go] = [b for b in at.button if b.label == "Track with both and compare"]
     go.click().run()
-    [job] = jobs.jobs("compare", clip_id=clip.id)  # A and B are the same (built-in): one run
-    jobs.wait(job.id, 120)
-    assert job.status == "done", job.error
+    runs = jobs.jobs("compare", clip_id=clip.id)  # A: built-in parameters, B: the shipped bundle
+    assert {j.meta["bundle"] for j in runs} == {"built-in parameters", "partlab's shipped bundle"}
+    for job in runs:
+        jobs.wait(job.id, 120)
+        assert job.status == "done", job.error
+        assert job.result.frame.min() == 0 and set(job.result.track_id) == {1}  # started from the truth's boxes
     at.run()
     assert not at.exception
     assert len(at.get("plotly_chart")) == 3  # two rate curves and the trajectories
