@@ -147,7 +147,7 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     head = page.locator('rect[data-part="head"][data-track="1"]').first
     head.wait_for()
     page.wait_for_timeout(500)
-    bb = head.bounding_box()
+    bb = _wait_for(head.bounding_box, timeout=15, what="the head box")
     scale = 320 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
     cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
     page.mouse.move(cx, cy)
@@ -195,7 +195,8 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
 
 
 def _drag(page, locator, dx: float, dy: float) -> None:
-    bb = locator.bounding_box()
+    # the editor redraws its boxes when Python sends new data: wait for the box to be there
+    bb = _wait_for(locator.bounding_box, timeout=15, what="the box to drag")
     cx, cy = bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2
     page.mouse.move(cx, cy)
     page.mouse.down()
