@@ -1,7 +1,7 @@
 """Entry script of the Streamlit labelling app: project picker, job list and page navigation.
 
 Run with ``partlab app`` (or ``make run``). Every page is a short script under
-``app/pages/`` that calls library functions; long work runs in :mod:`app.jobs`.
+``app/views/`` that calls library functions; long work runs in :mod:`app.jobs`.
 """
 
 import streamlit as st
@@ -10,7 +10,7 @@ st.set_page_config(page_title="partlab", layout="wide")
 
 from app import jobs, state  # noqa: E402
 from app.demo import ensure_demo  # noqa: E402
-from app.pages.common import bound_widget  # noqa: E402
+from app.views.common import bound_widget  # noqa: E402
 from labelling.config import data_dir  # noqa: E402
 
 
@@ -51,12 +51,12 @@ with st.sidebar:
     st.caption(f"Data: {data_dir()}")
 
 pages = [
-    st.Page("pages/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects",
+    st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects",
             default=True),
-    st.Page("pages/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
-    st.Page("pages/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
-    st.Page("pages/train.py", title="Train", icon=":material/model_training:", url_path="train"),
-    st.Page("pages/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
-    st.Page("pages/export.py", title="Export", icon=":material/download:", url_path="export"),
+    st.Page("views/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
+    st.Page("views/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
+    st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
+    st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
+    st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
 ]
 st.navigation(pages).run()

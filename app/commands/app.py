@@ -30,7 +30,7 @@ def streamlit_command(host: str, port: int) -> list[str]:
     except UploadRefused as exc:
         raise CommandError(str(exc)) from None
     return [
-        sys.executable, "-m", "app.serve", str(PAGE),
+        sys.executable, "-m", "streamlit", "run", str(PAGE),
         "--server.headless", "true",
         "--server.address", host,
         "--server.port", str(port),

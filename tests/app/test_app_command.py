@@ -14,7 +14,7 @@ def _opt(cmd: list[str], name: str) -> str:
 
 def test_upload_limit_and_address(monkeypatch):
     cmd = streamlit_command("127.0.0.1", 8599)
-    assert cmd[1:3] == ["-m", "app.serve"] and cmd[3].endswith("streamlit_app.py")
+    assert cmd[1:4] == ["-m", "streamlit", "run"] and cmd[4].endswith("streamlit_app.py")
     assert (_opt(cmd, "--server.maxUploadSize"), _opt(cmd, "--server.port"), _opt(cmd, "--server.headless")) == \
         ("1024", "8599", "true")
     monkeypatch.setenv("PARTLAB_MAX_UPLOAD_MB", "200")

@@ -13,7 +13,7 @@ from app.runs import missing
 
 from tracking.box import Box
 
-PAGES = Path(__file__).resolve().parents[2] / "app" / "pages"
+PAGES = Path(__file__).resolve().parents[2] / "app" / "views"
 
 
 def page(name: str, **session) -> AppTest:

@@ -6,7 +6,7 @@ import pandas as pd
 import streamlit as st
 
 from app import state
-from app.pages.common import job_panel, pick_clip, require_project
+from app.views.common import job_panel, pick_clip, require_project
 from app.demo import demo_files
 from app.runs import TRACKERS, bundle_choices, missing, start_tracking
 from labelling.store import Store

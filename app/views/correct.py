@@ -12,7 +12,7 @@ import streamlit as st
 from app import state
 from app.box_editor import box_editor, pending_events
 from app.editing import apply_events
-from app.pages.common import bound_widget, job_panel, pick_clip, require_project
+from app.views.common import bound_widget, job_panel, pick_clip, require_project
 from app.runs import missing, next_human_frame, start_tracking
 from labelling.store import Store
 from labelling.video import VideoClip, VideoError

@@ -9,7 +9,7 @@ import streamlit as st
 from app import jobs, state
 from app.box_editor import track_colour
 from app.demo import demo_files
-from app.pages.common import pick_clip, require_project
+from app.views.common import pick_clip, require_project
 from app.runs import bundle_choices, first_boxes, missing, optional, start_comparison_run, training_truth
 from tracking.tracks import read_tracks_csv
 

@@ -5,7 +5,7 @@ import plotly.graph_objects as go
 import streamlit as st
 
 from app import state
-from app.pages.common import job_panel, require_project
+from app.views.common import job_panel, require_project
 from app.runs import missing, start_training
 from labelling.store import StoreError
 

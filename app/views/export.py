@@ -7,7 +7,7 @@ from pathlib import Path
 import streamlit as st
 
 from app import state
-from app.pages.common import require_project
+from app.views.common import require_project
 from app.runs import optional, safe_name
 
 s = state.store()

@@ -7,7 +7,7 @@ import pandas as pd
 import streamlit as st
 
 from app import state
-from app.pages.common import require_project
+from app.views.common import require_project
 from app.runs import clip_state
 from app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
 from labelling.store import StoreError
