@@ -27,6 +27,9 @@ compute it ourselves because motmetrics 1.4's ``iou_matrix`` calls numpy's remov
 
 from __future__ import annotations
 
+import contextlib
+import io
+
 import json
 import math
 from dataclasses import dataclass, field
@@ -323,7 +326,10 @@ def hota_metrics(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame | No
     metadata pins ``opencv-python``, which clashes with our headless OpenCV, so ``make test``
     installs it with ``--no-deps`` (its metrics need only numpy and scipy)."""
     try:
-        from trackeval.metrics import HOTA
+        # TrackEval prints notes about its optional parts to stdout on import; keep them out of
+        # our output (``partlab eval --json`` must print JSON only).
+        with contextlib.redirect_stdout(io.StringIO()):
+            from trackeval.metrics import HOTA
     except Exception:  # not installed, or broken against this numpy
         return None
     metric = HOTA()
