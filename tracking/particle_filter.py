@@ -29,6 +29,7 @@ from tracking.histogram import (
     likelihood,
     update_reference,
 )
+from tracking import kernels
 from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 from tracking.params import BodyParams, PartNoise
 from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
@@ -66,6 +67,9 @@ class PartFilter:
         self.state = box_to_state(box)
         self.state[4:6] = velocity
         self.base_size = np.array([box.w, box.h], dtype=np.float64)
+        lo, hi = self.params.size_range
+        self._size_lo = (lo * self.base_size).astype(np.float32)
+        self._size_hi = (hi * self.base_size).astype(np.float32)
         n = int(n or self.params.particles_initial)
         spread = self._sigma * np.float32(self.params.init_spread)
         self.particles = (self.state.astype(np.float32)
@@ -87,10 +91,9 @@ class PartFilter:
         self.sqrt_target = np.sqrt(per_channel).reshape(-1)
 
     def _clip_sizes(self) -> None:
-        lo, hi = self.params.size_range
         wh = self.particles[:, 2:4]
-        np.maximum(wh, (lo * self.base_size).astype(np.float32), out=wh)
-        np.minimum(wh, (hi * self.base_size).astype(np.float32), out=wh)
+        np.maximum(wh, self._size_lo, out=wh)
+        np.minimum(wh, self._size_hi, out=wh)
 
     # -- one frame --------------------------------------------------------------------
     @property
@@ -110,9 +113,13 @@ class PartFilter:
     def predict(self) -> None:
         """Constant-velocity motion plus process noise (seed 002 sec. 3)."""
         p = self.particles
+        noise = self.rng.standard_normal(p.shape, dtype=np.float32)
+        if kernels.HAVE_NUMBA:
+            kernels.drift(p, noise, self._sigma, self._size_lo, self._size_hi)
+            return
         p[:, 0] += p[:, 4]
         p[:, 1] += p[:, 5]
-        p += self.rng.standard_normal(p.shape, dtype=np.float32) * self._sigma
+        p += noise * self._sigma
         self._clip_sizes()
 
     def predicted_box(self) -> Box:
@@ -131,14 +138,9 @@ class PartFilter:
         body's axis (the torso's centre line) instead of following a look-alike part of
         someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
         relative to the torso near the one it started with."""
-        H, W = ycc.shape[:2]
-        rects = particle_rectangles(self.particles, W, H)
-        stride = self._stride()
-        counts = rectangle_histograms(ycc, self.lut, rects, stride)
-        areas = sampled_areas(rects, stride)
-        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        _, rho, areas = self._similarities(ycc, self.particles)
         weights = likelihood(rho, self.noise.lam)
-        weights[areas * (stride * stride) < 4] = 0.0
+        weights[areas < 4] = 0.0
         if anchor_x is not None and anchor_sigma > 0:
             weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
         if anchor_y is not None and anchor_sigma_y > 0:
@@ -153,16 +155,27 @@ class PartFilter:
         hidden person shows again away from where its dynamics put it."""
         cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
         cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
-        H, W = ycc.shape[:2]
-        rects = particle_rectangles(cand, W, H)
-        stride = self._stride()
-        counts = rectangle_histograms(ycc, self.lut, rects, stride)
-        areas = sampled_areas(rects, stride)
-        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        rects, rho, _ = self._similarities(ycc, cand)
         full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
         rho[full < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
         k = int(np.argmax(rho))
         return cand[k].astype(np.float64), float(rho[k])
+
+    def _similarities(self, ycc: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Rectangles ``(N, 4) int32``, Bhattacharyya coefficients ``(N,)`` with the model and
+        areas ``(N,)`` (pixels, a sampled pixel standing for ``stride**2``) of ``states``: one
+        integral histogram over the region they cover (compiled kernel, or numpy + OpenCV)."""
+        H, W = ycc.shape[:2]
+        stride = self._stride()
+        if kernels.HAVE_NUMBA:
+            rects = kernels.rectangles(states, W, H)
+            rho, areas = kernels.rectangle_rho(ycc, self.mapping, rects, stride, self.sqrt_target)
+        else:
+            rects = particle_rectangles(states, W, H)
+            counts = rectangle_histograms(ycc, self.lut, rects, stride)
+            areas = sampled_areas(rects, stride)
+            rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        return rects, rho, areas * (stride * stride)
 
     def shift(self, delta: np.ndarray) -> None:
         """Move the estimate and every particle by ``delta`` (dx, dy)."""

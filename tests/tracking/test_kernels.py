@@ -1,0 +1,58 @@
+"""The compiled kernels give what the numpy + OpenCV path gives."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tracking import kernels
+from tracking.histogram import bhattacharyya_counts, equalization_map, fused_lut, level_histogram
+from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
+
+pytestmark = pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
+
+
+def _scene(seed=3):
+    rng = np.random.default_rng(seed)
+    ycc = rng.integers(0, 256, (70, 90, 3), dtype=np.uint8)
+    ycc[20:50, 30:60] = (120, 140, 110)  # a flat patch the target's model comes from
+    mapping = equalization_map(level_histogram(ycc[15:55, 25:65]))
+    target = np.bincount((mapping.astype(int) + 8 * np.arange(3)[:, None]).ravel(),
+                         weights=level_histogram(ycc[20:50, 30:60]).ravel(), minlength=24)
+    sqrt_target = np.sqrt(target.reshape(3, 8) / target.reshape(3, 8).sum(1, keepdims=True)).ravel()
+    states = np.column_stack([rng.uniform(-5, 95, 300), rng.uniform(-5, 75, 300), rng.uniform(2, 35, 300),
+                              rng.uniform(2, 35, 300), np.zeros(300), np.zeros(300)]).astype(np.float32)
+    states[:3, :4] = [[44.5, 35.5, 30, 30], [45.5, 34.5, 11, 13], [88, 68, 10, 10]]  # ties round to even
+    return ycc, mapping, sqrt_target, states
+
+
+@pytest.mark.parametrize("stride", [1, 2])
+def test_rectangle_rho_matches_numpy_path(stride):
+    ycc, mapping, sqrt_target, states = _scene()
+    rects = kernels.rectangles(states, 90, 70)
+    assert np.array_equal(rects, particle_rectangles(states, 90, 70))
+    rho, areas = kernels.rectangle_rho(ycc, mapping, rects, stride, sqrt_target)
+    counts = rectangle_histograms(ycc, fused_lut(mapping), rects, stride)
+    expect_areas = sampled_areas(rects, stride)
+    assert np.array_equal(areas, expect_areas)
+    assert rho == pytest.approx(bhattacharyya_counts(counts.astype(np.float64), expect_areas, sqrt_target),
+                                abs=1e-6)  # numpy: float32 areas
+    assert rho[0] == pytest.approx(1.0)  # the flat patch itself matches its model
+    assert rho.min() >= 0.0 and rho[areas > 0].min() < 0.7  # random pixels elsewhere do not
+
+
+def test_level_histogram_box_and_drift_match_numpy():
+    ycc, _, _, states = _scene(5)
+    got = kernels.level_histogram_box(ycc, 10, 5, 40, 33)
+    pixels = ycc[5:33, 10:40].reshape(-1, 3)
+    assert np.array_equal(got, np.stack([np.bincount(pixels[:, c], minlength=256) for c in range(3)]) / len(pixels))
+    assert np.all(kernels.level_histogram_box(ycc, 10, 5, 10, 33) == 1 / 256)  # empty: uniform
+    noise = np.random.default_rng(1).standard_normal(states.shape, dtype=np.float32)
+    sigma = np.array([4, 3, 1, 1, 1, 0.5], np.float32)
+    lo, hi = np.array([5, 6], np.float32), np.array([20, 21], np.float32)
+    expect = states.copy()
+    expect[:, 0:2] += expect[:, 4:6]
+    expect += noise * sigma
+    expect[:, 2:4] = np.minimum(np.maximum(expect[:, 2:4], lo), hi)
+    kernels.drift(states, noise, sigma, lo, hi)
+    assert np.array_equal(states, expect)
