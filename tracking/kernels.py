@@ -148,3 +148,114 @@ def drift(particles, noise, sigma, lo, hi):
         for k in range(2):
             v = particles[i, 2 + k]
             particles[i, 2 + k] = min(max(v, lo[k]), hi[k])
+
+
+@_jit
+def weigh(particles, rho, areas, lam, anchor_x, sigma_x, anchor_y, sigma_y):
+    """Normalised particle weights ``(N,) float64`` and their weighted-mean state ``(6,)``.
+
+    ``exp(-lam (1 - rho))`` (Nummiaro et al.), zero for rectangles of fewer than 4 pixels,
+    times ``exp(-0.5 ((X - anchor_x) / sigma_x)^2)`` if ``sigma_x > 0`` (and likewise for
+    Y); all-zero weights become uniform (as :func:`tracking.resampling.normalise_weights`).
+    """
+    n = particles.shape[0]
+    w = np.empty(n, dtype=np.float64)
+    total = 0.0
+    for i in range(n):
+        v = 0.0
+        if areas[i] >= 4:
+            v = np.exp(-lam * max(1.0 - rho[i], 0.0))
+            if sigma_x > 0:
+                v *= np.exp(-0.5 * ((particles[i, 0] - anchor_x) / sigma_x) ** 2)
+            if sigma_y > 0:
+                v *= np.exp(-0.5 * ((particles[i, 1] - anchor_y) / sigma_y) ** 2)
+            if not np.isfinite(v) or v < 0:
+                v = 0.0
+        w[i] = v
+        total += v
+    if total > 0:
+        w /= total
+    else:
+        w[:] = 1.0 / max(n, 1)
+    state = np.zeros(particles.shape[1], dtype=np.float64)
+    for i in range(n):
+        for k in range(particles.shape[1]):
+            state[k] += w[i] * particles[i, k]
+    return w, state
+
+
+@_jit
+def similarity(levels, mapping, sqrt_target):
+    """Bhattacharyya coefficient of a 256-level histogram ``levels (3, 256)`` binned by
+    ``mapping`` with the target (``sqrt_target``, per-channel normalised): the mean over the
+    three channels, as :func:`tracking.histogram.bhattacharyya`."""
+    bins = sqrt_target.shape[0] // 3
+    q = np.zeros((3, bins), dtype=np.float64)
+    for c in range(3):
+        for level in range(256):
+            q[c, mapping[c, level]] += levels[c, level]
+    rho = 0.0
+    for c in range(3):
+        total = max(q[c].sum(), 1e-12)
+        for b in range(bins):
+            rho += np.sqrt(q[c, b] / total) * sqrt_target[c * bins + b]
+    return rho / 3.0
+
+
+@_jit
+def equalize(smoothed, reference, bins, floor):
+    """The equalization map of a (smoothed) reference, sec. 3.1, and the binned target.
+
+    ``smoothed (3, 256)``: the reference after Gaussian smoothing; returns ``mapping (3,
+    256) uint8`` (level -> ``floor(bins * F(level))``, ``F`` the mid-point cumulative
+    distribution of the smoothed reference mixed with a uniform ``floor`` share), the
+    ``reference`` binned by it ``(3 * bins,)`` and the square root of that target
+    normalised per channel (as :func:`tracking.histogram.equalization_map`)."""
+    mapping = np.empty((3, 256), dtype=np.uint8)
+    target = np.zeros(3 * bins, dtype=np.float64)
+    for c in range(3):
+        total = max(smoothed[c].sum(), 1e-12)
+        cum = 0.0
+        for level in range(256):
+            p = (1.0 - floor) * (smoothed[c, level] / total) + floor / 256
+            cum += p
+            b = int(np.floor((cum - 0.5 * p) * bins))
+            b = min(max(b, 0), bins - 1)
+            mapping[c, level] = b
+            target[c * bins + b] += reference[c, level]
+    sqrt_target = np.empty(3 * bins, dtype=np.float64)
+    for c in range(3):
+        total = max(target[c * bins:(c + 1) * bins].sum(), 1e-12)
+        for b in range(bins):
+            sqrt_target[c * bins + b] = np.sqrt(target[c * bins + b] / total)
+    return mapping, target, sqrt_target
+
+
+@_jit
+def systematic_indices(weights, n, u):
+    """Systematic resampling (as :func:`tracking.resampling.systematic_resample`) of
+    normalised ``weights`` with the uniform offset ``u``: ``n`` indexes ``(n,) int64``."""
+    m = weights.shape[0]
+    out = np.empty(n, dtype=np.int64)
+    cum = weights[0]
+    j = 0
+    for i in range(n):
+        pos = (u + i) / n
+        while j < m - 1 and cum <= pos:
+            j += 1
+            cum += weights[j]
+        out[i] = j
+    return out
+
+
+@_jit
+def entropy_count(weights, c, lo, hi):
+    """Seed 002 eq. (2) for normalised ``weights``: ``C N H(w) / log N`` rounded, in [lo, hi]."""
+    n = weights.shape[0]
+    if n <= 1:
+        return lo
+    h = 0.0
+    for i in range(n):
+        if weights[i] > 0:
+            h -= weights[i] * np.log(weights[i])
+    return int(min(max(np.rint(c * n * h / np.log(n)), lo), hi))

@@ -20,6 +20,7 @@ import numpy as np
 
 from tracking.box import Box
 from tracking.histogram import (
+    _smooth,
     binned_histogram,
     bhattacharyya,
     bhattacharyya_counts,
@@ -82,6 +83,11 @@ class PartFilter:
 
     def _refresh_map(self) -> None:
         p = self.params
+        if kernels.HAVE_NUMBA:
+            smoothed = _smooth(np.asarray(self.reference, dtype=np.float64), p.equalization_smoothing)
+            self.mapping, self.target, self.sqrt_target = kernels.equalize(
+                smoothed, self.reference, p.bins_per_channel, p.equalization_floor)
+            return
         self.mapping = equalization_map(self.reference, p.bins_per_channel, p.equalization_smoothing,
                                         p.equalization_floor)
         self.lut = fused_lut(self.mapping, p.bins_per_channel)
@@ -139,6 +145,12 @@ class PartFilter:
         someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
         relative to the torso near the one it started with."""
         _, rho, areas = self._similarities(ycc, self.particles)
+        if kernels.HAVE_NUMBA:
+            ax, sx = (float(anchor_x), float(anchor_sigma)) if anchor_x is not None else (0.0, 0.0)
+            ay, sy = (float(anchor_y), float(anchor_sigma_y)) if anchor_y is not None else (0.0, 0.0)
+            self.weights, self.state = kernels.weigh(self.particles, rho, areas, float(self.noise.lam),
+                                                     ax, sx, ay, sy)
+            return
         weights = likelihood(rho, self.noise.lam)
         weights[areas < 4] = 0.0
         if anchor_x is not None and anchor_sigma > 0:
@@ -208,6 +220,8 @@ class PartFilter:
 
     def score(self, observed: np.ndarray) -> float:
         """Bhattacharyya coefficient of a 256-level histogram with this part's model."""
+        if kernels.HAVE_NUMBA:
+            return float(kernels.similarity(observed, self.mapping, self.sqrt_target))
         b = self.params.bins_per_channel
         return float(bhattacharyya(binned_histogram(observed, self.mapping, b), self.target, b))
 
@@ -219,8 +233,12 @@ class PartFilter:
     def resample(self) -> None:
         """Systematic resampling to the entropy-adaptive count of seed 002 eq. (2)."""
         p = self.params
-        n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
-        idx = systematic_resample(self.weights, n, self.rng)
+        if kernels.HAVE_NUMBA:  # the weights are normalised (measure, coast, reseed)
+            n = kernels.entropy_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
+            idx = kernels.systematic_indices(self.weights, n, self.rng.random())
+        else:
+            n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
+            idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)
 

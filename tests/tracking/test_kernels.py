@@ -56,3 +56,33 @@ def test_level_histogram_box_and_drift_match_numpy():
     expect[:, 2:4] = np.minimum(np.maximum(expect[:, 2:4], lo), hi)
     kernels.drift(states, noise, sigma, lo, hi)
     assert np.array_equal(states, expect)
+
+
+def test_weigh_equalize_similarity_resampling_match_numpy():
+    from tracking.histogram import bhattacharyya, binned_histogram, likelihood
+    from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
+
+    ycc, mapping, sqrt_target, states = _scene(7)
+    rects = kernels.rectangles(states, 90, 70)
+    rho, areas = kernels.rectangle_rho(ycc, mapping, rects, 1, sqrt_target)
+    w, state = kernels.weigh(states, rho, areas, 20.0, 45.0, 6.0, 0.0, 0.0)
+    expect = likelihood(rho, 20.0) * np.exp(-0.5 * ((states[:, 0] - np.float64(45.0)) / 6.0) ** 2)
+    expect = normalise_weights(np.where(areas < 4, 0.0, expect))
+    assert w == pytest.approx(expect, rel=1e-9, abs=1e-15)
+    assert state == pytest.approx((expect[:, None] * states).sum(0), rel=1e-9)
+    assert np.all(kernels.weigh(states, rho, np.zeros(300), 20.0, 0.0, 0.0, 0.0, 0.0)[0] == 1 / 300)
+
+    ref = level_histogram(ycc[15:55, 25:65])
+    m, target, st = kernels.equalize(ref, ref, 8, 0.05)
+    expect_map = equalization_map(ref, 8, smoothing=0.0, floor=0.05)
+    assert np.array_equal(m, expect_map)
+    assert target == pytest.approx(binned_histogram(ref, expect_map))
+    observed = level_histogram(ycc[0:20, 0:20])
+    assert kernels.similarity(observed, m, st) == pytest.approx(
+        bhattacharyya(binned_histogram(observed, m), target), rel=1e-12)
+
+    n = kernels.entropy_count(w, 1.2, 200, 1000)
+    assert n == adaptive_particle_count(w, 1.2, 200, 1000)
+    assert kernels.entropy_count(np.full(300, 1 / 300), 1.2, 200, 1000) == 360  # uniform: C N
+    idx = kernels.systematic_indices(w, n, np.random.default_rng(9).random())
+    assert np.array_equal(idx, systematic_resample(w, n, np.random.default_rng(9)))
