@@ -25,8 +25,11 @@ except ImportError:  # pragma: no cover - numba is a dependency; numpy fallback
 HAVE_NUMBA = numba is not None
 
 
-def _jit(fn):
-    return numba.njit(cache=True, nogil=True)(fn) if HAVE_NUMBA else fn
+def _jit(fn=None, **options):
+    """``numba.njit`` with an on-disk cache (the function itself without numba)."""
+    if fn is None:
+        return lambda f: _jit(f, **options)
+    return numba.njit(cache=True, nogil=True, **options)(fn) if HAVE_NUMBA else fn
 
 
 @_jit
@@ -57,7 +60,7 @@ def _grid(v, r0, stride):
     return -((r0 - v) // stride)
 
 
-@_jit
+@_jit(fastmath=True)  # lets the 24-bin sum of square roots vectorise (rho changes by ~1e-16)
 def rectangle_rho(ycc, mapping, rects, stride, sqrt_target):
     """Bhattacharyya coefficients ``(N,) float64`` and sampled areas ``(N,) float64`` of the
     rectangles ``rects (N, 4) int32 [x1, y1, x2, y2]`` (clipped to the image) of the YCrCb
@@ -92,14 +95,16 @@ def rectangle_rho(ycc, mapping, rects, stride, sqrt_target):
     for yy in range(h):
         y = ry1 + yy * stride
         row[:] = 0
-        integral[yy + 1, 0, :] = 0
+        prev = integral[yy]
+        cur = integral[yy + 1]
+        cur[0, :] = 0
         for xx in range(w):
             x = rx1 + xx * stride
             row[mapping[0, ycc[y, x, 0]]] += 1
             row[bins + mapping[1, ycc[y, x, 1]]] += 1
             row[2 * bins + mapping[2, ycc[y, x, 2]]] += 1
             for b in range(nb):
-                integral[yy + 1, xx + 1, b] = integral[yy, xx + 1, b] + row[b]
+                cur[xx + 1, b] = prev[xx + 1, b] + row[b]
     for i in range(n):
         x1 = _grid(rects[i, 0], rx1, stride)
         y1 = _grid(rects[i, 1], ry1, stride)
@@ -110,9 +115,8 @@ def rectangle_rho(ycc, mapping, rects, stride, sqrt_target):
         area = float((x2 - x1) * (y2 - y1))
         s = 0.0
         for b in range(nb):
-            c = (integral[y2, x2, b] - integral[y1, x2, b] - integral[y2, x1, b] + integral[y1, x1, b])
-            if c > 0:
-                s += np.sqrt(float(c)) * sqrt_target[b]
+            c = integral[y2, x2, b] - integral[y1, x2, b] - integral[y2, x1, b] + integral[y1, x1, b]
+            s += np.sqrt(float(c)) * sqrt_target[b]
         rho[i] = s / (3.0 * np.sqrt(area))
         areas[i] = area
     return rho, areas
@@ -259,3 +263,50 @@ def entropy_count(weights, c, lo, hi):
         if weights[i] > 0:
             h -= weights[i] * np.log(weights[i])
     return int(min(max(np.rint(c * n * h / np.log(n)), lo), hi))
+
+
+@_jit
+def ycc_tiles(bgr, out, done, tile, x1, y1, x2, y2):
+    """Convert to YCrCb (into ``out``) the ``tile`` x ``tile`` tiles of ``bgr (H, W, 3) uint8``
+    that meet ``[x1, x2) x [y1, y2)`` and are not ``done`` yet, then mark them done.
+
+    OpenCV's fixed-point BGR -> YCrCb (14-bit coefficients), the same values as
+    ``cv2.cvtColor(..., COLOR_BGR2YCrCb)`` for every 8-bit colour (checked on all 2^24).
+    """
+    H, W = bgr.shape[0], bgr.shape[1]
+    x1, y1 = max(x1, 0), max(y1, 0)
+    x2, y2 = min(x2, W), min(y2, H)
+    if x2 <= x1 or y2 <= y1:
+        return
+    half = 1 << 13
+    delta = (128 << 14) + half
+    for ty in range(y1 // tile, (y2 - 1) // tile + 1):
+        for tx in range(x1 // tile, (x2 - 1) // tile + 1):
+            if done[ty, tx]:
+                continue
+            done[ty, tx] = True
+            for y in range(ty * tile, min((ty + 1) * tile, H)):
+                for x in range(tx * tile, min((tx + 1) * tile, W)):
+                    b = np.int32(bgr[y, x, 0])
+                    g = np.int32(bgr[y, x, 1])
+                    r = np.int32(bgr[y, x, 2])
+                    lum = (r * 4899 + g * 9617 + b * 1868 + half) >> 14
+                    cr = ((r - lum) * 11682 + delta) >> 14
+                    cb = ((b - lum) * 9241 + delta) >> 14
+                    out[y, x, 0] = min(max(lum, 0), 255)
+                    out[y, x, 1] = min(max(cr, 0), 255)
+                    out[y, x, 2] = min(max(cb, 0), 255)
+
+
+@_jit
+def rects_bounds(rects):
+    """Union ``(x1, y1, x2, y2)`` of rectangles ``(N, 4) [x1, y1, x2, y2]`` (zeros if none)."""
+    if rects.shape[0] == 0:
+        return 0, 0, 0, 0
+    x1, y1, x2, y2 = rects[0, 0], rects[0, 1], rects[0, 2], rects[0, 3]
+    for i in range(1, rects.shape[0]):
+        x1 = min(x1, rects[i, 0])
+        y1 = min(y1, rects[i, 1])
+        x2 = max(x2, rects[i, 2])
+        y2 = max(y2, rects[i, 3])
+    return x1, y1, x2, y2

@@ -31,6 +31,7 @@ from tracking.histogram import (
     update_reference,
 )
 from tracking import kernels
+from tracking.lazy_ycc import as_array, cover, cover_rects
 from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 from tracking.params import BodyParams, PartNoise
 from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
@@ -77,7 +78,7 @@ class PartFilter:
                           + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
         self._clip_sizes()
         self.weights = np.full(n, 1.0 / n)
-        self.reference = level_histogram(ycc, _int_box(box))
+        self.reference = _box_histogram(ycc, box)
         self._refresh_map()
         self.similarity = 1.0
 
@@ -181,10 +182,11 @@ class PartFilter:
         stride = self._stride()
         if kernels.HAVE_NUMBA:
             rects = kernels.rectangles(states, W, H)
-            rho, areas = kernels.rectangle_rho(ycc, self.mapping, rects, stride, self.sqrt_target)
+            pixels = cover_rects(ycc, rects)
+            rho, areas = kernels.rectangle_rho(pixels, self.mapping, rects, stride, self.sqrt_target)
         else:
             rects = particle_rectangles(states, W, H)
-            counts = rectangle_histograms(ycc, self.lut, rects, stride)
+            counts = rectangle_histograms(as_array(ycc), self.lut, rects, stride)
             areas = sampled_areas(rects, stride)
             rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
         return rects, rho, areas * (stride * stride)
@@ -216,7 +218,7 @@ class PartFilter:
 
     def appearance(self, ycc: np.ndarray) -> np.ndarray:
         """``Q_t``: the 256-level histogram ``(3, 256)`` of the current estimate's rectangle."""
-        return level_histogram(ycc, _int_box(self.box))
+        return _box_histogram(ycc, self.box)
 
     def score(self, observed: np.ndarray) -> float:
         """Bhattacharyya coefficient of a 256-level histogram with this part's model."""
@@ -241,6 +243,13 @@ class PartFilter:
             idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)
+
+
+def _box_histogram(ycc, box: Box) -> np.ndarray:
+    """256-level histogram ``(3, 256)`` of ``box`` (rounded to whole pixels) in ``ycc`` (an
+    array or a :class:`tracking.lazy_ycc.LazyYcc`)."""
+    x, y, w, h = _int_box(box)
+    return level_histogram(cover(ycc, x, y, x + w, y + h), (x, y, w, h))
 
 
 def _int_box(box: Box) -> tuple[int, int, int, int]:
