@@ -265,19 +265,26 @@ def entropy_count(weights, c, lo, hi):
     return int(min(max(np.rint(c * n * h / np.log(n)), lo), hi))
 
 
-@_jit
+@_jit(fastmath=True)
 def ycc_tiles(bgr, out, done, tile, x1, y1, x2, y2):
     """Convert to YCrCb (into ``out``) the ``tile`` x ``tile`` tiles of ``bgr (H, W, 3) uint8``
     that meet ``[x1, x2) x [y1, y2)`` and are not ``done`` yet, then mark them done.
 
     OpenCV's fixed-point BGR -> YCrCb (14-bit coefficients), the same values as
     ``cv2.cvtColor(..., COLOR_BGR2YCrCb)`` for every 8-bit colour (checked on all 2^24).
+    Each tile row is split into planes first so that the arithmetic vectorises.
     """
     H, W = bgr.shape[0], bgr.shape[1]
     x1, y1 = max(x1, 0), max(y1, 0)
     x2, y2 = min(x2, W), min(y2, H)
     if x2 <= x1 or y2 <= y1:
         return
+    b = np.empty(tile, dtype=np.int32)
+    g = np.empty(tile, dtype=np.int32)
+    r = np.empty(tile, dtype=np.int32)
+    lum = np.empty(tile, dtype=np.int32)
+    cr = np.empty(tile, dtype=np.int32)
+    cb = np.empty(tile, dtype=np.int32)
     half = 1 << 13
     delta = (128 << 14) + half
     for ty in range(y1 // tile, (y2 - 1) // tile + 1):
@@ -285,17 +292,24 @@ def ycc_tiles(bgr, out, done, tile, x1, y1, x2, y2):
             if done[ty, tx]:
                 continue
             done[ty, tx] = True
+            xs, xe = tx * tile, min((tx + 1) * tile, W)
+            n = xe - xs
             for y in range(ty * tile, min((ty + 1) * tile, H)):
-                for x in range(tx * tile, min((tx + 1) * tile, W)):
-                    b = np.int32(bgr[y, x, 0])
-                    g = np.int32(bgr[y, x, 1])
-                    r = np.int32(bgr[y, x, 2])
-                    lum = (r * 4899 + g * 9617 + b * 1868 + half) >> 14
-                    cr = ((r - lum) * 11682 + delta) >> 14
-                    cb = ((b - lum) * 9241 + delta) >> 14
-                    out[y, x, 0] = min(max(lum, 0), 255)
-                    out[y, x, 1] = min(max(cr, 0), 255)
-                    out[y, x, 2] = min(max(cb, 0), 255)
+                src = bgr[y, xs:xe]
+                for i in range(n):
+                    b[i] = src[i, 0]
+                    g[i] = src[i, 1]
+                    r[i] = src[i, 2]
+                for i in range(n):
+                    v = (r[i] * 4899 + g[i] * 9617 + b[i] * 1868 + half) >> 14
+                    lum[i] = v
+                    cr[i] = min(max(((r[i] - v) * 11682 + delta) >> 14, 0), 255)
+                    cb[i] = min(max(((b[i] - v) * 9241 + delta) >> 14, 0), 255)
+                dst = out[y, xs:xe]
+                for i in range(n):
+                    dst[i, 0] = lum[i]
+                    dst[i, 1] = cr[i]
+                    dst[i, 2] = cb[i]
 
 
 @_jit
