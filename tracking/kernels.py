@@ -324,3 +324,58 @@ def rects_bounds(rects):
         x2 = max(x2, rects[i, 2])
         y2 = max(y2, rects[i, 3])
     return x1, y1, x2, y2
+
+
+@_jit
+def scatter(particles, state, noise, sigma, lo, hi):
+    """Every particle reset to ``state (6,) float32`` plus ``noise * sigma``, W and H clipped to
+    ``[lo, hi]``, in place (a part that coasts on its dynamics, sec. 4.3)."""
+    for i in range(particles.shape[0]):
+        for k in range(6):
+            particles[i, k] = state[k] + noise[i, k] * sigma[k]
+        for k in range(2):
+            particles[i, 2 + k] = min(max(particles[i, 2 + k], lo[k]), hi[k])
+
+
+# Acklam's rational approximation of the standard normal quantile (relative error < 1.2e-9).
+_A = (-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02, 1.383577518672690e+02,
+      -3.066479806614716e+01, 2.506628277459239e+00)
+_B = (-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02, 6.680131188771972e+01,
+      -1.328068155288572e+01)
+_C = (-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00, -2.549732539343734e+00,
+      4.374664141464968e+00, 2.938163982698783e+00)
+_D = (7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00, 3.754408661907416e+00)
+
+
+@_jit(fastmath=True)
+def _uniform_to_normal(u):
+    """In place: uniforms ``u`` (float32 in [0, 1)) -> standard normals by the inverse CDF."""
+    a0, a1, a2, a3, a4, a5 = _A
+    b0, b1, b2, b3, b4 = _B
+    c0, c1, c2, c3, c4, c5 = _C
+    d0, d1, d2, d3 = _D
+    flat = u.reshape(-1)
+    for i in range(flat.size):
+        p = np.float64(flat[i]) + 0.5 / 16777216.0  # centre of the float32 grid step: inside (0, 1)
+        if p < 0.02425 or p > 0.97575:
+            q = np.sqrt(-2.0 * np.log(min(p, 1.0 - p)))
+            x = (((((c0 * q + c1) * q + c2) * q + c3) * q + c4) * q + c5) / ((((d0 * q + d1) * q + d2) * q + d3) * q + 1.0)
+            if p > 0.5:
+                x = -x
+        else:
+            q = p - 0.5
+            r = q * q
+            x = ((((((a0 * r + a1) * r + a2) * r + a3) * r + a4) * r + a5) * q
+                 / (((((b0 * r + b1) * r + b2) * r + b3) * r + b4) * r + 1.0))
+        flat[i] = x
+
+
+def standard_normal(rng: np.random.Generator, shape) -> np.ndarray:
+    """Standard normal ``float32`` samples of ``shape`` from ``rng``: uniforms through the
+    inverse normal CDF (about twice as fast as ``rng.standard_normal`` for the particle
+    filters' noise; ``rng.standard_normal`` itself without numba)."""
+    if not HAVE_NUMBA:
+        return rng.standard_normal(shape, dtype=np.float32)
+    u = rng.random(shape, dtype=np.float32)
+    _uniform_to_normal(u)
+    return u

@@ -120,7 +120,7 @@ class PartFilter:
     def predict(self) -> None:
         """Constant-velocity motion plus process noise (seed 002 sec. 3)."""
         p = self.particles
-        noise = self.rng.standard_normal(p.shape, dtype=np.float32)
+        noise = kernels.standard_normal(self.rng, p.shape)
         if kernels.HAVE_NUMBA:
             kernels.drift(p, noise, self._sigma, self._size_lo, self._size_hi)
             return
@@ -205,9 +205,14 @@ class PartFilter:
         """Dynamics only (occlusion, sec. 4.3.1-4.3.2): the estimate moves by its velocity and
         the particles are re-centred on it, so the cloud does not drift or spread."""
         self.state[0:2] += self.state[4:6]
-        self.particles[:, :] = self.state.astype(np.float32)
-        self.particles += self.rng.standard_normal(self.particles.shape, dtype=np.float32) * self._sigma
-        self._clip_sizes()
+        noise = kernels.standard_normal(self.rng, self.particles.shape)
+        if kernels.HAVE_NUMBA:
+            kernels.scatter(self.particles, self.state.astype(np.float32), noise, self._sigma, self._size_lo,
+                            self._size_hi)
+        else:
+            self.particles[:, :] = self.state.astype(np.float32)
+            self.particles += noise * self._sigma
+            self._clip_sizes()
         self.weights = np.full(self.n, 1.0 / self.n)
 
     def set_velocity(self, velocity: np.ndarray) -> None:

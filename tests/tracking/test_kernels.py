@@ -86,3 +86,30 @@ def test_weigh_equalize_similarity_resampling_match_numpy():
     assert kernels.entropy_count(np.full(300, 1 / 300), 1.2, 200, 1000) == 360  # uniform: C N
     idx = kernels.systematic_indices(w, n, np.random.default_rng(9).random())
     assert np.array_equal(idx, systematic_resample(w, n, np.random.default_rng(9)))
+
+
+def test_standard_normal_is_standard_normal_and_seeded():
+    from scipy import stats
+
+    z = kernels.standard_normal(np.random.default_rng(0), (20000, 6))
+    assert z.dtype == np.float32 and z.shape == (20000, 6)
+    assert abs(z.mean()) < 0.01 and abs(z.std() - 1) < 0.01
+    assert stats.kstest(z.ravel(), "norm").pvalue > 0.01
+    assert 0.002 < (np.abs(z) > 3).mean() < 0.0035  # the tails are there (2 x 0.00135)
+    assert np.array_equal(z, kernels.standard_normal(np.random.default_rng(0), (20000, 6)))
+    ppf = stats.norm.ppf([0.001, 0.01, 0.3, 0.5, 0.9, 0.99])
+    u = np.array([0.001, 0.01, 0.3, 0.5, 0.9, 0.99], np.float32) - np.float32(0.5 / 2**24)
+    kernels._uniform_to_normal(u)
+    assert u == pytest.approx(ppf, abs=1e-5)
+
+
+def test_scatter_matches_numpy():
+    states = np.zeros((50, 6), np.float32)
+    state = np.array([10, 20, 8, 9, 1, -1], np.float32)
+    noise = np.random.default_rng(2).standard_normal((50, 6), dtype=np.float32)
+    sigma = np.array([4, 3, 1, 1, 1, 0.5], np.float32)
+    lo, hi = np.array([7.5, 8], np.float32), np.array([8.5, 10], np.float32)
+    kernels.scatter(states, state, noise, sigma, lo, hi)
+    expect = state + noise * sigma
+    expect[:, 2:4] = np.minimum(np.maximum(expect[:, 2:4], lo), hi)
+    assert np.array_equal(states, expect)
