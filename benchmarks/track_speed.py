@@ -151,7 +151,8 @@ def main() -> None:
             path = write_video(Path(tmp) / f"walkers{n}.mp4", scene.frames, scene.fps)
             frames = [f for _, f in VideoClip(path).frames()]
             init = scene.init[scene.init.part.isin(["person", "head", "torso", "hipleg"])]
-            dec, bg, tr, people = repeated(a.repeat, lambda: decode_ms(path), lambda: body_ms(frames, init, a.particles))
+            dec, bg, tr, people = repeated(a.repeat, lambda: decode_ms(path),
+                                           lambda: body_ms(frames, init, a.particles))
             mil = mil_ms(frames, init, a.mil_frames)
             rows.append(row(f"synthetic, {n} walker(s)", "720x480", people, dec, bg, tr, mil))
     if not a.skip_pets and a.pets_video.exists():

@@ -359,7 +359,8 @@ def _uniform_to_normal(u):
         p = np.float64(flat[i]) + 0.5 / 16777216.0  # centre of the float32 grid step: inside (0, 1)
         if p < 0.02425 or p > 0.97575:
             q = np.sqrt(-2.0 * np.log(min(p, 1.0 - p)))
-            x = (((((c0 * q + c1) * q + c2) * q + c3) * q + c4) * q + c5) / ((((d0 * q + d1) * q + d2) * q + d3) * q + 1.0)
+            x = ((((((c0 * q + c1) * q + c2) * q + c3) * q + c4) * q + c5)
+                 / ((((d0 * q + d1) * q + d2) * q + d3) * q + 1.0))
             if p > 0.5:
                 x = -x
         else:

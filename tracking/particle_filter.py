@@ -9,6 +9,10 @@ coefficient ``rho`` between a particle's equalized histogram and the target's
 (sec. 3.1); the estimate is the weighted mean; particles are then resampled
 systematically to the count of eq. (2) (entropy-adaptive, C = 1.2, 200..1000).
 
+The per-particle work runs in compiled kernels (``tracking.kernels``, numba; the numpy +
+OpenCV path remains when numba is missing); ``ycc`` is an array or a
+``tracking.lazy_ycc.LazyYcc`` converted only where the particles are.
+
 A frame is ``predict()`` then ``measure(ycc)`` (or ``coast()`` when the part is
 occluded: dynamics only, appearance frozen, sec. 4.3), then ``update_model(ycc)`` and
 ``resample()``.
@@ -18,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tracking import kernels
 from tracking.box import Box
 from tracking.histogram import (
     _smooth,
@@ -30,9 +35,8 @@ from tracking.histogram import (
     likelihood,
     update_reference,
 )
-from tracking import kernels
-from tracking.lazy_ycc import as_array, cover, cover_rects
 from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
+from tracking.lazy_ycc import as_array, cover, cover_rects
 from tracking.params import BodyParams, PartNoise
 from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
 
