@@ -285,7 +285,7 @@ class BodyTracker:
                 person.occluded_by = None
                 person.occluded_frames = 0
         hidden = []
-        for name, f in person.filters.items():
+        for name, f in person.filters.items() if self.occluders else ():
             b = f.predicted_box()
             if any(_overlap_fraction(b, o) >= self.params.occluder_overlap for o in self.occluders):
                 hidden.append(name)
