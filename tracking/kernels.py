@@ -380,3 +380,15 @@ def standard_normal(rng: np.random.Generator, shape) -> np.ndarray:
     u = rng.random(shape, dtype=np.float32)
     _uniform_to_normal(u)
     return u
+
+
+@_jit
+def resample(particles, weights, c, lo, hi, u):
+    """Seed 002 eq. (2) count, then systematic resampling with offset ``u``: the new particles
+    ``(n, 6)`` and their uniform weights ``(n,)`` (one call for the two steps above)."""
+    n = entropy_count(weights, c, lo, hi)
+    idx = systematic_indices(weights, n, u)
+    out = np.empty((n, particles.shape[1]), dtype=particles.dtype)
+    for i in range(n):
+        out[i, :] = particles[idx[i], :]
+    return out, np.full(n, 1.0 / n)

@@ -245,11 +245,11 @@ class PartFilter:
         """Systematic resampling to the entropy-adaptive count of seed 002 eq. (2)."""
         p = self.params
         if kernels.HAVE_NUMBA:  # the weights are normalised (measure, coast, reseed)
-            n = kernels.entropy_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
-            idx = kernels.systematic_indices(self.weights, n, self.rng.random())
-        else:
-            n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
-            idx = systematic_resample(self.weights, n, self.rng)
+            self.particles, self.weights = kernels.resample(self.particles, self.weights, p.particles_c,
+                                                            p.particles_min, p.particles_max, self.rng.random())
+            return
+        n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
+        idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)
 

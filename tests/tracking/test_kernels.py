@@ -113,3 +113,15 @@ def test_scatter_matches_numpy():
     expect = state + noise * sigma
     expect[:, 2:4] = np.minimum(np.maximum(expect[:, 2:4], lo), hi)
     assert np.array_equal(states, expect)
+
+
+def test_fused_resample_matches_the_two_steps():
+    rng = np.random.default_rng(11)
+    particles = rng.normal(0, 5, (300, 6)).astype(np.float32)
+    w = rng.random(300) ** 8
+    w /= w.sum()
+    new, weights = kernels.resample(particles, w, 1.2, 200, 1000, 0.37)
+    n = kernels.entropy_count(w, 1.2, 200, 1000)
+    assert len(new) == n and 200 <= n < 360  # peaked weights: fewer than C N
+    assert np.array_equal(new, particles[kernels.systematic_indices(w, n, 0.37)])
+    assert np.all(weights == 1.0 / n)
