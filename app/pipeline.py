@@ -49,13 +49,15 @@ def _split_model(model) -> tuple[BodyParams, LimbParams, object]:
 def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.DataFrame | None = None,
                 model=None, occluders=(), seed: int = 0,
                 progress: Callable[[int, int], None] | None = None, failure_detector=None,
-                start: int = 0, stop: int | None = None) -> pd.DataFrame:
+                start: int = 0, stop: int | None = None, events_out: list | None = None) -> pd.DataFrame:
     """Track ``video_path`` and return the tracks table (frame indexes of the whole clip).
 
     ``tracker``: body (head/torso/hip-leg + person MBR), whole (one box per person),
     limbs (head and hands) or all (body and limbs). Limb track ids are offset when
     ``all`` runs both without ``init`` so the two never share an id. The same ``seed``
-    gives the same output. Raises :class:`app.cli.CommandError` with a clear message
+    gives the same output. With ``all``, a limb head that shares its track id with a body
+    head is not written twice (the body tracker's head is kept). ``events_out``: a list
+    that receives the limb tracker's join/separation events (a DataFrame). Raises :class:`app.cli.CommandError` with a clear message
     for an unreadable clip, a bad ``init`` table or an unknown tracker.
     """
     from tracking.body import BodyTracker  # heavy imports only when tracking
@@ -101,10 +103,15 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
     try:
         for index, frame in clip.frames(start, stop):
             mask = background.apply(frame)
+            body_heads: set[int] = set()
             for k, t in enumerate(trackers):
                 out = t.step(index, frame, mask)
-                if k > 0 and tracker == "all" and init is None:
-                    out = [_offset(r, 100000) for r in out]
+                if k == 0 and tracker == "all":
+                    body_heads = {r.track_id for r in out if r.part == "head"}
+                if k > 0 and tracker == "all":
+                    if init is None:
+                        out = [_offset(r, 100000) for r in out]
+                    out = [r for r in out if not (r.part == "head" and r.track_id in body_heads)]
                 records.extend(out)
             done += 1
             if progress is not None:
@@ -113,6 +120,8 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
         raise CommandError(str(exc)) from None
     finally:
         clip.close()
+    if events_out is not None and tracker in ("limbs", "all"):
+        events_out.append(trackers[-1].events)
     if not records:
         return empty_tracks()
     return records_to_frame(records)

@@ -1,10 +1,62 @@
-"""Entry page of the Streamlit app (placeholder until the app issue lands)."""
+"""Entry script of the Streamlit labelling app: project picker, job list and page navigation.
+
+Run with ``partlab app`` (or ``make run``). Every page is a short script under
+``app/views/`` that calls library functions; long work runs in :mod:`app.jobs`.
+"""
 
 import streamlit as st
 
-from labelling.config import data_dir
-
 st.set_page_config(page_title="partlab", layout="wide")
-st.title("partlab")
-st.write("Label human body parts in video: track, correct, learn, export.")
-st.caption(f"Data directory: {data_dir()}")
+
+from app import jobs, state  # noqa: E402
+from app.demo import ensure_demo  # noqa: E402
+from app.views.common import bound_widget  # noqa: E402
+from labelling.config import data_dir  # noqa: E402
+
+
+@st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
+def _demo_ready(data: str) -> bool:
+    """Once per server process and data directory."""
+    return ensure_demo()
+
+
+_demo_ready(str(data_dir()))
+store = state.store()
+
+with st.sidebar:
+    st.markdown("### partlab")
+    projects = store.projects()
+    if projects:
+        state.project_id(store)
+        names = {p.id: p.name for p in projects}
+        bound_widget(st.selectbox, state.PROJECT, "project_select", "Project", list(names), format_func=names.get)
+    st.session_state.setdefault(state.AUTHOR, "")
+    bound_widget(st.text_input, state.AUTHOR, "author_input", "Your name (saved with your edits)")
+
+    @st.fragment(run_every=2 if jobs.active() else None)
+    def _job_list():
+        running = jobs.active()
+        recent = [j for j in jobs.jobs() if not j.active][:3]
+        if running or recent:
+            st.caption("Background jobs")
+        for j in running:
+            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
+        for j in recent:
+            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
+                       (f" ({j.error})" if j.error else ""))
+        if recent:
+            st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
+
+    _job_list()
+    st.caption(f"Data: {data_dir()}")
+
+pages = [
+    st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects",
+            default=True),
+    st.Page("views/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
+    st.Page("views/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
+    st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
+    st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
+    st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
+]
+st.navigation(pages).run()

@@ -220,6 +220,7 @@ class BodyTracker:
         p = self.params
         ycc = self._ycc.load(frame)  # converted to YCrCb only where the filters look
         H, W = ycc.shape[:2]
+        self.frame_size = (W, H)
         self.frames_seen += 1
         mask = foreground
         new_ids = set()
@@ -246,8 +247,10 @@ class BodyTracker:
         for person in active:
             if self.whole:
                 continue
-            person.history.append(np.array([[*f.box.centre, f.box.w, f.box.h]
-                                            for f in (person.filters[n] for n in BODY_PARTS)]))
+            # the detector sees the boxes as reported (and as corrected by people), not the
+            # inner rectangles, so that what it was trained on and what it judges agree
+            reported = [self.report_box(n, person.filters[n].box) for n in BODY_PARTS]
+            person.history.append(np.array([[*b.centre, b.w, b.h] for b in reported]))
             if self.failure_detector is None or person.occluded_by is not None or person.hidden_parts:
                 continue
             verdict = self.failure_detector.detect(np.stack(person.history), self.fps)
@@ -455,6 +458,14 @@ class BodyTracker:
             if q.occluded_by is not None and q.occluded_by not in self.people:
                 q.occluded_by = None
 
+    def report_box(self, part: str, box: Box) -> Box:
+        """The box written for a part: its tracked inner rectangle widened to the part's extent
+        (``BodyParams.output_extent``), clipped to the frame."""
+        sw, sh, dx, dy = self.params.output_extent.get(part, (1.0, 1.0, 0.0, 0.0))
+        out = box.transformed(sw, sh, dx, dy)
+        size = getattr(self, "frame_size", None)
+        return out.clip(*size) if size else out
+
     def _records(self, index: int, new_ids: set[int]) -> list[TrackRecord]:
         out: list[TrackRecord] = []
         for tid in sorted(self.people):
@@ -468,13 +479,15 @@ class BodyTracker:
             else:
                 state = "tracked"
             scores = [person.scores.get(n, 1.0) for n in person.filters]
+            boxes = {name: self.report_box(name, f.box) for name, f in person.filters.items()}
             if not self.whole:
-                out.append(TrackRecord(index, tid, "person", person.box(), float(np.mean(scores)),
+                out.append(TrackRecord(index, tid, "person", minimum_bounding_rectangle(boxes.values()),
+                                       float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
             for name, f in person.filters.items():
                 hidden = person.occluded_by is not None or name in person.hidden_parts
                 part_state = "occluded" if hidden and state == "tracked" else state
-                out.append(TrackRecord(index, tid, name, f.box, person.scores.get(name, 1.0),
+                out.append(TrackRecord(index, tid, name, boxes[name], person.scores.get(name, 1.0),
                                        name in person.failed, 1.0 if hidden else 0.0, part_state))
         return out

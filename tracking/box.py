@@ -68,6 +68,14 @@ class Box:
         x2, y2 = max(self.x2, other.x2), max(self.y2, other.y2)
         return Box(x1, y1, x2 - x1, y2 - y1)
 
+    def transformed(self, scale_w: float, scale_h: float, shift_x: float = 0.0, shift_y: float = 0.0) -> "Box":
+        """The box scaled about its centre and moved by fractions of its own size."""
+        cx, cy = self.centre
+        cx += shift_x * self.w
+        cy += shift_y * self.h
+        w, h = self.w * scale_w, self.h * scale_h
+        return Box(cx - w / 2.0, cy - h / 2.0, w, h)
+
     def as_tuple(self) -> tuple[float, float, float, float]:
         return (self.x, self.y, self.w, self.h)
 

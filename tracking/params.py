@@ -37,6 +37,25 @@ def _default_part_noise() -> dict[str, PartNoise]:
     }
 
 
+def _default_output_extent() -> dict[str, tuple[float, float, float, float]]:
+    # The filters track inner rectangles (mass centre +- one standard deviation, seed 002
+    # sec. 4.1), which keep the colour model clean but cover only the middle of a part: for an
+    # evenly filled region the full extent is 2*sqrt(3) ~ 3.5 standard deviations, i.e. about
+    # 1.7x the inner rectangle. The hip-leg's inner rectangle is the upper half of the legs, so its
+    # extent reaches further down and, with legs swinging, wider. Medians measured on the
+    # synthetic suite (tracked vs truth, seed 7). The hip-leg's median
+    # (4.3 x 1.73, shifted 0.38 down) would cost a bending walker's hip-leg its tracking rate
+    # (averaged 0.77 -> 0.63); 1.8 x 1.5 shifted 0.25 keeps every rate of the suite and still
+    # raises the hip-leg's mean IoU from 0.16 to 0.39.; refitted from corrections by models/extent.py.
+    return {
+        "head": (1.65, 1.6, 0.0, -0.12),
+        "torso": (1.6, 1.6, 0.0, -0.05),
+        "hipleg": (1.8, 1.5, 0.0, 0.25),
+        # the whole-body baseline tracks the full person box: reported as it is
+        "person": (1.0, 1.0, 0.0, 0.0),
+    }
+
+
 @dataclass(frozen=True)
 class BodyParams:
     """Parameters of the three-part body tracker (seed 002)."""
@@ -59,6 +78,11 @@ class BodyParams:
     min_person_height: float = 40.0
     min_person_width: float = 12.0
     part_noise: dict[str, PartNoise] = field(default_factory=_default_part_noise)
+    # How a tracked inner rectangle is reported as the part's box: (scale_w, scale_h, shift_x,
+    # shift_y), scales about the centre and shifts in fractions of the tracked size. Only the
+    # output changes; the filters keep tracking the inner rectangles. (1, 1, 0, 0) reports them as
+    # they are, as the paper does.
+    output_extent: dict[str, tuple[float, float, float, float]] = field(default_factory=_default_output_extent)
     # seed 002 sec. 3.1 equalization: the reference is smoothed (Gaussian, in levels) and mixed
     # with a uniform share before its quantiles become bin edges, so that colours next to a
     # narrow peak (a plain shirt) still fall into distinct bins instead of all into one.
@@ -158,6 +182,8 @@ class BodyParams:
         for name in ("height_ratios", "size_range"):
             if name in data:
                 data[name] = tuple(data[name])
+        if "output_extent" in data:
+            data["output_extent"] = {k: tuple(float(x) for x in v) for k, v in data["output_extent"].items()}
         return cls(**data)
 
 
@@ -167,7 +193,9 @@ class LimbParams:
 
     The paper gives no state-machine thresholds; they are parameters here. The
     ``sigma_*`` terms are the 2D variances of the candidate priors (seed 000 eq. 25-27),
-    fitted from training video by ``models/``.
+    fitted from training video by ``models/``. ``sigma_v`` and ``sigma_d`` compare two
+    cameras (eq. 25-26) and are kept for multi-camera use; one camera uses ``sigma_s``
+    (eq. 27, distance of a blob to the silhouette) and ``sigma_xy`` (p(x|Z), eq. 17).
     """
 
     particles: int = 300
@@ -177,17 +205,80 @@ class LimbParams:
     sigma_v: float = 12.0
     sigma_d: float = 20.0
     sigma_s: float = 8.0
+    # spread of p(x | Z_c), the particle-to-candidate term of seed 000 eq. 17 (pixels):
+    # about a hand's radius, so a particle on the blob scores near 1 and one beside it little.
+    sigma_xy: float = 8.0
+    # weight every particle keeps (added to blob x hue, which is ~0.8 on target), so a filter
+    # whose blob is missed (shadow, occlusion) diffuses around its last place.
+    blob_floor: float = 0.01
     noise_xy: float = 6.0
-    lam: float = 20.0
+    # velocity noise of the second-order dynamics x_t - x_{t-1} = x_{t-1} - x_{t-2} + w_t
+    # (seed 003 sec. 3); the decay < 1 damps the velocity so a stopped hand does not overshoot.
+    noise_v: float = 2.0
+    velocity_decay: float = 0.8
+    # seed 003 eq. (1): pi = exp(-lam D^2). The reference holds only skin pixels while a
+    # candidate box also holds ~20% background at its corners (D^2 ~ 0.1 when on target):
+    # lam = 4 keeps that near 0.65 and a box on background (D^2 ~ 1) near 0.02; the paper's
+    # lam = 1 is too flat to tell them apart, the body tracker's 20 rejects even the target.
+    lam: float = 4.0
+    # hue is undefined for grey pixels: only pixels with S and V at least these count.
+    hue_min_saturation: int = 30
+    hue_min_value: int = 40
+    # seed 003 sec. 3: mean shift on the back-projection refines the PF mean.
+    mean_shift_iterations: int = 10
+    mean_shift_eps: float = 1.0
     # state machine thresholds (seed 000 sec. 5.2)
     combine_distance: float = 20.0
     split_distance: float = 30.0
+    # the same in units of the targets' box side, used when sizes are known (always in the
+    # tracker) so the thresholds hold at any resolution: hands combine when about touching
+    # (1.3 sides between centres) and split once a gap of most of a hand shows (1.8 sides).
+    combine_size: float = 1.3
+    split_size: float = 1.8
     lost_likelihood: float = 0.15
+    # hysteresis: a lost target comes back only above this confidence.
+    recover_likelihood: float = 0.3
     lost_frames: int = 5
+    # a lost target's particles are spread this wide (pixels, std) around where it is looked
+    # for: about a swinging hand's excursion from where the body carried it.
+    lost_search: float = 20.0
     start_frames: int = 3
-    # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2), drop tiny ones
-    blob_alpha: float = 1.0
+    # prior p(Z) a candidate needs for start_frames frames to start a tracker (sec. 5.2).
+    start_prior: float = 0.5
+    # frames of estimates kept to read the direction between two targets before they join.
+    history_frames: int = 10
+    # a combined filter spreads its particles this much wider so it sees both modes.
+    combined_noise_scale: float = 1.5
+    # a combined pair's posterior modes are sought among its own blobs (those no other target
+    # sits on) within this many split distances of the filter: one mode stays under the filter,
+    # the other may already be a swing away when the pair is seen to part (a walker's hands
+    # ~50 px a step; a desk clap's hands back at rest within two frames). 4 gave desk 720x480
+    # right-hand rate 0.83 vs 0.75 at 2, and walker left hand 1.00 vs 0.75.
+    mode_search: float = 4.0
+    # labelling (seed 000 sec. 7.1): a hand belongs to the nearest head within this many
+    # head heights; a person facing the camera has the left hand on the image's right.
+    person_radius: float = 5.0
+    facing_camera: bool = True
+    # frames an unlabelled tracker with no head nearby waits before it is taken as a head.
+    head_guess_frames: int = 5
+    # seed 003 sec. 3: re-acquire the head with the face detector after this many frames
+    # below reacquire_confidence.
+    reacquire_frames: int = 5
+    reacquire_confidence: float = 0.3
+    # a tracked target keeps a box this many times its size around it observable even where
+    # the adaptive background model has absorbed a person who sits still (limbs._support).
+    support_scale: float = 2.0
+    # blobs: keep ceil(3 * alpha * people) largest (seed 000 sec. 6.2: alpha > 1), drop tiny ones
+    blob_alpha: float = 1.5
     min_blob_area: float = 30.0
+    # skin probability above which a pixel is skin (skin.SkinModel)
+    skin_threshold: float = 0.5
+    # with --init, refit the skin model on the init frame's head/hand boxes (limbs.LimbTracker)
+    skin_adapt: bool = True
+    # luma bins of the refitted model: coarse, so lighting drift stays within a bin or two
+    skin_ybins: int = 8
+    # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
+    skin_open: int = 3
 
     def to_dict(self) -> dict:
         return asdict(self)

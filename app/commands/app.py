@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from app.cli import CommandError
+
 PAGE = Path(__file__).resolve().parent.parent / "streamlit_app.py"
 
 
@@ -16,7 +18,17 @@ def add_arguments(p) -> None:
 
 
 def streamlit_command(host: str, port: int) -> list[str]:
-    """The command line that serves the app; also used by the browser tests."""
+    """The command line that serves the app; also used by the browser tests.
+
+    The upload limit comes from ``PARTLAB_MAX_UPLOAD_MB`` (default 1024), the same
+    number :mod:`app.uploads` checks again on the server side.
+    """
+    from app.uploads import UploadRefused, max_upload_mb  # lazy: `partlab --help` stays light
+
+    try:
+        max_mb = max_upload_mb()
+    except UploadRefused as exc:
+        raise CommandError(str(exc)) from None
     return [
         sys.executable, "-m", "streamlit", "run", str(PAGE),
         "--server.headless", "true",
@@ -24,6 +36,9 @@ def streamlit_command(host: str, port: int) -> list[str]:
         "--server.port", str(port),
         "--browser.gatherUsageStats", "false",
         "--server.fileWatcherType", "none",
+        "--server.maxUploadSize", str(max_mb),
+        "--server.runOnSave", "false",
+        "--client.toolbarMode", "minimal",  # no "Deploy" button: this is a local labelling tool
     ]
 
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import importlib
 from pathlib import Path
 
 from app.cli import CommandError
@@ -16,8 +15,13 @@ def add_arguments(p) -> None:
     p.add_argument("--tracker", choices=["body", "limbs", "all", "whole"], default="body",
                    help="body: head/torso/hip-leg; limbs: head and hands; all: both; whole: one box per person")
     p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
-    p.add_argument("--model", metavar="BUNDLE_DIR", help="model bundle (default: the one shipped with partlab)")
+    p.add_argument("--model", metavar="BUNDLE_DIR",
+                   help="model bundle from partlab train, or 'default' for the one shipped with partlab "
+                        "(failure detection and adjustment on); without it: the built-in parameters, no "
+                        "failure detection")
     p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
+    p.add_argument("--events", metavar="EVENTS.csv",
+                   help="limbs/all: write the limbs' join and separation events (claps, handshakes, ...)")
     p.add_argument("--occluders", metavar="FILE",
                    help="CSV with columns x,y,w,h: fixed regions (pillars, doors) that can hide people")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
@@ -52,11 +56,12 @@ def read_occluders(path: str | Path):
 
 
 def load_model(path: str | Path):
+    """A model bundle by directory, or the shipped one by the name ``default``."""
+    from models import bundle
+
     try:
-        bundle = importlib.import_module("models.bundle")
-    except ImportError:
-        raise CommandError("model bundles are not available yet (models.bundle is missing)") from None
-    try:
+        if str(path) == "default" and not Path(path).exists():
+            return bundle.default_bundle()
         return bundle.load_bundle(path)
     except (OSError, ValueError) as exc:
         raise CommandError(f"{path}: cannot load model bundle: {exc}") from None
@@ -78,6 +83,7 @@ def run(args) -> int:
             raise CommandError(f"{args.init}: no boxes to start from")
     occluders = read_occluders(args.occluders) if args.occluders else ()
     model = load_model(args.model) if args.model else None
+    events: list = []
     bar = None
 
     def progress(done: int, total: int) -> None:
@@ -88,7 +94,7 @@ def run(args) -> int:
 
     try:
         tracks = track_video(args.video, tracker=args.tracker, init=init, model=model, occluders=occluders,
-                             seed=args.seed, progress=progress if args.progress else None)
+                             seed=args.seed, progress=progress if args.progress else None, events_out=events)
     finally:
         if bar is not None:
             bar.close()
@@ -98,4 +104,11 @@ def run(args) -> int:
         raise CommandError(f"{args.output}: cannot write: {exc}") from None
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
+    if args.events:
+        if args.tracker not in ("limbs", "all"):
+            raise CommandError("--events needs --tracker limbs or all (events are the limbs' joins)")
+        from tracking.limbs import write_events
+
+        write_events(events[0], args.events)
+        print(f"wrote {len(events[0])} event(s) to {args.events}")
     return 0

@@ -64,14 +64,12 @@ def test_pipeline_same_seed_same_output_and_start_stop(clip):
 
 
 @pytest.mark.parametrize("argv_extra, message", [
-    (["--tracker", "limbs"], "limb tracker is not available yet"),
+    (["--events", "ev.csv"], "--events needs --tracker limbs or all"),
     (["--model", "nowhere"], "model bundle"),
     (["--occluders", "missing.csv"], "no such occluders file"),
 ])
 def test_track_command_refuses_with_clear_messages(clip, capsys, argv_extra, message):
     d, path, _ = clip
-    if "limbs" in argv_extra and importlib.util.find_spec("tracking.limbs") is not None:
-        pytest.skip("the limb tracker exists")
     if "--model" in argv_extra and importlib.util.find_spec("models.bundle") is not None:
         argv_extra = ["--model", str(d / "not-a-bundle")]
     assert main(["track", str(path), "-o", str(d / "x.csv"), "--no-progress"] + argv_extra) == 2
@@ -92,3 +90,25 @@ def test_bad_inputs_are_reported(clip, tmp_path, capsys):
     assert "missing column(s) h" in capsys.readouterr().err
     with pytest.raises(CommandError, match="outside the clip"):
         track_video(path, start=500)
+
+
+def test_all_trackers_write_one_head_per_person_and_the_events(tmp_path, capsys):
+    from labelling.synth import render_scenario
+
+    d = render_scenario("desk", tmp_path / "desk", seed=3, n_frames=70, width=360, height=240)
+    out, ev = tmp_path / "all.csv", tmp_path / "events.csv"
+    assert main(["track", str(d / "clip.mp4"), "-o", str(out), "--tracker", "all", "--init", str(d / "init.csv"),
+                 "--events", str(ev), "--no-progress"]) == 0
+    tracks = pd.read_csv(out)
+    assert not tracks.duplicated(["frame", "track_id", "part"]).any()
+    assert {"head", "torso", "left_hand", "right_hand"} <= set(tracks.part)
+    events = pd.read_csv(ev)
+    assert (events.kind == "clap").sum() >= 1   # the desk scene claps around frames 40-60 (scaled to 70 frames)
+
+
+def test_model_default_names_the_shipped_bundle(clip, tmp_path):
+    d, path, init = clip
+    out = tmp_path / "t.csv"
+    assert main(["track", str(path), "-o", str(out), "--model", "default", "--init", str(d / "init.csv"),
+                 "--no-progress"]) == 0
+    assert len(pd.read_csv(out)) > 0

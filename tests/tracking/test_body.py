@@ -169,3 +169,28 @@ def test_init_rows_of_other_parts_are_ignored_and_bad_boxes_refused():
     bad = pd.DataFrame([dict(frame=0, track_id=1, part="person", x=0, y=0, w=1, h=30)])
     with pytest.raises(ValueError, match="too small"):
         init_starts(bad)
+
+
+def _mean_iou(tracks, truths, part):
+    rows = tracks[(tracks.track_id == 1) & (tracks.part == part) & (tracks.frame > 0)]
+    return float(np.mean([Box(r.x, r.y, r.w, r.h).iou(truths[r.frame][1][part]) for r in rows.itertuples()]))
+
+
+def test_reported_boxes_cover_the_parts_not_just_their_inner_rectangles():
+    """The filters track inner rectangles; the written boxes are widened to the part's extent
+    (``BodyParams.output_extent``), so a user corrects far less. (1, 1, 0, 0) gives the paper's
+    inner rectangles back, which overlap the drawn parts much less."""
+    from dataclasses import replace
+
+    frames, truths = _scene(n=30)
+    wide = _run(BodyTracker(BodyParams(), np.random.default_rng(1), init=_init(truths[0])), frames)
+    inner_params = replace(BodyParams(), output_extent={})
+    inner = _run(BodyTracker(inner_params, np.random.default_rng(1), init=_init(truths[0])), frames)
+    for part in ("head", "torso", "person"):
+        assert _mean_iou(wide, truths, part) > _mean_iou(inner, truths, part) + 0.15, part
+    assert _mean_iou(wide, truths, "torso") > 0.6
+    assert _rate(wide, truths, 1, "torso")[0] >= 0.9
+    # the same filters underneath: the centres of the two outputs differ only by the shift
+    w = wide[(wide.part == "torso") & (wide.frame == 20)].iloc[0]
+    i = inner[(inner.part == "torso") & (inner.frame == 20)].iloc[0]
+    assert w.w == pytest.approx(i.w * BodyParams().output_extent["torso"][0], rel=1e-3)

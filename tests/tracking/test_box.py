@@ -33,3 +33,8 @@ def test_vectorised_iou_matches_scalar():
     for i in range(7):
         for j in range(5):
             assert m[i, j] == pytest.approx(Box(*a[i]).iou(Box(*b[j])))
+
+
+def test_transformed_scales_about_the_centre_and_shifts_by_own_size():
+    b = Box(10, 20, 10, 20).transformed(2.0, 0.5, shift_x=0.5, shift_y=-0.25)
+    assert b == Box(10, 20, 20, 10)  # centre (15, 30) -> (20, 25); size (20, 10)

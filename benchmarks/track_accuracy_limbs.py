@@ -1,0 +1,178 @@
+"""Accuracy of the limb tracker on the synthetic scenes (issue 4's limbs table).
+
+For each scenario and seed: render the scene (``labelling.synth.make_scene``), run
+``LimbTracker`` from the scene's init boxes with the shared background model, and
+report per part (head, left hand, right hand)
+
+- the tracking rate at frame ``--at`` (105 by default): the fraction of (seed, person)
+  whose box is right there; a box is right when at least half of it lies on the true
+  box and its centre is inside the true box (seed 002 sec. 5.3, DESIGN.md);
+- the mean rate over all frames;
+- the number of identity swaps of the hands after the clap (in the left_hand row): a
+  swap starts at a frame where each hand's box is nearer the other hand's true centre
+  than its own.
+
+Named so as not to clash with the body developer's ``benchmarks/track_accuracy.py``.
+A script, not a test:
+
+    PYTHONPATH=. python benchmarks/track_accuracy_limbs.py [--seeds 0 1 2] [--scenarios desk single] [--fg plate]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from tracking.limbs import LimbTracker
+from tracking.params import LimbParams
+from tracking.parts import LIMB_PARTS
+from tracking.tracks import records_to_frame
+
+
+def box_correct(pred: np.ndarray, true: np.ndarray) -> np.ndarray:
+    """``(N,) bool``: at least half of each predicted box ``(N, 4) x, y, w, h`` lies on its true
+    box and its centre is inside it."""
+    pred = np.asarray(pred, float).reshape(-1, 4)
+    true = np.asarray(true, float).reshape(-1, 4)
+    iw = np.minimum(pred[:, 0] + pred[:, 2], true[:, 0] + true[:, 2]) - np.maximum(pred[:, 0], true[:, 0])
+    ih = np.minimum(pred[:, 1] + pred[:, 3], true[:, 1] + true[:, 3]) - np.maximum(pred[:, 1], true[:, 1])
+    inter = np.clip(iw, 0, None) * np.clip(ih, 0, None)
+    area = pred[:, 2] * pred[:, 3]
+    cx, cy = pred[:, 0] + pred[:, 2] / 2, pred[:, 1] + pred[:, 3] / 2
+    inside = (cx >= true[:, 0]) & (cx <= true[:, 0] + true[:, 2]) & (cy >= true[:, 1]) & (cy <= true[:, 1] + true[:, 3])
+    return (area > 0) & (inter >= 0.5 * area) & inside
+
+
+def foreground_model():
+    """The shared background model if it has landed, else OpenCV's MOG2 with its defaults."""
+    try:
+        from tracking.background import BackgroundModel
+        return BackgroundModel()
+    except ImportError:
+        import cv2
+        mog = cv2.createBackgroundSubtractorMOG2(detectShadows=False)
+
+        class _Mog:
+            def apply(self, frame):
+                return mog.apply(frame)
+        return _Mog()
+
+
+class PlateForeground:
+    """Foreground from the scene's empty-room plate (``Scene.background``): what a background
+    model converges to, so the tracker is measured apart from the background model's warm-up
+    (the desk scene's person sits there from frame 0, which an adaptive model learns as
+    background)."""
+
+    def __init__(self, plate: np.ndarray, threshold: float = 30.0):
+        import cv2
+        self.plate = cv2.GaussianBlur(plate, (5, 5), 0).astype(np.int16)
+        self.threshold = threshold
+
+    def apply(self, frame: np.ndarray) -> np.ndarray:
+        import cv2
+        diff = np.abs(cv2.GaussianBlur(frame, (5, 5), 0).astype(np.int16) - self.plate).max(axis=2)
+        return (diff > self.threshold).astype(np.uint8) * 255
+
+
+def run_scene(scene, params: LimbParams, seed: int, fg: str = "model") -> tuple[pd.DataFrame, pd.DataFrame]:
+    init = scene.init[scene.init["part"].isin(LIMB_PARTS)]
+    tracker = LimbTracker(params, np.random.default_rng(seed), init=init)
+    bg = PlateForeground(scene.background) if fg == "plate" else foreground_model()
+    recs = []
+    for i, frame in enumerate(scene.frames):
+        recs += tracker.step(i, frame, bg.apply(frame))
+    return records_to_frame(recs), tracker.events
+
+
+def score(out: pd.DataFrame, truth: pd.DataFrame) -> pd.DataFrame:
+    """Truth rows of the limb parts with a ``correct`` column (missing predictions are wrong)."""
+    t = truth[truth["part"].isin(LIMB_PARTS)][["frame", "track_id", "part", "x", "y", "w", "h"]]
+    m = t.merge(out[["frame", "track_id", "part", "x", "y", "w", "h", "state"]],
+                on=["frame", "track_id", "part"], how="left", suffixes=("_t", ""))
+    ok = box_correct(m[["x", "y", "w", "h"]].fillna(0).to_numpy(), m[["x_t", "y_t", "w_t", "h_t"]].to_numpy())
+    return m.assign(correct=ok & m["x"].notna().to_numpy())
+
+
+def hand_swaps(m: pd.DataFrame, after: int) -> int:
+    """Swap onsets after frame ``after``: frames where both hands are nearer the other's truth."""
+    swaps = 0
+    for _, g in m[m.frame > after].groupby("track_id"):
+        lh = g[g.part == "left_hand"].set_index("frame")
+        rh = g[g.part == "right_hand"].set_index("frame")
+        frames = lh.index.intersection(rh.index)
+        if len(frames) == 0:
+            continue
+        lh, rh = lh.loc[frames], rh.loc[frames]
+
+        def c(df, s=""):
+            return np.column_stack([df["x" + s] + df["w" + s] / 2, df["y" + s] + df["h" + s] / 2])
+        pl, pr, tl, tr = c(lh), c(rh), c(lh, "_t"), c(rh, "_t")
+        d = lambda a, b: np.hypot(*(a - b).T)  # noqa: E731
+        swapped = (d(pl, tr) < d(pl, tl)) & (d(pr, tl) < d(pr, tr))
+        swapped = np.nan_to_num(swapped, nan=0).astype(bool)
+        swaps += int(swapped[0]) + int(((~swapped[:-1]) & swapped[1:]).sum())
+    return swaps
+
+
+def clap_end(truth: pd.DataFrame, gap: float) -> int:
+    """Last frame at which some person's true hand centres are closer than ``gap`` (the clap)."""
+    frames = []
+    for (f, tid), g in truth[truth.part.isin(["left_hand", "right_hand"])].groupby(["frame", "track_id"]):
+        if len(g) == 2:
+            c = g[["x", "y"]].to_numpy() + g[["w", "h"]].to_numpy() / 2
+            if np.hypot(*(c[0] - c[1])) < gap:
+                frames.append(f)
+    return max(frames) if frames else -1
+
+
+def main() -> None:
+    from labelling.synth import make_scene
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenarios", nargs="+", default=["desk", "single"])
+    ap.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
+    ap.add_argument("--frames", type=int, default=150)
+    ap.add_argument("--width", type=int, default=320)
+    ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--at", type=int, default=105, help="frame of the tracking rate")
+    ap.add_argument("--params", default="{}", help='LimbParams overrides as JSON, e.g. {"lam": 2}')
+    ap.add_argument("--fg", choices=["model", "plate"], default="model",
+                    help="foreground: the shared background model (MOG2 until tracking/background.py "
+                         "lands) or the scene's empty-room plate")
+    args = ap.parse_args()
+    params = LimbParams.from_dict({**LimbParams().to_dict(), **json.loads(args.params)})
+    rows = []
+    for name in args.scenarios:
+        for seed in tqdm(args.seeds, desc=name):
+            scene = make_scene(name, seed, args.frames, args.width, args.height)
+            out, events = run_scene(scene, params, seed, args.fg)
+            m = score(out, scene.truth)
+            hands = m[m.part.isin(["left_hand", "right_hand"])]
+            gap = float(np.median(hands.w_t)) * 1.5 if len(hands) else 0.0
+            end = clap_end(scene.truth, gap)
+            for part in LIMB_PARTS:
+                mp = m[m.part == part]
+                at = mp[mp.frame == args.at]
+                rows.append({"scenario": name, "seed": seed, "part": part,
+                             f"rate@{args.at}": at.correct.mean() if len(at) else np.nan,
+                             "rate_all": mp.correct.mean() if len(mp) else np.nan,
+                             "swaps_after_clap": hand_swaps(m, end) if end >= 0 and part == "left_hand" else 0,
+                             "clap_end": end, "events": len(events),
+                             "lost_frames": int((mp.state == "lost").sum())})
+    df = pd.DataFrame(rows)
+    pd.set_option("display.width", 160)
+    print(df.to_string(index=False, float_format="%.3f"))
+    print()
+    summary = df.groupby(["scenario", "part"]).agg(
+        **{f"rate@{args.at}": (f"rate@{args.at}", "mean"), "rate_all": ("rate_all", "mean"),
+           "swaps": ("swaps_after_clap", "sum")})
+    print(summary.to_string(float_format="%.3f"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,230 @@
+"""Training a model bundle from corrected clips (seed 002 sec. 4.2, seed 000 sec. 6.4).
+
+Samples for the four SVMs come from three sources:
+
+1. **the tracker's own output**: each clip is tracked from the truth's first boxes
+   (``tracker_runner``) and every tracked part is labelled against the corrected
+   box (:func:`models.labels.label_tracks`), as the paper does by hand;
+2. **hand-set failure flags**: truth rows with ``failure`` set and ``source == "human"``
+   are tracker boxes a user marked as failed without moving them; they are
+   negatives (the other parts of that person and frame are positives) and are left
+   out of everything else;
+3. **perturbed states** (:mod:`models.perturb`): simulated single and multi-part
+   failures, so that a few clips give enough failures of every kind. With the
+   tracker, its own output is perturbed (so the SVMs learn its box geometry) and
+   labelled against the truth; without it, the truth is.
+
+The variance parameters are fitted from the truth (:mod:`models.variance`), the
+colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
+(:mod:`models.sharpness`; only where the body tracker's histograms are installed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable, Iterable, Iterator
+
+import numpy as np
+import pandas as pd
+
+from models.bundle import Bundle
+from models.failure_svm import SVMFailureDetector, TNR_TARGETS, train_failure_svms
+from models.features import BODY_PARTS, DEFAULT_DT, features_from_tracks, person_histories
+from models.labels import NEGATIVE, POSITIVE, SVM_NAMES, label_tracks, labels_for_keys
+from models.perturb import PerturbConfig, perturbed_samples
+from models.variance import fit_variances
+from tracking.params import BodyParams, LimbParams
+from tracking.tracks import normalise_tracks
+
+FramesFactory = Callable[[], Iterator[tuple[int, np.ndarray]]]
+Clip = tuple[FramesFactory, float, pd.DataFrame]
+#: ``runner(frames_factory, fps, init, seed) -> tracks DataFrame`` of the body tracker.
+TrackerRunner = Callable[[FramesFactory, float, pd.DataFrame, int], pd.DataFrame]
+
+
+def first_boxes(truth: pd.DataFrame) -> pd.DataFrame:
+    """The truth rows of every track at its first frame (the tracker's ``init``)."""
+    truth = normalise_tracks(truth)
+    first = truth.groupby("track_id")["frame"].transform("min")
+    return truth[truth["frame"] == first].reset_index(drop=True)
+
+
+def split_human_flags(truth: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``(truth without flagged rows, flagged rows)``; flagged = failure set by a human."""
+    truth = normalise_tracks(truth)
+    flagged = truth["failure"] & (truth["source"] == "human")
+    return truth[~flagged].reset_index(drop=True), truth[flagged].reset_index(drop=True)
+
+
+def human_flag_samples(truth: pd.DataFrame, fps: float, dt: float = DEFAULT_DT) -> tuple[np.ndarray, np.ndarray]:
+    """Features and labels of every person and frame where a user flagged a part as failed."""
+    truth = normalise_tracks(truth)
+    flagged = truth["failure"] & (truth["source"] == "human") & truth["part"].isin(BODY_PARTS)
+    if not flagged.any():
+        return np.zeros((0, 24)), np.zeros((0, 3), dtype=np.int8)
+    keys, x = features_from_tracks(truth, fps, dt)
+    flags = truth[flagged][["track_id", "frame", "part"]]
+    wanted = pd.MultiIndex.from_frame(keys).isin(pd.MultiIndex.from_frame(flags[["track_id", "frame"]]))
+    keys, x = keys[wanted].reset_index(drop=True), x[wanted]
+    labels = np.full((len(keys), 3), POSITIVE, dtype=np.int8)
+    for k, part in enumerate(BODY_PARTS):
+        f = flags[flags["part"] == part]
+        labels[pd.MultiIndex.from_frame(keys).isin(pd.MultiIndex.from_frame(f[["track_id", "frame"]])), k] = NEGATIVE
+    return x, labels
+
+
+def tracker_samples(tracked: pd.DataFrame, truth: pd.DataFrame, fps: float,
+                    dt: float = DEFAULT_DT) -> tuple[np.ndarray, np.ndarray]:
+    """Features of the tracker's output and its part labels against the truth."""
+    tracked = normalise_tracks(tracked)
+    keys, x = features_from_tracks(tracked, fps, dt)
+    if len(keys) == 0:
+        return x, np.zeros((0, 3), dtype=np.int8)
+    labels = labels_for_keys(label_tracks(tracked, truth), keys)
+    return x, labels
+
+
+def sharpness_available() -> bool:
+    """Whether ``lam`` can be fitted (it needs the body tracker's ``tracking.histogram``)."""
+    try:
+        import tracking.histogram  # noqa: F401  (only whether it imports)
+    except ImportError:
+        return False
+    return True
+
+
+def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None = None) -> int:
+    """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
+    if with_sharpness is None:
+        with_sharpness = sharpness_available()
+    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1
+
+
+def _apply_lam(body: BodyParams, table: pd.DataFrame,
+               d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
+    """Put the ML ``lam`` of every part with enough distances into ``body`` and the table."""
+    from models.sharpness import fit_lam
+    from models.variance import MIN_SAMPLES
+
+    noise = dict(body.part_noise)
+    table = table.copy()
+    for part, chunks in d2.items():
+        values = np.concatenate(chunks) if chunks else np.zeros(0)
+        row = (table["tracker"] == "body") & (table["part"] == part) & (table["parameter"] == "lam")
+        table.loc[row, "n"] = len(values)
+        if len(values) < MIN_SAMPLES or part not in noise:
+            continue
+        lam = fit_lam(values)
+        noise[part] = replace(noise[part], lam=lam)
+        table.loc[row, "fitted"] = lam
+        table.loc[row, "applied"] = lam
+    return replace(body, part_noise=noise), table
+
+
+def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], None] | None = None,
+                 tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
+                 perturbed_per_person: int = 300, body: BodyParams | None = None,
+                 limb: LimbParams | None = None, dt: float = DEFAULT_DT,
+                 fit_sharpness: bool | None = None) -> Bundle:
+    """Fit the four failure SVMs and the variance parameters from corrected clips.
+
+    ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
+    ``(index, frame)``. Without ``tracker_runner`` (or where it fails on a clip) only
+    perturbed-truth and hand-flag samples are used; the summary records how many of
+    each. ``progress`` is called once per step with a short description.
+    ``fit_sharpness`` (default: when available) decodes each clip once more to fit ``lam``.
+    """
+    if not clips:
+        raise ValueError("no clips to train from")
+    names = list(names) if names is not None else [f"clip{i}" for i in range(len(clips))]
+    if len(names) != len(clips):
+        raise ValueError(f"{len(names)} names for {len(clips)} clips")
+    rng = np.random.default_rng(seed)
+    step = progress or (lambda _msg: None)
+    xs, ys, truths, clip_info, tracked_runs = [], [], [], [], []
+    counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
+    if fit_sharpness is None:
+        fit_sharpness = sharpness_available()
+    d2: dict[str, list[np.ndarray]] = {}
+    for i, ((factory, fps, truth), name) in enumerate(zip(clips, names)):
+        truth_clean, _ = split_human_flags(truth)
+        truths.append(truth_clean)
+        info = {"name": name, "fps": float(fps), "people": int(truth_clean["track_id"].nunique()),
+                "frames": int(truth_clean["frame"].nunique())}
+        if tracker_runner is not None:
+            step(f"tracking {name}")
+            tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
+            tracked_runs.append((tracked, truth_clean))
+            x, y = tracker_samples(tracked, truth_clean, fps, dt)
+            xs.append(x), ys.append(y)
+            counts["tracker"] += len(x)
+            info["tracker_samples"] = len(x)
+            info["tracker_failures"] = int(np.sum(np.any(y == NEGATIVE, axis=1)))
+        if fit_sharpness:
+            from models.sharpness import colour_distances
+            step(f"colours of {name}")
+            for part, values in colour_distances(factory, truth_clean, body or BodyParams()).items():
+                d2.setdefault(part, []).append(values)
+        step(f"samples of {name}")
+        x, y = human_flag_samples(truth, fps, dt)
+        xs.append(x), ys.append(y)
+        counts["human_flags"] += len(x)
+        n_pert = 0
+        true_hist = person_histories(truth_clean)
+        if tracker_runner is not None:
+            # failures simulated on the tracker's own boxes (its geometry), labelled against the truth
+            for tid, (frames, hist) in person_histories(tracked).items():
+                aligned = np.full(hist.shape, np.nan)
+                if tid in true_hist:
+                    tf, th = true_hist[tid]
+                    pos = np.searchsorted(tf, frames)
+                    hit = (pos < len(tf)) & (tf[np.minimum(pos, len(tf) - 1)] == frames)
+                    aligned[hit] = th[pos[hit]]
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt,
+                                         truth=aligned)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
+        else:
+            for _tid, (frames, hist) in true_hist.items():
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
+        counts["perturbed"] += n_pert
+        clip_info.append(info)
+    x_all = np.concatenate(xs, axis=0)
+    y_all = np.concatenate(ys, axis=0)
+    if len(x_all) == 0:
+        raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
+    models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
+    step("variance parameters")
+    # the tracker's prediction errors are not used for the noise (measured worse, see models.variance)
+    body_p, limb_p, table = fit_variances(truths, body, limb)
+    if fit_sharpness:
+        body_p, table = _apply_lam(body_p, table, d2)
+    if tracked_runs:
+        from models.extent import fit_output_extent
+
+        step("output extent")
+        current = (body or BodyParams()).output_extent
+        body_p = replace(body_p, output_extent=fit_output_extent([t for t, _ in tracked_runs],
+                                                                 [g for _, g in tracked_runs], current))
+    detector = SVMFailureDetector(models, dt=dt) if models else None
+    summary = {
+        "seed": seed,
+        "clips": clip_info,
+        "samples": {**counts, "total": int(len(x_all))},
+        "svms": {n: r.to_dict() for n, r in reports.items()},
+        "tnr_targets": dict(TNR_TARGETS),
+        "thresholds": {n: r.threshold for n, r in reports.items()},
+        "variances": table.to_dict(orient="records"),
+        "output_extent": {k: list(v) for k, v in body_p.output_extent.items()},
+        "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
+    }
+    return Bundle(body_p, limb_p, detector, summary)
+
+
+def iterate_frames(frames: np.ndarray) -> FramesFactory:
+    """A frames factory over an in-memory ``(T, H, W, 3)`` array (synthetic scenes)."""
+    def factory():
+        return ((i, frames[i]) for i in range(len(frames)))
+    return factory

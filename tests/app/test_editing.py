@@ -1,0 +1,86 @@
+"""The editor events -> store glue: edits, flags, deletes, undo/redo, stale refusals."""
+
+from __future__ import annotations
+
+from app.editing import EditHistory, apply_events
+
+
+def _box(store, clip_id, frame, part, track=1):
+    df = store.frame_boxes(clip_id, frame)
+    row = df[(df.track_id == track) & (df.part == part)]
+    return None if row.empty else row.iloc[0]
+
+
+def test_move_then_failure_flag_are_stored_as_revisions(store, tracked_clip):
+    _, clip = tracked_clip
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [
+        dict(seq=1, kind="edit", frame=3, track_id=1, part="head", box=[25.5, 22, 8, 10], failure=False,
+             occluded=0, revision=0),
+        dict(seq=2, kind="edit", frame=3, track_id=1, part="head", box=[25.5, 22, 8, 10], failure=True,
+             occluded=0, revision=1),
+    ], hist)
+    assert res.errors == [] and res.written == 2
+    head = _box(store, clip.id, 3, "head")
+    assert (head.x, head.y, bool(head.failure), head.source, int(head.revision)) == (25.5, 22.0, True, "human", 2)
+    # the person box of that frame is still the tracker's
+    assert _box(store, clip.id, 3, "person").source == "tracker"
+    assert [r.revision for r in hist.undo] == [1, 2]
+
+
+def test_stale_edit_is_refused_with_the_store_message(store, tracked_clip):
+    _, clip = tracked_clip
+    apply_events(store, clip.id, [dict(kind="edit", frame=0, track_id=1, part="head", box=[1, 2, 3, 4],
+                                       failure=False, occluded=0, revision=0)], EditHistory())
+    # a second session that still saw revision 0 tries to move the same box
+    res = apply_events(store, clip.id, [dict(kind="edit", frame=0, track_id=1, part="head", box=[9, 9, 3, 4],
+                                             failure=False, occluded=0, revision=0)], EditHistory())
+    assert res.written == 0 and len(res.errors) == 1
+    assert "changed by someone else" in res.errors[0] and "revision 1, you had 0" in res.errors[0]
+    assert _box(store, clip.id, 0, "head").x == 1.0  # the first edit was not lost
+
+
+def test_undo_and_redo_walk_this_sessions_edits(store, tracked_clip):
+    _, clip = tracked_clip
+    hist = EditHistory()
+    apply_events(store, clip.id, [dict(kind="edit", frame=5, track_id=1, part="person", box=[40, 21, 15, 44],
+                                       failure=False, occluded=0, revision=0)], hist)
+    res = apply_events(store, clip.id, [dict(kind="undo")], hist)
+    assert res.errors == [] and res.frame == 5
+    assert _box(store, clip.id, 5, "person").x == 25.0  # the tracker's box (10 + 3*5) is back
+    res = apply_events(store, clip.id, [dict(kind="redo")], hist)
+    assert res.errors == []
+    assert _box(store, clip.id, 5, "person").x == 40.0
+    assert len(hist.undo) == 1 and hist.redo == []
+    assert "nothing to redo" in apply_events(store, clip.id, [dict(kind="redo")], hist).notes[0]
+
+
+def test_add_and_delete_boxes_and_occluders(store, tracked_clip):
+    _, clip = tracked_clip
+    new_id = store.next_track_id(clip.id)
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [
+        dict(kind="edit", added=True, frame=2, track_id=new_id, part="left_hand", box=[50, 40, 5, 5],
+             failure=False, occluded=1, revision=None),
+        dict(kind="delete", frame=2, track_id=1, part="head", revision=0),
+        dict(kind="occluders", boxes=[[0, 0, 20, 72]]),
+        dict(kind="frame", target=7),
+    ], hist)
+    assert res.errors == [] and res.frame == 7
+    hand = _box(store, clip.id, 2, "left_hand", track=new_id)
+    assert (hand.x, hand.w, float(hand.occluded)) == (50.0, 5.0, 1.0)
+    assert _box(store, clip.id, 2, "head") is None
+    assert [(b.x, b.w, b.h) for b in store.occluders(clip.id)] == [(0.0, 20.0, 72.0)]
+    # undoing the delete brings the tracker's head back
+    apply_events(store, clip.id, [dict(kind="undo")], hist)
+    assert _box(store, clip.id, 2, "head").x == 19.0
+
+
+def test_bad_event_is_reported_not_raised(store, tracked_clip):
+    _, clip = tracked_clip
+    res = apply_events(store, clip.id, [dict(kind="edit", frame=99, track_id=1, part="head", box=[1, 1, 2, 2],
+                                             failure=False, occluded=0, revision=0),
+                                        dict(kind="edit", frame=0, track_id=1, part="elbow", box=[1, 1, 2, 2],
+                                             revision=0)], EditHistory())
+    assert res.written == 0
+    assert "outside clip" in res.errors[0] and "unknown part 'elbow'" in res.errors[1]

@@ -1,0 +1,200 @@
+"""The limb tracker on small drawn scenes: a seated person (head + two hands) on a shirt."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from tracking.limbs import EVENT_COLUMNS, LimbTracker, event_kind, load_face_detector, write_events
+from tracking.params import LimbParams
+from tracking.tracks import records_to_frame
+
+SKIN = (110, 150, 210)
+BG = (90, 110, 70)
+SHIRT = (140, 60, 40)
+P = LimbParams(particles=150)
+
+
+def clap_scene(n=60, hide_left=()):
+    """Hands 60 px apart close in, touch over frames 20-29, and part again; the person's left
+    hand is on the image's right (facing the camera). ``hide_left``: frames where it is hidden."""
+    frames, rows = [], []
+    for t in range(n):
+        f = np.full((120, 160, 3), BG, np.uint8)
+        cv2.rectangle(f, (55, 35), (105, 115), SHIRT, -1)
+        off = 30 - 1.2 * t if t < 20 else (6 if t < 30 else min(6 + 1.2 * (t - 30), 30))
+        head, lh, rh = (80, 25), (int(80 + off), 80), (int(80 - off), 80)
+        cv2.circle(f, head, 11, SKIN, -1)
+        if t not in hide_left:
+            cv2.circle(f, lh, 6, SKIN, -1)
+        cv2.circle(f, rh, 6, SKIN, -1)
+        frames.append(f)
+        rows += [(t, 7, "head", head[0] - 11, head[1] - 11, 22, 22),
+                 (t, 7, "left_hand", lh[0] - 6, lh[1] - 6, 12, 12),
+                 (t, 7, "right_hand", rh[0] - 6, rh[1] - 6, 12, 12)]
+    return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def run(tracker, frames):
+    recs = []
+    fg = np.full(frames[0].shape[:2], 255, np.uint8)
+    for i, f in enumerate(frames):
+        recs += tracker.step(i, f, fg)
+    return records_to_frame(recs)
+
+
+def centre_error(out, truth):
+    m = out.merge(truth, on=["frame", "track_id", "part"], suffixes=("", "_t"))
+    return np.hypot(m.x + m.w / 2 - (m.x_t + m.w_t / 2), m.y + m.h / 2 - (m.y_t + m.h_t / 2)), m
+
+
+def test_clap_hands_are_combined_then_split_with_their_own_labels():
+    frames, truth = clap_scene()
+    tr = LimbTracker(P, np.random.default_rng(0), init=truth[truth.frame == 0])
+    out = run(tr, frames)
+    assert len(out) == 3 * len(frames)
+    err, m = centre_error(out, truth)
+    after = m.frame >= 45
+    assert err[after].max() < 4.0  # no left/right swap after the separation
+    states = out.set_index(["frame", "part"])["state"]
+    assert states[(25, "left_hand")] == "combined" and states[(25, "right_hand")] == "combined"
+    assert states[(25, "head")] == "normal" and states[(50, "left_hand")] == "normal"
+    ev = tr.events
+    assert list(ev.columns) == list(EVENT_COLUMNS)
+    assert len(ev) == 1
+    e = ev.iloc[0]
+    assert e.kind == "clap" and e.ended_by == "split" and {e.part_a, e.part_b} == {"left_hand", "right_hand"}
+    assert 14 <= e.start_frame <= 20 and 31 <= e.end_frame <= 42
+
+
+def test_same_seed_same_output_and_another_seed_differs():
+    frames, truth = clap_scene(20)
+    init = truth[truth.frame == 0]
+    a = run(LimbTracker(P, np.random.default_rng(5), init=init), frames)
+    b = run(LimbTracker(P, np.random.default_rng(5), init=init), frames)
+    c = run(LimbTracker(P, np.random.default_rng(6), init=init), frames)
+    pd.testing.assert_frame_equal(a, b)
+    assert not np.allclose(a[["x", "y"]].to_numpy(), c[["x", "y"]].to_numpy())
+
+
+def test_hidden_hand_is_lost_then_recovered_at_its_return():
+    hidden = range(40, 52)
+    frames, truth = clap_scene(60, hide_left=hidden)
+    tr = LimbTracker(P, np.random.default_rng(1), init=truth[truth.frame == 0])
+    out = run(tr, frames)
+    lh = out[out.part == "left_hand"].set_index("frame")
+    assert lh.loc[51, "state"] == "lost" and bool(lh.loc[51, "failure"])
+    assert lh.loc[59, "state"] == "normal"
+    err, m = centre_error(out, truth)
+    assert err[(m.frame == 59) & (m.part == "left_hand")].iloc[0] < 4.0
+
+
+def test_without_init_head_and_hands_start_and_are_labelled_by_position():
+    frames, truth = clap_scene(14)
+    tr = LimbTracker(P, np.random.default_rng(2), face_detector=False)
+    out = run(tr, frames)
+    last = out[out.frame == 13]
+    assert sorted(last.part) == ["head", "left_hand", "right_hand"]
+    assert last.track_id.nunique() == 1
+    t = truth[truth.frame == 13].assign(track_id=int(last.track_id.iloc[0]))
+    err, _ = centre_error(last, t)
+    assert err.max() < 4.0
+    assert (out.frame.min()) >= P.start_frames - 1  # nothing before a candidate was strong long enough
+
+
+def test_init_with_only_body_rows_starts_limbs_automatically_after_its_ids():
+    frames, _ = clap_scene(14)
+    init = pd.DataFrame({"frame": [0], "track_id": [4], "part": ["torso"], "x": [55.0], "y": [35.0],
+                         "w": [50.0], "h": [80.0]})
+    tr = LimbTracker(P, np.random.default_rng(2), init=init, face_detector=False)
+    assert tr.auto_start
+    out = run(tr, frames)
+    last = out[out.frame == 13]
+    assert sorted(last.part) == ["head", "left_hand", "right_hand"] and set(last.track_id) == {5}
+
+
+def test_bad_frames_are_refused():
+    tr = LimbTracker(P, np.random.default_rng(0), face_detector=False)
+    with pytest.raises(ValueError, match="BGR"):
+        tr.step(0, np.zeros((10, 10), np.uint8), None)
+    with pytest.raises(ValueError, match="does not match"):
+        tr.step(0, np.zeros((10, 10, 3), np.uint8), np.zeros((5, 5), np.uint8))
+
+
+def test_event_kinds_and_events_csv(tmp_path):
+    assert event_kind("left_hand", 1, "right_hand", 1) == "clap"
+    assert event_kind("left_hand", 1, "right_hand", 2) == "handshake"
+    assert event_kind("head", 1, "left_hand", 1) == "hand_head"
+    assert event_kind("head", 1, "head", 2) == "join"
+    ev = pd.DataFrame([{"start_frame": 9, "end_frame": 12, "kind": "clap", "track_id_a": 1, "part_a": "left_hand",
+                        "track_id_b": 1, "part_b": "right_hand", "ended_by": "split"},
+                       {"start_frame": 3, "end_frame": 5, "kind": "join", "track_id_a": 1, "part_a": "head",
+                        "track_id_b": 2, "part_b": "head", "ended_by": "lost"}])
+    write_events(ev, tmp_path / "out" / "events.csv")
+    back = pd.read_csv(tmp_path / "out" / "events.csv")
+    assert list(back.columns) == list(EVENT_COLUMNS) and back.start_frame.tolist() == [3, 9]
+    with pytest.raises(ValueError, match="lacks column"):
+        write_events(ev.drop(columns="kind"), tmp_path / "x.csv")
+
+
+def test_bundled_face_cascade_loads():
+    det = load_face_detector()
+    assert det is not None and not det.empty()
+    # a flat frame has no face
+    assert len(det.detectMultiScale(np.full((80, 80), 128, np.uint8))) == 0
+
+
+def test_a_still_head_absorbed_by_the_background_model_stays_tracked():
+    frames, truth = clap_scene(40)
+    mog = cv2.createBackgroundSubtractorMOG2(history=50, detectShadows=False)
+    tr = LimbTracker(P, np.random.default_rng(4), init=truth[truth.frame == 0], face_detector=False)
+    recs, fgs = [], []
+    for i, f in enumerate(frames):
+        fg = mog.apply(f, learningRate=1.0 if i == 0 else 0.05)
+        fgs.append(fg)
+        recs += tr.step(i, f, fg)
+    assert fgs[-1][14:36, 69:91].max() == 0  # the head is background for MOG2
+    out = records_to_frame(recs)
+    err, m = centre_error(out, truth)
+    heads = m.part == "head"
+    assert (out[out.part == "head"].state == "normal").all()
+    assert err[heads].max() < 3.0
+
+
+class FakeFaces:
+    """Stands in for the cascade: reports a face box at a given frame-dependent place."""
+
+    def __init__(self):
+        self.box = None
+        self.calls = 0
+
+    def detectMultiScale(self, grey, **kw):  # noqa: N802 (OpenCV's name)
+        self.calls += 1
+        return np.zeros((0, 4), int) if self.box is None else np.array([self.box])
+
+
+def test_head_whose_confidence_stays_low_is_reacquired_by_the_face_detector():
+    """The head jumps 60 px sideways (out of the particles' reach in a few frames); after
+    reacquire_frames low-confidence frames the face detector puts it back."""
+    frames, truth = clap_scene(30)
+    for t in range(10, 30):  # move the drawn head
+        f = frames[t]
+        cv2.circle(f, (80, 25), 11, BG, -1)
+        cv2.circle(f, (140, 25), 11, SKIN, -1)
+    params = LimbParams(particles=150, reacquire_frames=3, person_radius=5.0)
+    tr = LimbTracker(params, np.random.default_rng(0), init=truth[truth.frame == 0], face_detector=False)
+    faces = FakeFaces()
+    tr.face = faces
+    fg = np.full(frames[0].shape[:2], 255, np.uint8)
+    heads = []
+    for i, f in enumerate(frames):
+        faces.box = (129, 14, 22, 22) if i >= 10 else None
+        heads += [r for r in tr.step(i, f, fg) if r.part == "head"]
+    assert heads[9].box.centre[0] < 90
+    assert heads[11].box.centre[0] < 100  # not yet: the filter alone does not get there
+    assert faces.calls >= 1
+    for h in heads[14:]:  # 3 low frames (10, 11, 12), re-acquired at 12
+        assert np.hypot(*(np.array(h.box.centre) - (140, 25))) < 3.0
+    assert heads[-1].state == "normal"
