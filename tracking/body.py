@@ -36,7 +36,7 @@ from tracking.box import Box, iou_xywh
 from tracking.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from tracking.detection import person_blobs
 from tracking.frame_tracker import FailureDetector, FailureVerdict
-from tracking.histogram import to_ycc
+from tracking.lazy_ycc import LazyYcc, as_array
 from tracking.params import BodyParams
 from tracking.particle_filter import PartFilter
 from tracking.parts import BODY_PARTS
@@ -143,6 +143,7 @@ class BodyTracker:
         self.next_id = max(self.starts, default=0) + 1
         self.candidates: list[tuple[Box, int]] = []
         self.frames_seen = 0
+        self._ycc = LazyYcc()
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -167,6 +168,7 @@ class BodyTracker:
         """Start tracking a person from its boxes (person and/or part boxes)."""
         if self.frames_seen < self.params.background_warmup // 2:
             mask = None  # the background model has not learnt the scene yet: decompose by contrast
+        ycc = as_array(ycc)
         parts = self._part_boxes_for_start(boxes, ycc, mask)
         H, W = ycc.shape[:2]
         filters = {}
@@ -216,7 +218,7 @@ class BodyTracker:
     # -- one frame ----------------------------------------------------------------------
     def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None) -> list[TrackRecord]:
         p = self.params
-        ycc = to_ycc(frame)
+        ycc = self._ycc.load(frame)  # converted to YCrCb only where the filters look
         H, W = ycc.shape[:2]
         self.frame_size = (W, H)
         self.frames_seen += 1
@@ -286,7 +288,7 @@ class BodyTracker:
                 person.occluded_by = None
                 person.occluded_frames = 0
         hidden = []
-        for name, f in person.filters.items():
+        for name, f in person.filters.items() if self.occluders else ():
             b = f.predicted_box()
             if any(_overlap_fraction(b, o) >= self.params.occluder_overlap for o in self.occluders):
                 hidden.append(name)
@@ -433,7 +435,7 @@ class BodyTracker:
     def _adjust(self, person: Person, verdict: FailureVerdict, ycc: np.ndarray, mask) -> None:
         from tracking.adjustment import adjust_person
 
-        adjust_person(self, person, verdict, ycc, mask)
+        adjust_person(self, person, verdict, as_array(ycc), mask)
         person.failed = tuple(verdict.failed) if verdict.failed else (BODY_PARTS if verdict.multi else ())
         person.adjusted = True
 

@@ -24,6 +24,8 @@ from functools import lru_cache
 import cv2
 import numpy as np
 
+from tracking import kernels
+
 LEVELS = 256
 
 
@@ -45,6 +47,8 @@ def level_histogram(ycc: np.ndarray, box: tuple[int, int, int, int] | None = Non
         x, y, w, h = (int(round(v)) for v in box)
         H, W = ycc.shape[:2]
         x1, y1, x2, y2 = max(x, 0), max(y, 0), min(x + w, W), min(y + h, H)
+        if mask is None and kernels.HAVE_NUMBA:
+            return kernels.level_histogram_box(ycc, x1, y1, max(x2, x1), max(y2, y1))
         ycc = ycc[y1:max(y2, y1), x1:max(x2, x1)]
         if mask is not None:
             mask = mask[y1:max(y2, y1), x1:max(x2, x1)]

@@ -9,6 +9,10 @@ coefficient ``rho`` between a particle's equalized histogram and the target's
 (sec. 3.1); the estimate is the weighted mean; particles are then resampled
 systematically to the count of eq. (2) (entropy-adaptive, C = 1.2, 200..1000).
 
+The per-particle work runs in compiled kernels (``tracking.kernels``, numba; the numpy +
+OpenCV path remains when numba is missing); ``ycc`` is an array or a
+``tracking.lazy_ycc.LazyYcc`` converted only where the particles are.
+
 A frame is ``predict()`` then ``measure(ycc)`` (or ``coast()`` when the part is
 occluded: dynamics only, appearance frozen, sec. 4.3), then ``update_model(ycc)`` and
 ``resample()``.
@@ -18,8 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from tracking import kernels
 from tracking.box import Box
 from tracking.histogram import (
+    _smooth,
     binned_histogram,
     bhattacharyya,
     bhattacharyya_counts,
@@ -30,6 +36,7 @@ from tracking.histogram import (
     update_reference,
 )
 from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
+from tracking.lazy_ycc import as_array, cover, cover_rects
 from tracking.params import BodyParams, PartNoise
 from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
 
@@ -66,18 +73,26 @@ class PartFilter:
         self.state = box_to_state(box)
         self.state[4:6] = velocity
         self.base_size = np.array([box.w, box.h], dtype=np.float64)
+        lo, hi = self.params.size_range
+        self._size_lo = (lo * self.base_size).astype(np.float32)
+        self._size_hi = (hi * self.base_size).astype(np.float32)
         n = int(n or self.params.particles_initial)
         spread = self._sigma * np.float32(self.params.init_spread)
         self.particles = (self.state.astype(np.float32)
                           + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
         self._clip_sizes()
         self.weights = np.full(n, 1.0 / n)
-        self.reference = level_histogram(ycc, _int_box(box))
+        self.reference = _box_histogram(ycc, box)
         self._refresh_map()
         self.similarity = 1.0
 
     def _refresh_map(self) -> None:
         p = self.params
+        if kernels.HAVE_NUMBA:
+            smoothed = _smooth(np.asarray(self.reference, dtype=np.float64), p.equalization_smoothing)
+            self.mapping, self.target, self.sqrt_target = kernels.equalize(
+                smoothed, self.reference, p.bins_per_channel, p.equalization_floor)
+            return
         self.mapping = equalization_map(self.reference, p.bins_per_channel, p.equalization_smoothing,
                                         p.equalization_floor)
         self.lut = fused_lut(self.mapping, p.bins_per_channel)
@@ -87,10 +102,9 @@ class PartFilter:
         self.sqrt_target = np.sqrt(per_channel).reshape(-1)
 
     def _clip_sizes(self) -> None:
-        lo, hi = self.params.size_range
         wh = self.particles[:, 2:4]
-        np.maximum(wh, (lo * self.base_size).astype(np.float32), out=wh)
-        np.minimum(wh, (hi * self.base_size).astype(np.float32), out=wh)
+        np.maximum(wh, self._size_lo, out=wh)
+        np.minimum(wh, self._size_hi, out=wh)
 
     # -- one frame --------------------------------------------------------------------
     @property
@@ -110,9 +124,13 @@ class PartFilter:
     def predict(self) -> None:
         """Constant-velocity motion plus process noise (seed 002 sec. 3)."""
         p = self.particles
+        noise = kernels.standard_normal(self.rng, p.shape)
+        if kernels.HAVE_NUMBA:
+            kernels.drift(p, noise, self._sigma, self._size_lo, self._size_hi)
+            return
         p[:, 0] += p[:, 4]
         p[:, 1] += p[:, 5]
-        p += self.rng.standard_normal(p.shape, dtype=np.float32) * self._sigma
+        p += noise * self._sigma
         self._clip_sizes()
 
     def predicted_box(self) -> Box:
@@ -131,14 +149,15 @@ class PartFilter:
         body's axis (the torso's centre line) instead of following a look-alike part of
         someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
         relative to the torso near the one it started with."""
-        H, W = ycc.shape[:2]
-        rects = particle_rectangles(self.particles, W, H)
-        stride = self._stride()
-        counts = rectangle_histograms(ycc, self.lut, rects, stride)
-        areas = sampled_areas(rects, stride)
-        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        _, rho, areas = self._similarities(ycc, self.particles)
+        if kernels.HAVE_NUMBA:
+            ax, sx = (float(anchor_x), float(anchor_sigma)) if anchor_x is not None else (0.0, 0.0)
+            ay, sy = (float(anchor_y), float(anchor_sigma_y)) if anchor_y is not None else (0.0, 0.0)
+            self.weights, self.state = kernels.weigh(self.particles, rho, areas, float(self.noise.lam),
+                                                     ax, sx, ay, sy)
+            return
         weights = likelihood(rho, self.noise.lam)
-        weights[areas * (stride * stride) < 4] = 0.0
+        weights[areas < 4] = 0.0
         if anchor_x is not None and anchor_sigma > 0:
             weights *= np.exp(-0.5 * ((self.particles[:, 0] - anchor_x) / anchor_sigma) ** 2)
         if anchor_y is not None and anchor_sigma_y > 0:
@@ -153,16 +172,28 @@ class PartFilter:
         hidden person shows again away from where its dynamics put it."""
         cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
         cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
-        H, W = ycc.shape[:2]
-        rects = particle_rectangles(cand, W, H)
-        stride = self._stride()
-        counts = rectangle_histograms(ycc, self.lut, rects, stride)
-        areas = sampled_areas(rects, stride)
-        rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        rects, rho, _ = self._similarities(ycc, cand)
         full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
         rho[full < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
         k = int(np.argmax(rho))
         return cand[k].astype(np.float64), float(rho[k])
+
+    def _similarities(self, ycc: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Rectangles ``(N, 4) int32``, Bhattacharyya coefficients ``(N,)`` with the model and
+        areas ``(N,)`` (pixels, a sampled pixel standing for ``stride**2``) of ``states``: one
+        integral histogram over the region they cover (compiled kernel, or numpy + OpenCV)."""
+        H, W = ycc.shape[:2]
+        stride = self._stride()
+        if kernels.HAVE_NUMBA:
+            rects = kernels.rectangles(states, W, H)
+            pixels = cover_rects(ycc, rects)
+            rho, areas = kernels.rectangle_rho(pixels, self.mapping, rects, stride, self.sqrt_target)
+        else:
+            rects = particle_rectangles(states, W, H)
+            counts = rectangle_histograms(as_array(ycc), self.lut, rects, stride)
+            areas = sampled_areas(rects, stride)
+            rho = bhattacharyya_counts(counts, areas, self.sqrt_target)
+        return rects, rho, areas * (stride * stride)
 
     def shift(self, delta: np.ndarray) -> None:
         """Move the estimate and every particle by ``delta`` (dx, dy)."""
@@ -178,9 +209,14 @@ class PartFilter:
         """Dynamics only (occlusion, sec. 4.3.1-4.3.2): the estimate moves by its velocity and
         the particles are re-centred on it, so the cloud does not drift or spread."""
         self.state[0:2] += self.state[4:6]
-        self.particles[:, :] = self.state.astype(np.float32)
-        self.particles += self.rng.standard_normal(self.particles.shape, dtype=np.float32) * self._sigma
-        self._clip_sizes()
+        noise = kernels.standard_normal(self.rng, self.particles.shape)
+        if kernels.HAVE_NUMBA:
+            kernels.scatter(self.particles, self.state.astype(np.float32), noise, self._sigma, self._size_lo,
+                            self._size_hi)
+        else:
+            self.particles[:, :] = self.state.astype(np.float32)
+            self.particles += noise * self._sigma
+            self._clip_sizes()
         self.weights = np.full(self.n, 1.0 / self.n)
 
     def set_velocity(self, velocity: np.ndarray) -> None:
@@ -191,10 +227,12 @@ class PartFilter:
 
     def appearance(self, ycc: np.ndarray) -> np.ndarray:
         """``Q_t``: the 256-level histogram ``(3, 256)`` of the current estimate's rectangle."""
-        return level_histogram(ycc, _int_box(self.box))
+        return _box_histogram(ycc, self.box)
 
     def score(self, observed: np.ndarray) -> float:
         """Bhattacharyya coefficient of a 256-level histogram with this part's model."""
+        if kernels.HAVE_NUMBA:
+            return float(kernels.similarity(observed, self.mapping, self.sqrt_target))
         b = self.params.bins_per_channel
         return float(bhattacharyya(binned_histogram(observed, self.mapping, b), self.target, b))
 
@@ -206,10 +244,21 @@ class PartFilter:
     def resample(self) -> None:
         """Systematic resampling to the entropy-adaptive count of seed 002 eq. (2)."""
         p = self.params
+        if kernels.HAVE_NUMBA:  # the weights are normalised (measure, coast, reseed)
+            self.particles, self.weights = kernels.resample(self.particles, self.weights, p.particles_c,
+                                                            p.particles_min, p.particles_max, self.rng.random())
+            return
         n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
         idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)
+
+
+def _box_histogram(ycc, box: Box) -> np.ndarray:
+    """256-level histogram ``(3, 256)`` of ``box`` (rounded to whole pixels) in ``ycc`` (an
+    array or a :class:`tracking.lazy_ycc.LazyYcc`)."""
+    x, y, w, h = _int_box(box)
+    return level_histogram(cover(ycc, x, y, x + w, y + h), (x, y, w, h))
 
 
 def _int_box(box: Box) -> tuple[int, int, int, int]:

@@ -30,7 +30,14 @@ def test_state_box_round_trip():
     assert state_to_box(s) == b
 
 
-def test_filter_follows_a_moving_rectangle():
+@pytest.mark.parametrize("compiled", [True, False], ids=["numba", "numpy"])
+def test_filter_follows_a_moving_rectangle(compiled, monkeypatch):
+    from tracking import kernels
+    from tracking.lazy_ycc import LazyYcc
+
+    if compiled and not kernels.HAVE_NUMBA:
+        pytest.skip("numba not installed")
+    monkeypatch.setattr(kernels, "HAVE_NUMBA", compiled)  # False: the numpy + OpenCV fallback
     rng = np.random.default_rng(0)
     params = BodyParams(particles_initial=300)
     noise = PartNoise(x=3, y=3, w=0.5, h=0.5, vx=0.5, vy=0.5, lam=20)
@@ -41,7 +48,7 @@ def test_filter_follows_a_moving_rectangle():
     for t in range(40):
         cx += 2.0  # 2 px per frame to the right
         cy += 0.5 * np.sin(t / 5)
-        ycc = to_ycc(_frame(rng, cx, cy))
+        ycc = LazyYcc(_frame(rng, cx, cy))  # converted where the particles are (all of it without numba)
         pf.predict()
         pf.measure(ycc)
         pf.update_model(pf.appearance(ycc))
