@@ -11,6 +11,13 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field, fields
 
 
+def _refuse_unknown(cls, data: dict, what: str) -> None:
+    """A saved parameter this version does not know is an error, not something to drop."""
+    unknown = set(data) - {f.name for f in fields(cls)}
+    if unknown:
+        raise ValueError(f"unknown {what} parameter(s): {', '.join(sorted(unknown))}")
+
+
 @dataclass(frozen=True)
 class PartNoise:
     """Process-noise standard deviations of the constant-velocity state
@@ -172,10 +179,7 @@ class BodyParams:
 
     @classmethod
     def from_dict(cls, data: dict) -> "BodyParams":
-        known = {f.name for f in fields(cls)}
-        unknown = set(data) - known
-        if unknown:
-            raise ValueError(f"unknown body parameter(s): {', '.join(sorted(unknown))}")
+        _refuse_unknown(cls, data, "body")
         data = dict(data)
         if "part_noise" in data:
             data["part_noise"] = {k: PartNoise(**v) for k, v in data["part_noise"].items()}
@@ -285,8 +289,5 @@ class LimbParams:
 
     @classmethod
     def from_dict(cls, data: dict) -> "LimbParams":
-        known = {f.name for f in fields(cls)}
-        unknown = set(data) - known
-        if unknown:
-            raise ValueError(f"unknown limb parameter(s): {', '.join(sorted(unknown))}")
+        _refuse_unknown(cls, data, "limb")
         return cls(**data)

@@ -143,6 +143,16 @@ def select_frames(df: pd.DataFrame, every: int) -> np.ndarray:
     return frames[frames % every == 0]
 
 
+def thinned_tracks(tracks_df: pd.DataFrame, info: VideoInfo, video_path, every: int, out_dir
+                   ) -> tuple[pd.DataFrame, np.ndarray]:
+    """What every exporter starts with: the checked tracks of the kept frames, the kept frame
+    indexes, and the output directory made."""
+    df = prepare_tracks(tracks_df, info, video_path)
+    keep = select_frames(df, every)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    return df[df["frame"].isin(keep)], keep
+
+
 def parse_mapping(mapping: str | dict | None) -> dict[str, str]:
     """Label mapping from a dict, a JSON object or ``"their=ours,..."``; values must be part names.
 

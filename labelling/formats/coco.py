@@ -20,7 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 from labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    prepare_tracks, select_frames)
+                                    thinned_tracks)
 from labelling.formats.frames import frame_name, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
@@ -31,10 +31,7 @@ FILE_NAME = "annotations.json"
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
-    df = prepare_tracks(df, info, video_path)
-    keep = select_frames(df, every)
-    df = df[df["frame"].isin(keep)]
-    out_dir.mkdir(parents=True, exist_ok=True)
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     images = [{"id": int(f) + 1, "file_name": f"{frame_name(f)}.jpg", "width": info.width,
                "height": info.height, "frame_id": int(f)} for f in keep]
     categories = [{"id": i + 1, "name": p, "supercategory": "person"} for i, p in enumerate(PART_NAMES)]

@@ -24,7 +24,7 @@ from defusedxml import ElementTree as SafeET
 from defusedxml.common import DefusedXmlException
 
 from labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    prepare_tracks, select_frames)
+                                    thinned_tracks)
 from labelling.formats.frames import all_frames, frame_name, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
@@ -93,10 +93,7 @@ def _box(track: ET.Element, r, *, outside: bool) -> None:
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
-    df = prepare_tracks(df, info, video_path)
-    keep = select_frames(df, every)
-    df = df[df["frame"].isin(keep)]
-    out_dir.mkdir(parents=True, exist_ok=True)
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     root = ET.Element("annotations")
     ET.SubElement(root, "version").text = "1.1"
     _meta(root, info, every)

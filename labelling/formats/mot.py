@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    prepare_tracks, select_frames)
+                                    thinned_tracks)
 from labelling.formats.frames import all_frames, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
@@ -46,10 +46,7 @@ def _num(v: float) -> str:
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
-    df = prepare_tracks(df, info, video_path)
-    keep = select_frames(df, every)
-    df = df[df["frame"].isin(keep)]
-    out_dir.mkdir(parents=True, exist_ok=True)
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     (out_dir / "gt").mkdir(exist_ok=True)
     part_index = df["part"].map({p: i for i, p in enumerate(PART_NAMES)}).to_numpy()
     ids = mot_id(df["track_id"].to_numpy(), part_index)

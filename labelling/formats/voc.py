@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from labelling.formats.base import ExportManifest, prepare_tracks, select_frames
+from labelling.formats.base import ExportManifest, thinned_tracks
 from labelling.formats.frames import frame_name, write_frames
 from labelling.formats.yolo import clipped_xyxy
 from labelling.video import VideoInfo
@@ -48,9 +48,7 @@ def _object(ann: ET.Element, r, box: np.ndarray, truncated: bool) -> None:
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
-    df = prepare_tracks(df, info, video_path)
-    keep = select_frames(df, every)
-    df = df[df["frame"].isin(keep)]
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     for sub in ("Annotations", "JPEGImages", "ImageSets/Main"):
         (out_dir / sub).mkdir(parents=True, exist_ok=True)
     xyxy = clipped_xyxy(df, info.width, info.height)

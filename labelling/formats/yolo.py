@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from labelling.formats.base import ExportManifest, prepare_tracks, select_frames
+from labelling.formats.base import ExportManifest, thinned_tracks
 from labelling.formats.frames import frame_name, write_frames
 from labelling.video import VideoInfo
 from tracking.parts import PART_NAMES
@@ -35,9 +35,7 @@ def clipped_xyxy(df: pd.DataFrame, width: int, height: int) -> np.ndarray:
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
-    df = prepare_tracks(df, info, video_path)
-    keep = select_frames(df, every)
-    df = df[df["frame"].isin(keep)]
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     labels_dir = out_dir / "labels" / SUBSET
     labels_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "images" / SUBSET).mkdir(parents=True, exist_ok=True)
