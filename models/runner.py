@@ -33,6 +33,8 @@ def run_body_tracker(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], fps
     return records_to_frame(records) if records else empty_tracks()
 
 
-def body_tracker_runner(frames, fps: float, init: pd.DataFrame, seed: int) -> pd.DataFrame:
-    """:data:`models.training.TrackerRunner` with default parameters and no failure detector."""
-    return run_body_tracker(frames, fps, init, seed)
+def body_tracker_runner(frames, fps: float, init: pd.DataFrame, seed: int, params: BodyParams | None = None,
+                        failure_detector=None) -> pd.DataFrame:
+    """:data:`models.training.TrackerRunner`: default parameters and no failure detector
+    unless given (validation, :mod:`models.selection`, passes both)."""
+    return run_body_tracker(frames, fps, init, seed, params=params, failure_detector=failure_detector)

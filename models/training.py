@@ -17,6 +17,11 @@ Samples for the four SVMs come from three sources:
 The variance parameters are fitted from the truth (:mod:`models.variance`), the
 colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
 (:mod:`models.sharpness`; only where the body tracker's histograms are installed).
+
+With the tracker, every fitted component (noise and ``lam``, output extent, SVM
+detector) is then validated on the training clips (:mod:`models.selection`) and kept
+only if it raises the tracking rate there; the summary's ``selection`` records the
+scores and decisions.
 """
 
 from __future__ import annotations
@@ -38,7 +43,8 @@ from tracking.tracks import normalise_tracks
 
 FramesFactory = Callable[[], Iterator[tuple[int, np.ndarray]]]
 Clip = tuple[FramesFactory, float, pd.DataFrame]
-#: ``runner(frames_factory, fps, init, seed) -> tracks DataFrame`` of the body tracker.
+#: ``runner(frames_factory, fps, init, seed, params=None, failure_detector=None) -> tracks DataFrame``
+#: of the body tracker (``params=None``: built-in parameters).
 TrackerRunner = Callable[[FramesFactory, float, pd.DataFrame, int], pd.DataFrame]
 
 
@@ -97,7 +103,7 @@ def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None
     """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
     if with_sharpness is None:
         with_sharpness = sharpness_available()
-    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1
+    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
 
 
 def _apply_lam(body: BodyParams, table: pd.DataFrame,
@@ -125,7 +131,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
                  tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
                  perturbed_per_person: int = 300, body: BodyParams | None = None,
                  limb: LimbParams | None = None, dt: float = DEFAULT_DT,
-                 fit_sharpness: bool | None = None) -> Bundle:
+                 fit_sharpness: bool | None = None, validate: bool = True) -> Bundle:
     """Fit the four failure SVMs and the variance parameters from corrected clips.
 
     ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
@@ -133,6 +139,9 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     perturbed-truth and hand-flag samples are used; the summary records how many of
     each. ``progress`` is called once per step with a short description.
     ``fit_sharpness`` (default: when available) decodes each clip once more to fit ``lam``.
+    ``validate`` (with ``tracker_runner``): keep each fitted component only if it does not
+    lower the tracking rate on the training clips (:func:`models.selection.select_components`;
+    up to three more tracker runs per clip); without it, everything fitted is used.
     """
     if not clips:
         raise ValueError("no clips to train from")
@@ -209,6 +218,28 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         body_p = replace(body_p, output_extent=fit_output_extent([t for t, _ in tracked_runs],
                                                                  [g for _, g in tracked_runs], current))
     detector = SVMFailureDetector(models, dt=dt) if models else None
+    selection = None
+    if tracked_runs and validate:
+        from models.selection import select_components
+
+        base = body or BodyParams()
+        inits = [first_boxes(g) for g in truths]
+
+        def run(i, params, det):
+            return tracker_runner(clips[i][0], clips[i][1], inits[i], seed + i, params=params, failure_detector=det)
+
+        fitted = replace(base, part_noise=body_p.part_noise, output_extent=body_p.output_extent)
+        chosen = select_components(run, truths, base, fitted, detector,
+                                   base_tracks=[t for t, _ in tracked_runs] if body is None else None,
+                                   progress=step)
+        body_p = replace(body_p, part_noise=chosen.body_params.part_noise,
+                         output_extent=chosen.body_params.output_extent)
+        detector = chosen.failure_detector
+        selection = chosen.to_dict()
+        selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output_extent.items()}
+        if not chosen.kept["noise"]:  # the table's "applied" says what the bundle uses
+            body_rows = table["tracker"] == "body"
+            table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]
     summary = {
         "seed": seed,
         "clips": clip_info,
@@ -220,6 +251,8 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         "output_extent": {k: list(v) for k, v in body_p.output_extent.items()},
         "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
     }
+    if selection is not None:
+        summary["selection"] = selection
     return Bundle(body_p, limb_p, detector, summary)
 
 

@@ -83,6 +83,11 @@ def main(argv=None) -> int:
     print(f"wrote {out} in {time.time() - t0:.0f} s; samples {bundle.summary['samples']}")
     print(report_table({n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}))
     print(comparison_table(pd.DataFrame(bundle.summary["variances"])))
+    if "selection" in bundle.summary:
+        from models.selection import selection_table
+
+        print("validation on the training clips (a component is kept only if it raises the mean rate):")
+        print(selection_table(bundle.summary["selection"]))
     return 0
 
 

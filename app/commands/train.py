@@ -2,7 +2,8 @@
 
 Fits the four failure SVMs and the variance parameters from corrected clips
 (:func:`models.training.train_bundle`), writes a model bundle and prints the
-cross-validation table and the fitted-vs-default variances.
+cross-validation table, the fitted-vs-default variances and which fitted components
+validation on the training clips kept (:mod:`models.selection`).
 """
 
 from __future__ import annotations
@@ -86,6 +87,13 @@ def run(args) -> int:
 
         print("\nreported box extent per part (fitted vs default: scale of the tracked inner rectangle, "
               "shift in its size):")
-        table = extent_table(bundle.body_params.output_extent, BodyParams().output_extent)
+        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output_extent)
+        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output_extent)
         print(table.pivot(index="part", columns="term", values="fitted").round(3).to_string())
+    if "selection" in bundle.summary:
+        from models.selection import selection_table
+
+        print("\nvalidation on the training clips (tracking rate per part; a component is kept only if it "
+              "raises the mean):")
+        print(selection_table(bundle.summary["selection"]))
     return 0

@@ -117,34 +117,28 @@ def test_same_bundle_gives_the_same_bytes(bundle, tmp_path):
         assert (a / f).read_bytes() == (b / f).read_bytes(), f
 
 
-def test_default_bundle_ships_and_judges_the_body_trackers_output():
-    from labelling.synth import make_scene
+def test_default_bundle_ships_and_keeps_only_what_validation_approved():
     from models.bundle import default_bundle
-    from models.features import person_histories
-    from models.labels import POSITIVE
-    from models.runner import run_body_tracker
-    from models.training import first_boxes, tracker_samples
+    from tracking.params import BodyParams
 
     b = default_bundle()
-    assert set(b.failure_detector.models) == {"head", "torso", "hipleg", "multi"}
-    assert b.failure_detector.persist == 3
     r = b.summary["svms"]["torso"]
     assert r["tnr"] >= 0.95 or r["tpr"] >= 0.95
     assert {c["name"] for c in b.summary["clips"]} >= {"single-101", "crowd-104"}
     assert b.summary["samples"]["tracker"] > 0
-    scene = make_scene("single", seed=7, n_frames=60)
-    frames = lambda: ((i, scene.frames[i]) for i in range(len(scene.frames)))  # noqa: E731
-    tracked = run_body_tracker(frames, scene.fps, first_boxes(scene.truth), 0, b.body_params)
-    x, y = tracker_samples(tracked, scene.truth, scene.fps)
-    scores = b.failure_detector.part_scores(x)
-    good = y == POSITIVE
-    # the tracker's correct parts are (almost) never flagged
-    assert good.sum() > 100 and np.mean(scores[good] < 0) < 0.1
-    _f, hist = person_histories(tracked)[1]
-    bad = hist[:30].copy()
-    bad[-10:, 1, :2] = bad[-10, 1, :2] + [0.0, -1.2 * bad[-10, 1, 3]]   # torso stuck above the head
-    v = b.failure_detector.detect(bad, scene.fps)
-    assert v.failed and ("torso" in v.failed or v.multi)
+    sel = b.summary["selection"]
+    assert set(sel["kept"]) == {"noise", "extent", "detector"}
+    scores = sel["scores"]
+    assert 0.5 < scores["builtin"]["mean"] <= 1.0
+    # every component it uses scored above the built-in parameters on the training clips
+    if not sel["kept"]["noise"]:
+        assert b.body_params.part_noise == BodyParams().part_noise
+        assert scores["+noise"]["mean"] <= scores["builtin"]["mean"]
+    if not sel["kept"]["extent"]:
+        assert b.body_params.output_extent == BodyParams().output_extent
+    assert (b.failure_detector is not None) == sel["kept"]["detector"]
+    if b.failure_detector is not None:
+        assert set(b.failure_detector.models) == {"head", "torso", "hipleg", "multi"}
 
 
 def test_a_bundle_applies_what_was_learned_over_the_installed_defaults(tmp_path):

@@ -1,0 +1,140 @@
+"""Keep a learned component only if it does not make tracking worse on the training clips.
+
+Fitting the noise, ``lam``, the output extent and the failure SVMs each optimises its own
+criterion (likelihood, median ratios, cross-validated TNR), none of which is the tracking
+rate; measured on the synthetic suite, the fitted parameters tracked worse than the
+built-in ones (README, "Learning from corrections"). So, as a careful pipeline would,
+after fitting every component is validated on the training clips themselves: the body
+tracker is re-run from the truth's first boxes with the components added one at a time,
+
+    (a) built-in parameters -> (b) + fitted noise and lam -> (c) + fitted output extent
+    -> (d) + the SVM failure detector (adjustment, seed 002 sec. 4.3),
+
+and a component is kept only if the mean per-part rate (head, torso, hip-leg) rises
+strictly above the best so far; a tie keeps the simpler model. The rate is seed 002
+sec. 5.2's: a box is right when at least half of it lies on the true box and its centre
+is inside it (:func:`models.labels.label_states`), averaged over every frame after a
+track's first, per clip, then over clips.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Callable
+
+import numpy as np
+import pandas as pd
+
+from models.features import BODY_PARTS
+from models.labels import POSITIVE, label_states
+from tracking.params import BodyParams
+
+#: ``run(clip_index, params, detector) -> tracks DataFrame`` of the body tracker on a training clip.
+ValidationRun = Callable[[int, BodyParams, object], pd.DataFrame]
+#: components in the order they are tried, and the BodyParams fields each one brings
+COMPONENTS: tuple[str, ...] = ("noise", "extent", "detector")
+_FIELDS = {"noise": ("part_noise",), "extent": ("output_extent",)}
+
+
+def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
+    return np.stack([d["x" + sfx] + d["w" + sfx] / 2, d["y" + sfx] + d["h" + sfx] / 2, d["w" + sfx], d["h" + sfx]],
+                    axis=1)
+
+
+def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
+    """Per part, the fraction of truth boxes after each track's first frame that the
+    tracker got right (a missing tracked box counts as wrong; no truth -> nan)."""
+    first = truth.groupby("track_id")["frame"].min().rename("f0")
+    out = {}
+    for part in BODY_PARTS:
+        t = truth[truth.part == part].join(first, on="track_id")
+        t = t[t.frame > t.f0]
+        r = tracks[tracks.part == part][["track_id", "frame", "x", "y", "w", "h"]]
+        m = t.merge(r, on=["track_id", "frame"], how="left", suffixes=("_t", ""))
+        have = m["x"].notna().to_numpy()
+        ok = np.zeros(len(m), bool)
+        if have.any():
+            mm = m[have]
+            ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
+        out[part] = float(ok.mean()) if len(ok) else float("nan")
+    return out
+
+
+def mean_rates(per_clip: list[dict[str, float]]) -> dict[str, float]:
+    """Per-part rates averaged over clips (nan-aware) and their mean over parts (``"mean"``)."""
+    out = {p: float(np.nanmean([c[p] for c in per_clip])) if per_clip else float("nan") for p in BODY_PARTS}
+    out["mean"] = float(np.nanmean([out[p] for p in BODY_PARTS]))
+    return out
+
+
+@dataclass(frozen=True)
+class Selection:
+    """What validation kept: the parameters, the detector (or None) and the record."""
+
+    body_params: BodyParams
+    failure_detector: object | None
+    kept: dict[str, bool] = field(default_factory=dict)
+    #: condition name -> {"head", "torso", "hipleg", "mean"} validation rates
+    scores: dict[str, dict[str, float]] = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        return {"kept": dict(self.kept), "scores": {k: dict(v) for k, v in self.scores.items()},
+                "order": ["builtin", *COMPONENTS],
+                "rule": "a component is kept only if the mean per-part rate on the training clips rises "
+                        "strictly above the best so far (ties keep the simpler)"}
+
+
+def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: BodyParams, fitted: BodyParams,
+                      detector=None, base_tracks: list[pd.DataFrame] | None = None,
+                      progress: Callable[[str], None] | None = None) -> Selection:
+    """Add the fitted noise (incl. ``lam``), output extent and ``detector`` to ``base`` one at
+    a time, keeping each only if it raises the mean per-part rate on the training clips.
+
+    ``run(i, params, detector)`` tracks training clip ``i``; ``truths[i]`` is its truth.
+    ``base_tracks`` (optional): the tracks of ``base`` without a detector, if already run
+    (training runs exactly that), to save one run per clip.
+    """
+    step = progress or (lambda _msg: None)
+
+    def score(params, det, name, tracks=None):
+        step(f"validating {name}")
+        if tracks is None:
+            tracks = [run(i, params, det) for i in range(len(truths))]
+        return mean_rates([part_rates(t, g) for t, g in zip(tracks, truths)])
+
+    scores = {"builtin": score(base, None, "built-in", base_tracks)}
+    best, best_params, best_det = scores["builtin"]["mean"], base, None
+    kept = {}
+    for comp in COMPONENTS:
+        if comp == "detector":
+            if detector is None:
+                kept[comp] = False
+                continue
+            params, det = best_params, detector
+        else:
+            params = replace(best_params, **{f: getattr(fitted, f) for f in _FIELDS[comp]})
+            det = best_det
+            if all(getattr(params, f) == getattr(best_params, f) for f in _FIELDS[comp]):
+                kept[comp] = False  # nothing fitted: the same model, no run needed
+                continue
+        scores[f"+{comp}"] = s = score(params, det, comp)
+        kept[comp] = bool(s["mean"] > best)
+        if kept[comp]:
+            best, best_params, best_det = s["mean"], params, det
+    return Selection(best_params, best_det, kept, scores)
+
+
+def selection_table(selection: dict) -> str:
+    """The validation scores and decisions of a bundle summary's ``selection``, as text."""
+    rows = []
+    scores = selection.get("scores", {})
+    order = ["builtin", *(f"+{c}" for c in COMPONENTS)]
+    for name, s in sorted(scores.items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order)):
+        comp = name.lstrip("+")
+        decision = "baseline" if name == "builtin" else ("kept" if selection["kept"].get(comp) else "dropped")
+        rows.append(dict(condition=name, **{k: round(s[k], 3) for k in (*BODY_PARTS, "mean") if k in s},
+                         decision=decision))
+    for comp, k in selection.get("kept", {}).items():
+        if f"+{comp}" not in scores:
+            rows.append(dict(condition=f"+{comp}", decision="not fitted"))
+    return pd.DataFrame(rows).to_string(index=False, na_rep="-") if rows else "(no validation)"
