@@ -89,6 +89,11 @@ def main(argv=None) -> int:
     clips, names, _ = scene_clips(RETRAIN_SCENES)
     retrained = train_bundle(clips, seed=1, tracker_runner=None if args.fast else body_tracker_runner, names=names)
     print(f"  done in {time.time() - t0:.0f} s")
+    if "selection" in retrained.summary:
+        from models.selection import selection_table
+
+        print("  validation on its training clips (components kept only if they raise the mean rate):")
+        print("  " + selection_table(retrained.summary["selection"]).replace("\n", "\n  "))
     conditions = {
         "none": (default.body_params, None),
         "default": (default.body_params, default.failure_detector),
