@@ -62,8 +62,12 @@ def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
 
 def mean_rates(per_clip: list[dict[str, float]]) -> dict[str, float]:
     """Per-part rates averaged over clips (nan-aware) and their mean over parts (``"mean"``)."""
-    out = {p: float(np.nanmean([c[p] for c in per_clip])) if per_clip else float("nan") for p in BODY_PARTS}
-    out["mean"] = float(np.nanmean([out[p] for p in BODY_PARTS]))
+    def nanmean(values) -> float:  # a part no clip shows (a seated person's hip-leg) stays nan, quietly
+        values = [v for v in values if not np.isnan(v)]
+        return float(np.mean(values)) if values else float("nan")
+
+    out = {p: nanmean([c[p] for c in per_clip]) for p in BODY_PARTS}
+    out["mean"] = nanmean([out[p] for p in BODY_PARTS])
     return out
 
 
