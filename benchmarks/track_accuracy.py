@@ -7,6 +7,11 @@ their initialisation; the mean rate averages over every (person, frame) pair.
     python benchmarks/track_accuracy.py                       # synthetic suite + PETS09-S2L1
     python benchmarks/track_accuracy.py --skip-pets --scenarios single,pillar
     python benchmarks/track_accuracy.py --skip-synth --pets-video V.avi --pets-truth gt.csv
+    python benchmarks/track_accuracy.py --skip-synth --skip-pets --limbs-seeds 0,1,2,3   # limbs table only
+
+The limbs table (issue 4) comes from ``benchmarks/track_accuracy_limbs.py``: head, left and right
+hand rates of the limb tracker at frame 105 on the synthetic desk and walker (``single``) scenes
+over ``--limbs-seeds``, and the identity swaps of the hands after the clap.
 
 Synthetic scenes come from ``labelling.synth.make_scene`` (started from their ``init``);
 PETS09-S2L1 (``../shared/data/pets09_s2l1_vtest``; PETS 2009, University of Reading, truth by
@@ -183,6 +188,8 @@ def main() -> None:
     ap.add_argument("--pets-frames", type=int, default=None, help="only the first N frames of PETS")
     ap.add_argument("--skip-synth", action="store_true")
     ap.add_argument("--skip-pets", action="store_true")
+    ap.add_argument("--limbs-seeds", default="0,1,2", help="seeds of the limbs table (720x480)")
+    ap.add_argument("--skip-limbs", action="store_true")
     a = ap.parse_args()
     if not a.skip_synth:
         synth_suite([s for s in a.scenarios.split(",") if s], a.seed, a.frames)
@@ -191,6 +198,19 @@ def main() -> None:
             pets(a.pets_video, a.pets_truth, a.pets_frames)
         else:
             print(f"PETS09-S2L1 not found at {a.pets_video}; skipped")
+    if not a.skip_limbs:
+        limbs_suite([int(v) for v in a.limbs_seeds.split(",") if v], a.frames)
+
+
+def limbs_suite(seeds: list[int], n_frames: int) -> None:
+    """The limb tracker's table (issue 4), from ``track_accuracy_limbs.limbs_table``."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from track_accuracy_limbs import limbs_table
+
+    _, summary = limbs_table(("desk", "single"), seeds, n_frames, 720, 480, AT)
+    print(f"\nLimb tracker (synthetic 720x480, {n_frames} frames, seeds {seeds}, from --init); rate at frame "
+          f"{AT} / mean, hand swaps after the clap:")
+    print(summary.reset_index().to_string(index=False, float_format=lambda v: f"{v:.2f}"))
 
 
 if __name__ == "__main__":

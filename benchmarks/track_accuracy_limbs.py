@@ -130,9 +130,40 @@ def clap_end(truth: pd.DataFrame, gap: float) -> int:
     return max(frames) if frames else -1
 
 
-def main() -> None:
+def limbs_table(scenarios=("desk", "single"), seeds=(0, 1, 2), n_frames: int = 150, width: int = 320,
+                height: int = 240, at: int = 105, params: LimbParams | None = None,
+                fg: str = "model") -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Per (scenario, seed, part) rows and the per (scenario, part) summary (rate at ``at``, mean
+    rate, swaps after the clap); ``benchmarks/track_accuracy.py`` prints the summary as its limbs table."""
     from labelling.synth import make_scene
 
+    params = params or LimbParams()
+    rows = []
+    for name in scenarios:
+        for seed in tqdm(seeds, desc=name):
+            scene = make_scene(name, seed, n_frames, width, height)
+            out, events = run_scene(scene, params, seed, fg)
+            m = score(out, scene.truth)
+            hands = m[m.part.isin(["left_hand", "right_hand"])]
+            gap = float(np.median(hands.w_t)) * 1.5 if len(hands) else 0.0
+            end = clap_end(scene.truth, gap)
+            for part in LIMB_PARTS:
+                mp = m[m.part == part]
+                at_rows = mp[mp.frame == at]
+                rows.append({"scenario": name, "seed": seed, "part": part,
+                             f"rate@{at}": at_rows.correct.mean() if len(at_rows) else np.nan,
+                             "rate_all": mp.correct.mean() if len(mp) else np.nan,
+                             "swaps_after_clap": hand_swaps(m, end) if end >= 0 and part == "left_hand" else 0,
+                             "clap_end": end, "events": len(events),
+                             "lost_frames": int((mp.state == "lost").sum())})
+    df = pd.DataFrame(rows)
+    summary = df.groupby(["scenario", "part"]).agg(
+        **{f"rate@{at}": (f"rate@{at}", "mean"), "rate_all": ("rate_all", "mean"),
+           "swaps": ("swaps_after_clap", "sum")})
+    return df, summary
+
+
+def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenarios", nargs="+", default=["desk", "single"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[0, 1, 2])
@@ -146,31 +177,11 @@ def main() -> None:
                          "lands) or the scene's empty-room plate")
     args = ap.parse_args()
     params = LimbParams.from_dict({**LimbParams().to_dict(), **json.loads(args.params)})
-    rows = []
-    for name in args.scenarios:
-        for seed in tqdm(args.seeds, desc=name):
-            scene = make_scene(name, seed, args.frames, args.width, args.height)
-            out, events = run_scene(scene, params, seed, args.fg)
-            m = score(out, scene.truth)
-            hands = m[m.part.isin(["left_hand", "right_hand"])]
-            gap = float(np.median(hands.w_t)) * 1.5 if len(hands) else 0.0
-            end = clap_end(scene.truth, gap)
-            for part in LIMB_PARTS:
-                mp = m[m.part == part]
-                at = mp[mp.frame == args.at]
-                rows.append({"scenario": name, "seed": seed, "part": part,
-                             f"rate@{args.at}": at.correct.mean() if len(at) else np.nan,
-                             "rate_all": mp.correct.mean() if len(mp) else np.nan,
-                             "swaps_after_clap": hand_swaps(m, end) if end >= 0 and part == "left_hand" else 0,
-                             "clap_end": end, "events": len(events),
-                             "lost_frames": int((mp.state == "lost").sum())})
-    df = pd.DataFrame(rows)
+    df, summary = limbs_table(args.scenarios, args.seeds, args.frames, args.width, args.height, args.at,
+                              params, args.fg)
     pd.set_option("display.width", 160)
     print(df.to_string(index=False, float_format="%.3f"))
     print()
-    summary = df.groupby(["scenario", "part"]).agg(
-        **{f"rate@{args.at}": (f"rate@{args.at}", "mean"), "rate_all": ("rate_all", "mean"),
-           "swaps": ("swaps_after_clap", "sum")})
     print(summary.to_string(float_format="%.3f"))
 
 

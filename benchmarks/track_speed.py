@@ -9,6 +9,9 @@ frame for all people, measured on the first ``--mil-frames`` frames).
     python benchmarks/track_speed.py
     python benchmarks/track_speed.py --walkers 1,4 --frames 60 --skip-pets
 
+Then the limb tracker's rows (issue 4) with 1 and 4 people, from
+``benchmarks/track_speed_limbs.py`` (``--skip-limbs`` to leave them out).
+
 Numbers depend on the machine and its load: read the ratios. The walkers come from
 ``labelling.synth`` (a benchmark-only scenario with N walkers at spread depths).
 """
@@ -143,6 +146,7 @@ def main() -> None:
     ap.add_argument("--skip-pets", action="store_true")
     ap.add_argument("--repeat", type=int, default=3, help="runs per clip; the run with the median "
                     "tracker/decode ratio is shown")
+    ap.add_argument("--skip-limbs", action="store_true")
     a = ap.parse_args()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
@@ -169,6 +173,16 @@ def main() -> None:
     print(df.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     print("people = mean number tracked per frame; PETS MIL ms is scaled from the people present at frame 0 "
           "to that mean.")
+    if not a.skip_limbs:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from track_speed_limbs import limb_speed_rows
+
+        from tracking.params import LimbParams
+        print(f"\nLimb tracker (head and hands, {LimbParams().particles} particles per target; seated people "
+              "clapping, 640x480, "
+              f"{a.frames} frames; step only, a foreground of ones):")
+        print(pd.DataFrame(limb_speed_rows((1, 4), a.frames, 640, 480)).to_string(
+            index=False, float_format=lambda v: f"{v:.1f}"))
 
 
 if __name__ == "__main__":

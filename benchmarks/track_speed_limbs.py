@@ -47,6 +47,24 @@ def seated_people(n_people: int, n_frames: int, width: int, height: int):
     return frames, pd.DataFrame(init, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
 
 
+def limb_speed_rows(people=(1, 4), n_frames: int = 60, width: int = 320, height: int = 240) -> list[dict]:
+    """One row per people count: targets, fps, ms per frame and per target of ``LimbTracker``
+    (a foreground of ones, no face detector) on :func:`seated_people`; ``benchmarks/track_speed.py``
+    prints these as its limb rows."""
+    rows = []
+    for n in people:
+        frames, init = seated_people(n, n_frames, width, height)
+        tracker = LimbTracker(LimbParams(), np.random.default_rng(0), init=init, face_detector=False)
+        fg = np.full(frames[0].shape[:2], 255, np.uint8)
+        t0 = time.perf_counter()
+        for i, f in enumerate(frames):
+            tracker.step(i, f, fg)
+        dt = (time.perf_counter() - t0) / len(frames)
+        rows.append({"people": n, "targets": 3 * n, "fps": 1 / dt, "ms/frame": 1000 * dt,
+                     "ms/target": 1000 * dt / (3 * n)})
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--frames", type=int, default=60)
@@ -56,15 +74,8 @@ def main() -> None:
     print(f"limb tracker speed, {args.width}x{args.height}, {args.frames} frames, "
           f"{LimbParams().particles} particles per target")
     print(f"{'people':>6} {'targets':>7} {'fps':>8} {'ms/frame':>9} {'ms/target':>9}")
-    for n in (1, 4):
-        frames, init = seated_people(n, args.frames, args.width, args.height)
-        tracker = LimbTracker(LimbParams(), np.random.default_rng(0), init=init, face_detector=False)
-        fg = np.full(frames[0].shape[:2], 255, np.uint8)
-        t0 = time.perf_counter()
-        for i, f in enumerate(frames):
-            tracker.step(i, f, fg)
-        dt = (time.perf_counter() - t0) / len(frames)
-        print(f"{n:>6} {3 * n:>7} {1 / dt:>8.1f} {1000 * dt:>9.1f} {1000 * dt / (3 * n):>9.2f}")
+    for r in limb_speed_rows((1, 4), args.frames, args.width, args.height):
+        print(f"{r['people']:>6} {r['targets']:>7} {r['fps']:>8.1f} {r['ms/frame']:>9.1f} {r['ms/target']:>9.2f}")
 
 
 if __name__ == "__main__":

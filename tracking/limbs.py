@@ -176,7 +176,9 @@ class LimbTracker:
             # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
             # accepts, because their colours fill far more of the frame than the boxes.
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
-                                         bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin)
+                                         bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin,
+                                         keep_mass=p.skin_keep_mass, keep_recall=p.skin_keep_recall,
+                                         threshold=p.skin_threshold)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)

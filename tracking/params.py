@@ -281,6 +281,15 @@ class LimbParams:
     skin_adapt: bool = True
     # luma bins of the refitted model: coarse, so lighting drift stays within a bin or two
     skin_ybins: int = 8
+    # ... and where the refit sees under skin_keep_recall of an init box as skin, keep as skin
+    # the colour bins holding skin_keep_mass of that box's pixels (skin.train_skin_model).
+    # Off by default (0): on desk seeds 2 and 9 the plain refit sees under 6% of each hand
+    # (forearms and desk share the hands' bins), but keeping those bins brings in the
+    # same-coloured forearms, whose blob centre pulls the hand filter ~25 px up the arm:
+    # desk 720x480 (12 seeds) right hand 0.75 and left 0.83 at 0.8 vs 0.83 / 1.00 off
+    # (applied to every box: 0.50 / 0.75).
+    skin_keep_mass: float = 0.0
+    skin_keep_recall: float = 0.5
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     skin_open: int = 3
 

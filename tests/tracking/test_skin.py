@@ -96,3 +96,22 @@ def test_bad_inputs_get_clear_errors():
         SkinModel(np.zeros((16, 16)), blur=4)
     with pytest.raises(ValueError, match="not a skin model"):
         SkinModel.from_dict({"kind": "other"})
+
+
+def test_keep_mass_keeps_a_box_colour_that_fills_more_of_the_frame_elsewhere():
+    # a hand whose colour also covers a large forearm/desk area outside its box: the plain
+    # Bayes ratio drops below 0.5 and the refit model would no longer see the hand it was fit on
+    skin, bg, other = SKIN_BGR[0], (90, 110, 70), SKIN_BGR[2]
+    f = np.full((60, 120, 3), bg, np.uint8)
+    f[:, 60:] = skin  # same colour as the hand, outside the box
+    f[40:60, 0:30] = other  # a rule-skin colour that is not in the box
+    cv2.circle(f, (20, 20), 10, skin, -1)
+    box = [np.array([[10, 10, 20, 20]])]
+    plain = train_skin_model([f], box, bins=32)
+    kept = train_skin_model([f], box, bins=32, keep_mass=0.8)
+    assert plain.probability(_px(skin))[0, 0] < 0.5
+    assert kept.probability(_px(skin))[0, 0] == 1.0
+    assert kept.probability(_px(bg))[0, 0] < 0.05
+    assert kept.probability(_px(other))[0, 0] < 0.5  # colours not in the box still earn their ratio
+    with pytest.raises(ValueError, match="keep_mass"):
+        train_skin_model([f], box, bins=32, keep_mass=1.5)
