@@ -26,7 +26,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,30 +39,17 @@ AT = 105
 PARTS = ("head", "torso", "hipleg")
 
 
-def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
-    """``(N, 4)`` ``[cx, cy, w, h]`` from columns ``x, y, w, h`` (+ suffix)."""
-    return np.stack([d["x" + sfx] + d["w" + sfx] / 2, d["y" + sfx] + d["h" + sfx] / 2, d["w" + sfx], d["h" + sfx]],
-                    axis=1)
-
-
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame, at: int = AT) -> dict[str, tuple[int, int, float]]:
     """Per part ``(right at at, people with truth at at, mean rate over offsets 1..at)``,
     offsets counted from each truth track's first frame."""
-    from models.labels import POSITIVE, label_states
+    from models.selection import right_after_start
 
-    first = truth.groupby("track_id")["frame"].min().rename("f0")
     out = {}
     for part in PARTS:
-        t = truth[truth.part == part].join(first, on="track_id")
-        t = t[(t.frame > t.f0) & (t.frame <= t.f0 + at)]
-        r = tracks[tracks.part == part][["track_id", "frame", "x", "y", "w", "h"]]
-        m = t.merge(r, on=["track_id", "frame"], how="left", suffixes=("_t", ""))
-        have = m["x"].notna().to_numpy()
-        ok = np.zeros(len(m), bool)
-        if have.any():
-            mm = m[have]
-            ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
+        m = right_after_start(tracks, truth, part)
+        m = m[m.frame <= m.f0 + at]
         last = (m.frame == m.f0 + at).to_numpy()
+        ok = m.right.to_numpy()
         out[part] = (int(ok[last].sum()), int(last.sum()), float(ok.mean()) if len(ok) else float("nan"))
     return out
 

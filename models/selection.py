@@ -41,22 +41,29 @@ def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
                     axis=1)
 
 
+def right_after_start(tracks: pd.DataFrame, truth: pd.DataFrame, part: str) -> pd.DataFrame:
+    """The truth rows of ``part`` after each track's first frame (``f0``), each with ``right``:
+    whether the tracker's box there is right (a missing tracked box counts as wrong)."""
+    first = truth.groupby("track_id")["frame"].min().rename("f0")
+    t = truth[truth.part == part].join(first, on="track_id")
+    t = t[t.frame > t.f0]
+    r = tracks[tracks.part == part][["track_id", "frame", "x", "y", "w", "h"]]
+    m = t.merge(r, on=["track_id", "frame"], how="left", suffixes=("_t", ""))
+    have = m["x"].notna().to_numpy()
+    ok = np.zeros(len(m), bool)
+    if have.any():
+        mm = m[have]
+        ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
+    return m.assign(right=ok)
+
+
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
     """Per part, the fraction of truth boxes after each track's first frame that the
-    tracker got right (a missing tracked box counts as wrong; no truth -> nan)."""
-    first = truth.groupby("track_id")["frame"].min().rename("f0")
+    tracker got right (no truth -> nan)."""
     out = {}
     for part in BODY_PARTS:
-        t = truth[truth.part == part].join(first, on="track_id")
-        t = t[t.frame > t.f0]
-        r = tracks[tracks.part == part][["track_id", "frame", "x", "y", "w", "h"]]
-        m = t.merge(r, on=["track_id", "frame"], how="left", suffixes=("_t", ""))
-        have = m["x"].notna().to_numpy()
-        ok = np.zeros(len(m), bool)
-        if have.any():
-            mm = m[have]
-            ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
-        out[part] = float(ok.mean()) if len(ok) else float("nan")
+        m = right_after_start(tracks, truth, part)
+        out[part] = float(m.right.mean()) if len(m) else float("nan")
     return out
 
 
