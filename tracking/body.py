@@ -34,7 +34,7 @@ import pandas as pd
 
 from tracking.box import Box, iou_xywh
 from tracking.decomposition import decompose, minimum_bounding_rectangle, shrink_part
-from tracking.detection import person_blobs
+from tracking.detection import edge_contrast, person_blobs
 from tracking.frame_tracker import FailureDetector, FailureVerdict
 from tracking.lazy_ycc import LazyYcc, as_array
 from tracking.params import BodyParams
@@ -112,6 +112,29 @@ class Person:
         return minimum_bounding_rectangle(f.box for f in self.filters.values())
 
 
+def _moved(first: Box, now: Box, by: float) -> bool:
+    """Both side edges (or both the top and bottom edge) moved at least ``by`` pixels the same
+    way: a walker moves, while a walker separating from its ghost has one edge held by the ghost."""
+    for a, b in (((first.x, first.x2), (now.x, now.x2)), ((first.y, first.y2), (now.y, now.y2))):
+        d1, d2 = b[0] - a[0], b[1] - a[1]
+        if d1 * d2 > 0 and min(abs(d1), abs(d2)) >= by:
+            return True
+    return False
+
+
+def _piece_of(blob: Box, person: Box, p: BodyParams) -> bool:
+    """A blob beside a tracked person box that is a part of that person the box does not cover
+    (legs or head above or below it, within its width; an arm or a leg beside it, within its
+    height and shorter than the person), not someone new."""
+    near = p.detection_margin * person.h * 2
+    across = max(0.0, min(blob.x2, person.x2) - max(blob.x, person.x))
+    if across >= 0.5 * blob.w and max(person.y - blob.y2, blob.y - person.y2, 0.0) <= near:
+        return True
+    along = max(0.0, min(blob.y2, person.y2) - max(blob.y, person.y))
+    return (along >= 0.5 * blob.h and blob.h < 0.7 * person.h
+            and max(person.x - blob.x2, blob.x - person.x2, 0.0) <= near)
+
+
 def _overlap_fraction(a: Box, b: Box) -> float:
     """Share of ``a``'s area covered by ``b``."""
     return a.intersection(b) / a.area if a.area > 0 else 0.0
@@ -141,7 +164,7 @@ class BodyTracker:
         self.pending = dict(self.starts)
         self.people: dict[int, Person] = {}
         self.next_id = max(self.starts, default=0) + 1
-        self.candidates: list[tuple[Box, int]] = []
+        self.candidates: list[tuple[Box, int, Box]] = []  # (box, frames seen running, box when first seen)
         self.frames_seen = 0
         self._ycc = LazyYcc()
 
@@ -192,28 +215,43 @@ class BodyTracker:
                 del self.pending[tid]
                 self.start_track(tid, start.boxes, ycc, mask, index)
 
-    def _detect(self, index: int, ycc, mask) -> None:
-        """Start tracks on person-size blobs no tracked person covers, once stable."""
+    def _detect(self, index: int, frame: np.ndarray, ycc, mask) -> None:
+        """Start tracks on person-size blobs of the foreground no tracked person covers, once
+        they have been seen ``start_frames`` frames running, have moved and have an outline on
+        image edges (ghosts do neither)."""
         p = self.params
-        tracked = [person.box() for person in self.people.values()]
-        fresh: list[tuple[Box, int]] = []
-        for blob in person_blobs(mask, p):
-            if any(blob.intersection(t) > p.detection_overlap * blob.area for t in tracked):
+        tracked = [self._reported_person_box(person) for person in self.people.values()]
+        free = mask
+        if tracked and p.detection_margin >= 0:
+            free = mask.copy()
+            H, W = mask.shape[:2]
+            for t in tracked:
+                m = p.detection_margin
+                c = t.transformed(1 + 2 * m, 1 + 2 * m, 0.0, 0.0).clip(W, H)
+                free[int(c.y):int(np.ceil(c.y2)), int(c.x):int(np.ceil(c.x2))] = 0
+        fresh: list[tuple[Box, int, Box]] = []
+        for blob in person_blobs(free, p):
+            if any(blob.intersection(t) > p.detection_overlap * blob.area or _piece_of(blob, t, p) for t in tracked):
                 continue
-            count = 1
+            count, first = 1, blob
             if self.candidates:
-                prev = np.array([c.as_tuple() for c, _ in self.candidates])
+                prev = np.array([c[0].as_tuple() for c in self.candidates])
                 ious = iou_xywh(np.array([blob.as_tuple()]), prev)[0]
                 k = int(np.argmax(ious))
                 if ious[k] > 0.3:
-                    count = self.candidates[k][1] + 1
-            if count >= p.start_frames:
+                    count, first = self.candidates[k][1] + 1, self.candidates[k][2]
+            if (count >= p.start_frames and _moved(first, blob, p.start_min_motion * blob.h)
+                    and edge_contrast(frame, mask, blob) >= p.ghost_edge_contrast):
                 self.start_track(self.next_id, {"person": blob}, ycc, mask, index)
                 tracked.append(blob)
                 self.next_id += 1
             else:
-                fresh.append((blob, count))
+                fresh.append((blob, count, first))
         self.candidates = fresh
+
+    def _reported_person_box(self, person: Person) -> Box:
+        """The person box as written: the MBR of its parts' reported boxes."""
+        return minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.filters.items())
 
     # -- one frame ----------------------------------------------------------------------
     def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None) -> list[TrackRecord]:
@@ -272,7 +310,7 @@ class BodyTracker:
                 person.centres.append((index, *person.box().centre))
         self._end_tracks(active, mask, W, H)
         if self.auto and mask is not None:
-            self._detect(index, ycc, mask)
+            self._detect(index, frame, ycc, mask)
         return self._records(index, new_ids)
 
     def _update_person_occlusion(self, person: Person) -> None:

@@ -120,6 +120,20 @@ class BodyParams:
     # foreground inside its box; a track ends after ``lost_frames`` frames without foreground
     # support (fraction below ``support_min``) or when its box leaves the frame.
     start_frames: int = 3
+    # ... and both its side edges (or its top and bottom) must have moved the same way by this
+    # fraction of its height since it was first seen: a walker present in the first frames is
+    # learnt into the background model and leaves a "ghost" blob where it stood, which never
+    # moves, and while the walker separates from it their joint blob has one edge held still.
+    # (People who stand still from the first frame on are background anyway.)
+    start_min_motion: float = 0.05
+    # ... and its outline must lie on image edges: gradient magnitude around the outline over
+    # that of the background just outside (``tracking.detection.edge_contrast``; ghosts of
+    # people who stood in the first frames measure about 1.0-1.2, people 1.6-3).
+    ghost_edge_contrast: float = 1.4
+    # Blobs are looked for in the foreground left after blanking every tracked person's reported
+    # box, widened by this fraction of its size on each side: a tracked walker merging with a
+    # ghost or a newcomer no longer makes a blob that is mostly an already tracked person.
+    detection_margin: float = 0.25
     # blobs touching the frame border (people still entering) do not start tracks: their box
     # would be cut and the decomposition wrong.
     detection_border: int = 2

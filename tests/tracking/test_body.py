@@ -119,6 +119,20 @@ def test_people_are_found_without_init_and_tracks_end_when_they_leave():
     assert tracks["frame"].max() < 89
 
 
+def test_a_walker_in_the_first_frame_leaves_a_ghost_that_starts_no_track():
+    # the walker stands in frame 0, so the background model learns it there and, once it walks
+    # off, keeps reporting foreground where it stood; only the walker itself gets a track
+    frames, truths = _scene(n=70, walkers=(dict(x0=70, vx=3.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    tracks = _run(BodyTracker(BodyParams(), np.random.default_rng(2)), frames)
+    assert tracks["track_id"].nunique() == 1
+    tid = int(tracks["track_id"].iloc[0])
+    rate, n = _rate(tracks, truths, tid, "torso", 1)
+    assert n >= 40 and rate >= 0.85
+    # with the old start rule (seen 3 frames running, no motion needed) the ghost starts a track
+    old = BodyParams(start_min_motion=0.0, detection_margin=-1.0, ghost_edge_contrast=0.0)
+    assert _run(BodyTracker(old, np.random.default_rng(2)), frames)["track_id"].nunique() > 1
+
+
 def test_occluded_person_is_predicted_through_the_occlusion():
     """Sec. 4.3.1: B walks behind A; B's parts follow its dynamics while hidden and B is
     tracked again after they separate (without it B's filters would lock onto A)."""
