@@ -18,10 +18,13 @@ import pandas as pd
 from app.cli import CommandError
 from labelling.video import VideoClip, VideoError
 from tracking.background import BackgroundModel
+from tracking.identity import match_limb_people, merge_tracks
 from tracking.params import BodyParams, LimbParams
 from tracking.tracks import TracksCSVError, empty_tracks, normalise_tracks, records_to_frame
 
 TRACKERS = ("body", "limbs", "all", "whole")
+#: ``--tracker all`` without ``--init``: limb people not matched to a body person get ids from here
+LIMB_ID_OFFSET = 100000
 
 
 def _limb_tracker(params: LimbParams, rng: np.random.Generator, init: pd.DataFrame | None):
@@ -53,10 +56,11 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
     """Track ``video_path`` and return the tracks table (frame indexes of the whole clip).
 
     ``tracker``: body (head/torso/hip-leg + person MBR), whole (one box per person),
-    limbs (head and hands) or all (body and limbs). Limb track ids are offset when
-    ``all`` runs both without ``init`` so the two never share an id. The same ``seed``
-    gives the same output. With ``all``, a limb head that shares its track id with a body
-    head is not written twice (the body tracker's head is kept). ``events_out``: a list
+    limbs (head and hands) or all (body and limbs). With ``all`` one person has one track id:
+    from ``init`` both trackers use its ids; found automatically, a limb person takes the id of
+    the body person whose box holds its head (``tracking.identity``), and unmatched limb people
+    get ids from :data:`LIMB_ID_OFFSET` on. A person's head is written once per frame (the body
+    tracker's where both have it). The same ``seed`` gives the same output. ``events_out``: a list
     that receives the limb tracker's join/separation events (a DataFrame). Raises :class:`app.cli.CommandError` with a clear message
     for an unreadable clip, a bad ``init`` table or an unknown tracker.
     """
@@ -97,22 +101,14 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
         trackers.append(_limb_tracker(limb_params, limb_rng, init))
 
     background = BackgroundModel(body_params)
-    records = []
+    records: list[list] = [[] for _ in trackers]
     total = stop - start
     done = 0
     try:
         for index, frame in clip.frames(start, stop):
             mask = background.apply(frame)
-            body_heads: set[int] = set()
             for k, t in enumerate(trackers):
-                out = t.step(index, frame, mask)
-                if k == 0 and tracker == "all":
-                    body_heads = {r.track_id for r in out if r.part == "head"}
-                if k > 0 and tracker == "all":
-                    if init is None:
-                        out = [_offset(r, 100000) for r in out]
-                    out = [r for r in out if not (r.part == "head" and r.track_id in body_heads)]
-                records.extend(out)
+                records[k].extend(t.step(index, frame, mask))
             done += 1
             if progress is not None:
                 progress(done, total)
@@ -120,14 +116,22 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
         raise CommandError(str(exc)) from None
     finally:
         clip.close()
-    if events_out is not None and tracker in ("limbs", "all"):
-        events_out.append(trackers[-1].events)
-    if not records:
-        return empty_tracks()
-    return records_to_frame(records)
-
-
-def _offset(record, by: int):
-    from dataclasses import replace
-
-    return replace(record, track_id=record.track_id + by)
+    events = trackers[-1].events if tracker in ("limbs", "all") else None
+    tables = [records_to_frame(r) if r else empty_tracks() for r in records]
+    if tracker == "all":
+        body, limbs = tables
+        # with init both trackers use its ids; found automatically, a limb person takes the id of
+        # the body person around its head, the others are offset so the two never share an id
+        mapping = {} if init is not None else match_limb_people(body, limbs)
+        offset = 0 if init is not None else LIMB_ID_OFFSET
+        if events is not None and len(events):
+            events = events.copy()
+            for col in ("track_id_a", "track_id_b"):
+                events[col] = [mapping.get(int(t), int(t) + offset) for t in events[col]]
+        out = merge_tracks(body, limbs, mapping, offset)
+        out = out.sort_values(["frame", "track_id"], kind="stable").reset_index(drop=True)
+    else:
+        out = tables[0]
+    if events_out is not None and events is not None:
+        events_out.append(events)
+    return out if len(out) else empty_tracks()

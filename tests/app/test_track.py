@@ -104,6 +104,14 @@ def test_all_trackers_write_one_head_per_person_and_the_events(tmp_path, capsys)
     assert {"head", "torso", "left_hand", "right_hand"} <= set(tracks.part)
     events = pd.read_csv(ev)
     assert (events.kind == "clap").sum() >= 1   # the desk scene claps around frames 40-60 (scaled to 70 frames)
+    assert set(events.track_id_a) | set(events.track_id_b) <= set(tracks.track_id)
+    # found automatically: the events name the tracks as written (limb people not matched to a
+    # body person are offset, in the tracks and in the events alike)
+    assert main(["track", str(d / "clip.mp4"), "-o", str(out), "--tracker", "all", "--events", str(ev),
+                 "--no-progress"]) == 0
+    tracks, events = pd.read_csv(out), pd.read_csv(ev)
+    assert not tracks.duplicated(["frame", "track_id", "part"]).any()
+    assert len(events) and set(events.track_id_a) | set(events.track_id_b) <= set(tracks.track_id)
 
 
 def test_model_default_names_the_shipped_bundle(clip, tmp_path):

@@ -1,0 +1,47 @@
+"""One track id per person when body and limb trackers run together (tracking/identity.py)."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from tracking.identity import match_limb_people, merge_tracks
+
+
+def _rows(track_id, part, boxes):
+    return [dict(frame=f, track_id=track_id, part=part, x=x, y=y, w=w, h=h) for f, (x, y, w, h) in boxes]
+
+
+def _scene():
+    frames = range(30)
+    # body people 1 (walks right) and 2 (stands at x = 300)
+    body = pd.DataFrame(
+        _rows(1, "person", [(f, (10 + 3 * f, 50, 40, 120)) for f in frames])
+        + _rows(1, "head", [(f, (20 + 3 * f, 50, 20, 22)) for f in frames])
+        + _rows(2, "person", [(f, (300, 60, 40, 110)) for f in frames])
+        + _rows(2, "head", [(f, (310, 60, 20, 20)) for f in frames[:20]]))
+    # limb people: 7 is person 2 (head inside its box), 8 is person 1, 9 is on the wall
+    limbs = pd.DataFrame(
+        _rows(7, "head", [(f, (312, 62, 14, 14)) for f in frames])
+        + _rows(7, "left_hand", [(f, (290, 120, 10, 10)) for f in frames])
+        + _rows(8, "head", [(f, (22 + 3 * f, 52, 14, 14)) for f in frames[5:]])
+        + _rows(9, "head", [(f, (600, 20, 14, 14)) for f in frames]))
+    return body, limbs
+
+
+def test_limb_people_take_the_id_of_the_body_person_around_their_head():
+    body, limbs = _scene()
+    assert match_limb_people(body, limbs) == {7: 2, 8: 1}
+    # a head inside the box in too few frames is not matched
+    assert match_limb_people(body, limbs, min_frames=26) == {7: 2}
+
+
+def test_merged_table_has_one_head_per_person_and_frame():
+    body, limbs = _scene()
+    out = merge_tracks(body, limbs, match_limb_people(body, limbs), offset=100000)
+    assert sorted(out.track_id.unique()) == [1, 2, 100009]
+    heads = out[out.part == "head"].groupby(["frame", "track_id"]).size()
+    assert heads.max() == 1
+    # person 2's body head ends at frame 20: the limb head fills frames 20..29
+    p2 = out[(out.track_id == 2) & (out.part == "head")]
+    assert len(p2) == 30 and (p2[p2.frame >= 20].w == 14).all()
+    assert len(out[(out.track_id == 2) & (out.part == "left_hand")]) == 30
