@@ -187,9 +187,11 @@ class BodyTracker:
         return parts
 
     def start_track(self, track_id: int, boxes: dict[str, Box], ycc: np.ndarray, mask: np.ndarray | None,
-                    index: int) -> Person:
-        """Start tracking a person from its boxes (person and/or part boxes)."""
-        if self.frames_seen < self.params.background_warmup // 2:
+                    index: int, from_mask: bool = False) -> Person:
+        """Start tracking a person from its boxes (person and/or part boxes); ``from_mask``: the
+        boxes come from the foreground mask itself (automatic detection), so it is trusted even
+        while the background model is young."""
+        if not from_mask and self.frames_seen < self.params.background_warmup // 2:
             mask = None  # the background model has not learnt the scene yet: decompose by contrast
         ycc = as_array(ycc)
         parts = self._part_boxes_for_start(boxes, ycc, mask)
@@ -242,7 +244,7 @@ class BodyTracker:
                     count, first = self.candidates[k][1] + 1, self.candidates[k][2]
             if (count >= p.start_frames and _moved(first, blob, p.start_min_motion * blob.h)
                     and edge_contrast(frame, mask, blob) >= p.ghost_edge_contrast):
-                self.start_track(self.next_id, {"person": blob}, ycc, mask, index)
+                self.start_track(self.next_id, {"person": blob}, ycc, mask, index, from_mask=True)
                 tracked.append(blob)
                 self.next_id += 1
             else:
