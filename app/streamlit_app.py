@@ -23,7 +23,31 @@ def _demo_ready(data: str) -> bool:
 _demo_ready(str(data_dir()))
 store = state.store()
 
+PROJECTS = st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects")
+PAGES = [
+    PROJECTS,
+    st.Page("views/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
+    st.Page("views/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
+    st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
+    st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
+    st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
+]
+
+
+def _home():
+    """``/`` opens the projects page under its own address, so /projects works as a link too
+    (Streamlit serves a default page only at ``/``)."""
+    st.switch_page(PROJECTS)
+
+
+# the navigation is drawn by hand (page links) so that the hidden home page is not listed
+current = st.navigation([st.Page(_home, title="partlab", default=True), *PAGES], position="hidden")
+
+
 with st.sidebar:
+    for page in PAGES:
+        st.page_link(page)
+    st.divider()
     st.markdown("### partlab")
     projects = store.projects()
     if projects:
@@ -50,13 +74,4 @@ with st.sidebar:
     _job_list()
     st.caption(f"Data: {data_dir()}")
 
-pages = [
-    st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects",
-            default=True),
-    st.Page("views/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
-    st.Page("views/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
-    st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
-    st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
-    st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
-]
-st.navigation(pages).run()
+current.run()

@@ -245,3 +245,13 @@ def test_a_stale_edit_from_a_second_session_is_refused_not_lost(server, page, st
     _wait_for(lambda: store.revision(clip.id, 0, 1, "head") == 2, what="the second session's retry")
     final = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
     assert final.x == after.x and final.y > after.y
+
+
+def test_every_page_has_an_address_that_opens_it(server, page):
+    url, _ = server
+    for path, heading in (("", "Projects and clips"), ("/projects", "Projects and clips"), ("/train", "Train"),
+                          ("/export", "Export")):
+        page.goto(url + path)
+        page.locator("h1", has_text=heading).wait_for()
+        page.get_by_role("link", name="Correct").wait_for()  # the page links are drawn
+        assert page.get_by_text("Page not found").count() == 0, path
