@@ -61,14 +61,18 @@ with st.sidebar:
     def _job_list():
         running = jobs.active()
         recent = [j for j in jobs.jobs() if not j.active][:3]
-        if running or recent:
+        stopped = jobs.interrupted()[:3]
+        if running or recent or stopped:
             st.caption("Background jobs")
         for j in running:
             st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
         for j in recent:
             st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
                        (f" ({j.error})" if j.error else ""))
-        if recent:
+        for e in stopped:
+            st.caption(f"INTERRUPTED: {e['label']} (the app stopped at {e['done']}/{e['total'] or '?'}; "
+                       "start it again from its page)")
+        if recent or stopped:
             st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
 
     _job_list()

@@ -30,3 +30,26 @@ def test_job_progress_result_and_failure():
 
     bad = jobs.wait(jobs.submit("test", "boom", boom).id, 5)
     assert bad.status == "failed" and bad.error == "ValueError: no frames"
+
+
+def test_jobs_left_unfinished_by_a_stopped_server_are_reported_then_cleared():
+    import json
+    import os
+
+    # a previous server process (another pid) journalled a tracking job that never ended,
+    # and one that did
+    old = [dict(id="a1", pid=os.getpid() + 1, kind="track", label="track walk.mp4 (body)", status="running",
+                done=40, total=150, error="", time=1.0),
+           dict(id="b2", pid=os.getpid() + 1, kind="track", label="track other.mp4", status="done",
+                done=9, total=9, error="", time=2.0)]
+    path = jobs.journal_path()
+    path.write_text("".join(json.dumps(e) + "\n" for e in old) + "not json\n", encoding="utf-8")
+    assert [(e["id"], e["done"], e["total"]) for e in jobs.interrupted()] == [("a1", 40, 150)]
+
+    # this process's jobs are journalled, and never count as interrupted
+    job = jobs.wait(jobs.submit("test", "quick", lambda progress: 1).id, 5)
+    states = [json.loads(line)["status"] for line in path.read_text().splitlines()[3:]]
+    assert states[0] == "queued" and states[-1] == "done" and job.id not in {e["id"] for e in jobs.interrupted()}
+
+    assert jobs.clear_finished() >= 2 and jobs.interrupted() == []
+    assert "a1" not in path.read_text()
