@@ -180,7 +180,7 @@ class LimbTracker:
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
                                          bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin,
                                          keep_mass=p.skin_keep_mass, keep_recall=p.skin_keep_recall,
-                                         threshold=p.skin_threshold)
+                                         threshold=p.skin_threshold, keep_min_side=p.skin_keep_min_side)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
@@ -321,7 +321,8 @@ class LimbTracker:
             members.append(partner)
         if any(self.targets[m].part not in hands for m in members):
             return None
-        return float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
+        side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
+        return side if side >= self.params.tip_min_side else None
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""

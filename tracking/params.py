@@ -288,6 +288,9 @@ class LimbParams:
     # end (tip_span), not the blob centre: desk 720x480 (12 seeds) right hand 1.00 vs 0.83 off.
     skin_keep_mass: float = 0.8
     skin_keep_recall: float = 0.5
+    # ... for boxes with both sides at least this (pixels): the walker's 8 px hands have too
+    # few pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without)
+    skin_keep_min_side: float = 14.0
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     skin_open: int = 3
     # hands see the ends of elongated blobs, not their centres (limb_filter.blob_tips): a blob
@@ -297,6 +300,10 @@ class LimbParams:
     tip_span: float = 1.6
     tip_far: float = 2.5
     tip_radius: float = 0.8
+    # ... for hands with a box side at least this (pixels); smaller hands (a distant walker's
+    # 8 px) see blob centres: an end a few pixels wide is mostly noise (walker 640x480 left
+    # hand 0.25 at frame 105 with ends, 1.00 without).
+    tip_min_side: float = 14.0
 
     def to_dict(self) -> dict:
         return asdict(self)
