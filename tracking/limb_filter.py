@@ -101,27 +101,50 @@ def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: 
     """Hand-sized ends of one blob: ``(T, 2)`` points, or the blob's centre when it is compact.
 
     With short sleeves a hand and its forearm share one colour and form one blob (a desk
-    scene's arm is ~4 hand widths long); its centre lies mid-forearm, which pulls a hand
-    filter up the arm. The hand is an end of that blob. A blob whose two farthest pixels
-    (farthest-point search) are at least ``span`` sides apart gives those two ends, and
-    further ends (the tip of a V where two forearms meet at a clap) while some pixel lies at
-    least ``far`` sides from every end found. Each end's point is the centroid of the blob
-    pixels within ``radius`` sides of it: a hand's centre when the end is a hand.
+    scene's arm is ~3-4 hand widths long); its centre lies mid-forearm, which pulls a hand
+    filter up the arm. The hand is an end of that blob. A blob whose farthest pixels are at
+    least ``span`` sides apart is split into ends: points of its outline that stick out (local
+    maxima of the distance to the blob's centre along the outline), the two farthest apart
+    first, then more (the tip of a V where two forearms meet at a clap) while one lies at
+    least ``far`` sides from every end found. The middle of a long straight arm's side is
+    no end: its distance to the centre is a minimum along the outline. Each end's point is
+    the centroid of the blob pixels within ``radius`` sides of it: a hand's centre when the
+    end is a hand.
     """
     pts = np.asarray(points, float).reshape(-1, 2)
     centre = pts.mean(axis=0)
     t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
-    mind = np.hypot(*(pts - t1).T)
-    if mind.max() < span * side:
+    if np.hypot(*(pts - t1).T).max() < span * side:
         return centre[None]
+    ends = _outline_maxima(pts, centre, max(int(side / 2), 2))
     tips = [t1]
-    while len(tips) < max_tips:
+    mind = np.hypot(*(ends - t1).T)
+    while len(tips) < max_tips and len(ends):
         k = int(np.argmax(mind))
         if mind[k] < (span if len(tips) == 1 else far) * side:
             break
-        tips.append(pts[k])
-        mind = np.minimum(mind, np.hypot(*(pts - pts[k]).T))
+        tips.append(ends[k])
+        mind = np.minimum(mind, np.hypot(*(ends - ends[k]).T))
+    if len(tips) == 1:  # no outline end far enough (a ragged blob): its farthest pixel
+        tips.append(pts[np.argmax(np.hypot(*(pts - t1).T))])
     return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
+
+
+def _outline_maxima(pts: np.ndarray, centre: np.ndarray, half_window: int) -> np.ndarray:
+    """Points of a blob's outer outline farther from ``centre`` than every outline point
+    within ``half_window`` steps along it: ``(M, 2)``."""
+    x0, y0 = pts.min(axis=0).astype(int)
+    mask = np.zeros((int(pts[:, 1].max()) - y0 + 3, int(pts[:, 0].max()) - x0 + 3), np.uint8)
+    mask[pts[:, 1].astype(int) - y0 + 1, pts[:, 0].astype(int) - x0 + 1] = 1
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not contours:
+        return np.zeros((0, 2))
+    c = max(contours, key=len).reshape(-1, 2).astype(float) + np.array([x0 - 1, y0 - 1])
+    r = np.hypot(*(c - centre[None, :]).T)
+    n = len(r)
+    w = min(half_window, (n - 1) // 2)
+    shifted = np.stack([np.roll(r, s) for s in range(-w, w + 1)])
+    return c[r >= shifted.max(axis=0)]
 
 
 def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, params: LimbParams) -> Candidates:

@@ -250,11 +250,18 @@ class LimbTracker:
             if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
                 # one end per blob, the one nearest the predicted hand: the other end of its arm
                 # is its elbow, and a posterior split between both ends would put it mid-arm
-                at = before if prev is None else before + p.velocity_decay * (before - prev)
-                n_ends = np.bincount(own_c.parents, minlength=len(blobs))
-                obs_c = self._subset(obs_c, nearest_per_parent(obs_c, at))
-                nearest = int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))
-                on_end = bool(n_ends[obs_c.parents[nearest]] >= 2)
+                at = tgt.filter.estimate if state == LimbState.LOST else \
+                    before if prev is None else before + p.velocity_decay * (before - prev)
+                ends = np.bincount(own_c.parents, minlength=len(blobs))[obs_c.parents] >= 2
+                keep = nearest_per_parent(obs_c, at)
+                if state != LimbState.LOST:
+                    # an arm's end farther than tip_gate sides is another part of it (an elbow
+                    # when the hand end merged into another blob): not this hand
+                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.tip_gate * max(tgt.size)
+                    keep &= ~(ends & far)
+                obs_c, ends = self._subset(obs_c, keep), ends[keep]
+                if len(obs_c):
+                    on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))])
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:

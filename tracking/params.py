@@ -304,6 +304,8 @@ class LimbParams:
     # 8 px) see blob centres: an end a few pixels wide is mostly noise (walker 640x480 left
     # hand 0.25 at frame 105 with ends, 1.00 without).
     tip_min_side: float = 14.0
+    # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
+    tip_gate: float = 1.0
 
     def to_dict(self) -> dict:
         return asdict(self)
