@@ -289,8 +289,9 @@ class LimbParams:
     skin_keep_mass: float = 0.8
     skin_keep_recall: float = 0.5
     # ... for boxes with both sides at least this (pixels): the walker's 8 px hands have too
-    # few pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without)
-    skin_keep_min_side: float = 14.0
+    # few pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without),
+    # and at 320x240 (desk hands 13-16 px) it went with tip_min_side (below).
+    skin_keep_min_side: float = 17.0
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     skin_open: int = 3
     # hands see the ends of elongated blobs, not their centres (limb_filter.blob_tips): a blob
@@ -300,10 +301,12 @@ class LimbParams:
     tip_span: float = 1.6
     tip_far: float = 2.5
     tip_radius: float = 0.8
-    # ... for hands with a box side at least this (pixels); smaller hands (a distant walker's
-    # 8 px) see blob centres: an end a few pixels wide is mostly noise (walker 640x480 left
-    # hand 0.25 at frame 105 with ends, 1.00 without).
-    tip_min_side: float = 14.0
+    # ... for hands with a box side at least this (pixels); smaller hands see blob centres: a
+    # distant walker's 8 px hand end is mostly noise (walker 640x480 left hand 0.25 at frame
+    # 105 with ends, 1.00 without), and a 15 px desk hand's blob at 320x240 is cut square by
+    # the support box around it, whose corners become "ends" (desk seed 7 lost both hands;
+    # at 14 px the 12-seed 320x240 rates stayed 0.92 / 0.75, other seeds failing).
+    tip_min_side: float = 17.0
     # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
     tip_gate: float = 1.0
 

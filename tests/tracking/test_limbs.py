@@ -201,25 +201,25 @@ def test_head_whose_confidence_stays_low_is_reacquired_by_the_face_detector():
 
 
 def arm_scene(n=40):
-    """Short sleeves: each hand (radius 8, box 16) ends a forearm of the same skin colour
+    """Short sleeves: each hand (radius 10, box 20) ends a forearm of the same skin colour
     hanging from a sleeve; the person's right hand (image left) reaches out over frames
     10-20 and comes back over frames 25-35."""
     frames, rows = [], []
     for t in range(n):
-        f = np.full((180, 240, 3), BG, np.uint8)
-        cv2.rectangle(f, (95, 50), (145, 170), SHIRT, -1)
+        f = np.full((200, 260, 3), BG, np.uint8)
+        cv2.rectangle(f, (105, 50), (155, 185), SHIRT, -1)
         reach = min(max(t - 10, 0), 10) - min(max(t - 25, 0), 10)  # 0 .. 10 .. 0
-        head, lh, rh = (120, 32), (150, 150), (int(80 - 4 * reach), int(150 - reach))
+        head, lh, rh = (130, 32), (165, 165), (int(85 - 4 * reach), int(165 - reach))
         cv2.circle(f, head, 16, SKIN, -1)
-        for sh, el, hand in (((95, 60), (85, 105), rh), ((145, 60), (160, 105), lh)):
+        for sh, el, hand in (((105, 60), (92, 110), rh), ((155, 60), (170, 110), lh)):
             cv2.line(f, sh, el, SHIRT, 14)
-            cv2.line(f, el, hand, SKIN, 12)
-            cv2.circle(f, hand, 8, SKIN, -1)
-            cv2.circle(f, el, 7, SHIRT, -1)  # the sleeve's end
+            cv2.line(f, el, hand, SKIN, 14)
+            cv2.circle(f, hand, 10, SKIN, -1)
+            cv2.circle(f, el, 8, SHIRT, -1)  # the sleeve's end
         frames.append(f)
         rows += [(t, 7, "head", head[0] - 16, head[1] - 16, 32, 32),
-                 (t, 7, "left_hand", lh[0] - 8, lh[1] - 8, 16, 16),
-                 (t, 7, "right_hand", rh[0] - 8, rh[1] - 8, 16, 16)]
+                 (t, 7, "left_hand", lh[0] - 10, lh[1] - 10, 20, 20),
+                 (t, 7, "right_hand", rh[0] - 10, rh[1] - 10, 20, 20)]
     return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
 
 
