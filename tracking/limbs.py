@@ -212,19 +212,24 @@ class LimbTracker:
         active = [t for t in self.machine.trackers()
                   if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
         observations: dict[int, Observation] = {}
-        points = blob_points(blobs) if p.tip_span > 0 else None
+        pixels: list = []  # each blob's pixels, read once when a hand needs its ends
         sets: dict = {}  # hands' candidate sets (blob ends) and their owners, by box side
         owner, within = self._owners(cands, active)
         # a head's blob (face and neck) is no hand's: its lower end would look like one
         heads = within & np.array([self.targets[o].part == "head" if o >= 0 else False for o in owner], bool)
 
+        def points() -> list[np.ndarray]:
+            if not pixels:
+                pixels.append(blob_points(blobs))
+            return pixels[0]
+
         def not_heads(c: Candidates) -> Candidates:
             return self._subset(c, ~heads[c.parents]) if c.parents is not None else c
 
         def seen_by(t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
-            side = self._hand_side(t) if points is not None else None
+            side = self._hand_side(t)
             if side not in sets:
-                c = cands if side is None else not_heads(tip_candidates(cands, points, side, p))
+                c = cands if side is None else not_heads(tip_candidates(cands, points(), side, p))
                 sets[side] = (c, self._owners(c, active))
             return sets[side]
 
@@ -239,9 +244,9 @@ class LimbTracker:
             elif state == LimbState.COMBINED:
                 # the pair's filter sees only candidates no other tracker explains (its own blobs)
                 tgt.filter.predict(self.rng, p.combined_noise_scale)
-                side = self._hand_side(t) if points is not None else None
+                side = self._hand_side(t)
                 if side is not None:  # two hands: each blob's part nearest the pair
-                    own_c = not_heads(nearest_part_candidates(cands, points, tgt.filter.estimate, side, p))
+                    own_c = not_heads(nearest_part_candidates(cands, points(), tgt.filter.estimate, side, p))
                 obs_c = self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
             else:
                 tgt.filter.predict(self.rng)
@@ -329,7 +334,7 @@ class LimbTracker:
         if any(self.targets[m].part not in hands for m in members):
             return None
         side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
-        return side if side >= self.params.tip_min_side else None
+        return side if self.params.tip_span > 0 and side >= self.params.tip_min_side else None
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
