@@ -33,13 +33,16 @@ from tracking.skin import Blobs
 @dataclass(frozen=True)
 class Candidates:
     """Candidate points of one frame: ``centres (K, 2)``, ``boxes (K, 4)``, ``areas (K,)``,
-    their named prior terms ``terms[name] (K,)`` and the product ``priors (K,)`` (seed 000 eq. 19)."""
+    their named prior terms ``terms[name] (K,)`` and the product ``priors (K,)`` (seed 000 eq. 19);
+    ``parents (K,)``: the blob (index into the frame's :class:`Blobs`) each candidate comes from
+    (None: candidate k is blob k)."""
 
     centres: np.ndarray
     boxes: np.ndarray
     areas: np.ndarray
     terms: dict[str, np.ndarray]
     priors: np.ndarray
+    parents: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.priors.size)
@@ -82,6 +85,114 @@ def candidate_terms(blobs: Blobs, foreground: np.ndarray | None, skin_probabilit
     for t in terms.values():
         priors = priors * t
     return Candidates(blobs.centres, blobs.boxes, blobs.areas, terms, priors)
+
+
+def blob_points(blobs: Blobs) -> list[np.ndarray]:
+    """``(n, 2) float [x, y]`` pixel coordinates of each blob, in the blobs' order."""
+    out = []
+    for (x, y, w, h), i in zip(blobs.boxes.astype(int), blobs.ids):
+        ys, xs = np.nonzero(blobs.labels[y:y + h, x:x + w] == i)
+        out.append(np.column_stack([xs + x, ys + y]).astype(float))
+    return out
+
+
+def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: float,
+              max_tips: int = 4) -> np.ndarray:
+    """Hand-sized ends of one blob: ``(T, 2)`` points, or the blob's centre when it is compact.
+
+    With short sleeves a hand and its forearm share one colour and form one blob (a desk
+    scene's arm is ~3-4 hand widths long); its centre lies mid-forearm, which pulls a hand
+    filter up the arm. The hand is an end of that blob. A blob whose farthest pixels are at
+    least ``span`` sides apart is split into ends: points of its outline that stick out (local
+    maxima of the distance to the blob's centre along the outline), the two farthest apart
+    first, then more (the tip of a V where two forearms meet at a clap) while one lies at
+    least ``far`` sides from every end found. The middle of a long straight arm's side is
+    no end: its distance to the centre is a minimum along the outline. Each end's point is
+    the centroid of the blob pixels within ``radius`` sides of it: a hand's centre when the
+    end is a hand.
+    """
+    pts = np.asarray(points, float).reshape(-1, 2)
+    centre = pts.mean(axis=0)
+    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
+    if np.hypot(*(pts - t1).T).max() < span * side:
+        return centre[None]
+    ends = _outline_maxima(pts, centre, max(int(side / 2), 2))
+    tips = [t1]
+    mind = np.hypot(*(ends - t1).T)
+    while len(tips) < max_tips and len(ends):
+        k = int(np.argmax(mind))
+        if mind[k] < (span if len(tips) == 1 else far) * side:
+            break
+        tips.append(ends[k])
+        mind = np.minimum(mind, np.hypot(*(ends - ends[k]).T))
+    if len(tips) == 1:  # no outline end far enough (a ragged blob): its farthest pixel
+        tips.append(pts[np.argmax(np.hypot(*(pts - t1).T))])
+    return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
+
+
+def _outline_maxima(pts: np.ndarray, centre: np.ndarray, half_window: int) -> np.ndarray:
+    """Points of a blob's outer outline farther from ``centre`` than every outline point
+    within ``half_window`` steps along it: ``(M, 2)``."""
+    x0, y0 = pts.min(axis=0).astype(int)
+    mask = np.zeros((int(pts[:, 1].max()) - y0 + 3, int(pts[:, 0].max()) - x0 + 3), np.uint8)
+    mask[pts[:, 1].astype(int) - y0 + 1, pts[:, 0].astype(int) - x0 + 1] = 1
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not contours:
+        return np.zeros((0, 2))
+    c = max(contours, key=len).reshape(-1, 2).astype(float) + np.array([x0 - 1, y0 - 1])
+    r = np.hypot(*(c - centre[None, :]).T)
+    n = len(r)
+    w = min(half_window, (n - 1) // 2)
+    shifted = np.stack([np.roll(r, s) for s in range(-w, w + 1)])
+    return c[r >= shifted.max(axis=0)]
+
+
+def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, params: LimbParams) -> Candidates:
+    """Candidates of a hand of box side ``side``: each elongated blob replaced by its ends
+    (:func:`blob_tips`), which inherit the blob's prior terms."""
+    if len(cands) == 0:
+        return cands
+    centres, parents = [], []
+    for k, pts in enumerate(points):
+        tips = blob_tips(pts, side, params.tip_span, params.tip_far, params.tip_radius)
+        centres.append(tips)
+        parents += [k] * len(tips)
+    return _expand(cands, np.concatenate(centres), np.asarray(parents, int), side)
+
+
+def nearest_part_candidates(cands: Candidates, points: list[np.ndarray], near, side: float,
+                            params: LimbParams) -> Candidates:
+    """One candidate per blob: the centroid of its pixels within ``tip_radius`` sides of its
+    pixel nearest to ``near``. A combined pair of hands looks for its modes with these: where
+    two arms meet in a V the meeting point is no end of the blob's long axis, and as the hands
+    part each arm's part nearest the pair is its hand."""
+    if len(cands) == 0:
+        return cands
+    near = np.asarray(near, float)
+    centres = []
+    for pts in points:
+        d = np.hypot(*(pts - near[None, :]).T)
+        q = pts[int(np.argmin(d))]
+        centres.append(pts[np.hypot(*(pts - q).T) <= params.tip_radius * side].mean(axis=0))
+    return _expand(cands, np.asarray(centres).reshape(-1, 2), np.arange(len(points)), side)
+
+
+def nearest_per_parent(cands: Candidates, point) -> np.ndarray:
+    """``(K,) bool``: of the candidates sharing a parent blob, the one nearest ``point``."""
+    if cands.parents is None or len(cands) == 0:
+        return np.ones(len(cands), bool)
+    d = np.hypot(*(cands.centres - np.asarray(point, float)[None, :]).T)
+    keep = np.zeros(len(cands), bool)
+    for k in np.unique(cands.parents):
+        idx = np.flatnonzero(cands.parents == k)
+        keep[idx[np.argmin(d[idx])]] = True
+    return keep
+
+
+def _expand(cands: Candidates, centres: np.ndarray, parents: np.ndarray, side: float) -> Candidates:
+    boxes = np.column_stack([centres - side / 2, np.full((len(centres), 2), side)])
+    return Candidates(centres, boxes, cands.areas[parents], {k: v[parents] for k, v in cands.terms.items()},
+                      cands.priors[parents], parents)
 
 
 def blob_likelihood(points: np.ndarray, candidates: Candidates, sigma_xy: float) -> np.ndarray:
@@ -158,9 +269,13 @@ class LimbFilter:
         if backproj is None or p.mean_shift_iterations <= 0:
             return
         x, y, w, h = mean_shift(backproj, self.box(), p.mean_shift_iterations, p.mean_shift_eps)
-        new = np.array([x + w / 2, y + h / 2])
+        self.shift_to((x + w / 2, y + h / 2))
+
+    def shift_to(self, centre) -> None:
+        """Move the estimate to ``centre`` and every sample by the same amount (a refinement)."""
+        new = np.asarray(centre, dtype=float)
         self.particles[:, :2] += new - self.estimate
-        self.estimate = new
+        self.estimate = new.copy()
 
     def resample(self, rng: np.random.Generator) -> None:
         idx = systematic_resample(self.weights, len(self.particles), rng)

@@ -32,7 +32,8 @@ import pandas as pd
 
 from tracking.box import Box
 from tracking.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
-from tracking.limb_filter import Candidates, LimbFilter, candidate_modes, candidate_terms
+from tracking.limb_filter import (Candidates, LimbFilter, blob_points, candidate_modes, candidate_terms,
+                                 nearest_part_candidates, nearest_per_parent, tip_candidates)
 from tracking.params import LimbParams
 from tracking.parts import LIMB_PARTS
 from tracking.skin import SkinModel, find_blobs, train_skin_model
@@ -98,6 +99,7 @@ class _Target:
     missed: int = 0  # uninitialized: frames without its candidate
     shown: np.ndarray | None = None  # combined: the position written for this member
     anchor: np.ndarray | None = None  # the person's head estimate when ``last`` was taken
+    prev: np.ndarray | None = None  # normal: the estimate one frame before (the hand's velocity)
 
     @property
     def labelled(self) -> bool:
@@ -178,7 +180,7 @@ class LimbTracker:
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
                                          bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin,
                                          keep_mass=p.skin_keep_mass, keep_recall=p.skin_keep_recall,
-                                         threshold=p.skin_threshold)
+                                         threshold=p.skin_threshold, keep_min_side=p.skin_keep_min_side)
         skin_prob = self.skin.probability(frame)
         skin_mask = skin_prob >= p.skin_threshold
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
@@ -210,20 +212,61 @@ class LimbTracker:
         active = [t for t in self.machine.trackers()
                   if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
         observations: dict[int, Observation] = {}
-        owners = self._owners(cands, active)
+        pixels: list = []  # each blob's pixels, read once when a hand needs its ends
+        sets: dict = {}  # hands' candidate sets (blob ends) and their owners, by box side
+        owner, within = self._owners(cands, active)
+        # a head's blob (face and neck) is no hand's: its lower end would look like one
+        heads = within & np.array([self.targets[o].part == "head" if o >= 0 else False for o in owner], bool)
+
+        def points() -> list[np.ndarray]:
+            if not pixels:
+                pixels.append(blob_points(blobs))
+            return pixels[0]
+
+        def not_heads(c: Candidates) -> Candidates:
+            return self._subset(c, ~heads[c.parents]) if c.parents is not None else c
+
+        def seen_by(t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
+            side = self._hand_side(t)
+            if side not in sets:
+                c = cands if side is None else not_heads(tip_candidates(cands, points(), side, p))
+                sets[side] = (c, self._owners(c, active))
+            return sets[side]
+
         for t in active:
             tgt = self.targets[t]
             state = self.machine.state(t)
+            own_c, owners = seen_by(t)
+            before, prev, tgt.prev = tgt.filter.estimate.copy(), tgt.prev, None
             if state == LimbState.LOST:
                 tgt.filter.reset(self._search_centre(t), self.rng, spread=p.lost_search)
-                obs_c = self._unclaimed(cands, exclude=t)
+                obs_c = self._unclaimed(own_c, exclude=t)
             elif state == LimbState.COMBINED:
                 # the pair's filter sees only candidates no other tracker explains (its own blobs)
                 tgt.filter.predict(self.rng, p.combined_noise_scale)
-                obs_c = self._unclaimed(cands, exclude=(t, self.machine.partner(t)))
+                side = self._hand_side(t)
+                if side is not None:  # two hands: each blob's part nearest the pair
+                    own_c = not_heads(nearest_part_candidates(cands, points(), tgt.filter.estimate, side, p))
+                obs_c = self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
             else:
                 tgt.filter.predict(self.rng)
-                obs_c = self._owned(cands, t, owners)
+                obs_c = self._owned(own_c, t, owners)
+            on_end = False  # the hand is seen as the end of an arm-long blob
+            if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
+                # one end per blob, the one nearest the predicted hand: the other end of its arm
+                # is its elbow, and a posterior split between both ends would put it mid-arm
+                at = tgt.filter.estimate if state == LimbState.LOST else \
+                    before if prev is None else before + p.velocity_decay * (before - prev)
+                ends = np.bincount(own_c.parents, minlength=len(blobs))[obs_c.parents] >= 2
+                keep = nearest_per_parent(obs_c, at)
+                if state != LimbState.LOST:
+                    # an arm's end farther than tip_gate sides is another part of it (an elbow
+                    # when the hand end merged into another blob): not this hand
+                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.tip_gate * max(tgt.size)
+                    keep &= ~(ends & far)
+                obs_c, ends = self._subset(obs_c, keep), ends[keep]
+                if len(obs_c):
+                    on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))])
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
@@ -231,10 +274,18 @@ class LimbTracker:
                 # a kernel as wide as the search: the particles sit on one mode, the other may be far
                 m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
                 modes = tuple(map(tuple, m[:2]))
-            if state != LimbState.LOST:
+            if state != LimbState.LOST and on_end:
+                # the refinement of an arm's end is the end itself (mean shift on the skin
+                # would slide the window up the arm)
+                d = np.hypot(*(obs_c.centres - tgt.filter.estimate[None, :]).T)
+                if d.min() <= max(tgt.size):
+                    tgt.filter.shift_to(obs_c.centres[int(np.argmin(d))])
+            elif state != LimbState.LOST:
                 bp = back_projection(skin_bins, tgt.filter.ref_hist)
                 tgt.filter.refine(bp)
             tgt.filter.resample(self.rng)
+            if state == LimbState.NORMAL:
+                tgt.prev = before
             if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:
                 tgt.last = tgt.filter.estimate.copy()
                 tgt.anchor = self._head_of(t)
@@ -271,6 +322,19 @@ class LimbTracker:
             other = self.targets[partner]
             side = (side + (other.size[0] + other.size[1]) / 2) / 2
         return side
+
+    def _hand_side(self, t: int) -> float | None:
+        """Box side of a hand target (of both, for a combined pair of hands), rounded to a
+        pixel so hands of one size share their candidates; None for heads and unlabelled targets."""
+        hands = ("left_hand", "right_hand")
+        members = [t]
+        partner = self.machine.partner(t)
+        if self.machine.state(t) == LimbState.COMBINED and partner is not None:
+            members.append(partner)
+        if any(self.targets[m].part not in hands for m in members):
+            return None
+        side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
+        return side if self.params.tip_span > 0 and side >= self.params.tip_min_side else None
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
@@ -413,7 +477,8 @@ class LimbTracker:
     @staticmethod
     def _subset(cands: Candidates, keep: np.ndarray) -> Candidates:
         return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
-                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep])
+                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep],
+                          None if cands.parents is None else cands.parents[keep])
 
     def _unclaimed(self, cands: Candidates, exclude: int | tuple) -> Candidates:
         """Candidates not explained by another active tracker (a lost target must not

@@ -297,15 +297,32 @@ class LimbParams:
     skin_ybins: int = 8
     # ... and where the refit sees under skin_keep_recall of an init box as skin, keep as skin
     # the colour bins holding skin_keep_mass of that box's pixels (skin.train_skin_model).
-    # Off by default (0): on desk seeds 2 and 9 the plain refit sees under 6% of each hand
-    # (forearms and desk share the hands' bins), but keeping those bins brings in the
-    # same-coloured forearms, whose blob centre pulls the hand filter ~25 px up the arm:
-    # desk 720x480 (12 seeds) right hand 0.75 and left 0.83 at 0.8 vs 0.83 / 1.00 off
-    # (applied to every box: 0.50 / 0.75).
-    skin_keep_mass: float = 0.0
+    # On desk seeds 2 and 9 the plain refit sees under 6% of each hand (short sleeves: the
+    # forearms share the hands' bins); kept, hands and forearms show, and hands see the arm's
+    # end (tip_span), not the blob centre: desk 720x480 (12 seeds) right hand 1.00 vs 0.83 off.
+    skin_keep_mass: float = 0.8
     skin_keep_recall: float = 0.5
+    # ... for boxes with both sides at least this (pixels): the walker's 8 px hands have too
+    # few pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without),
+    # and at 320x240 (desk hands 13-16 px) it went with tip_min_side (below).
+    skin_keep_min_side: float = 17.0
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     skin_open: int = 3
+    # hands see the ends of elongated blobs, not their centres (limb_filter.blob_tips): a blob
+    # whose farthest pixels are tip_span hand sides apart gives its two ends, plus any pixel
+    # tip_far sides from every end found; an end's point is the centroid of the blob within
+    # tip_radius sides. tip_span = 0: blob centres only.
+    tip_span: float = 1.6
+    tip_far: float = 2.5
+    tip_radius: float = 0.8
+    # ... for hands with a box side at least this (pixels); smaller hands see blob centres: a
+    # distant walker's 8 px hand end is mostly noise (walker 640x480 left hand 0.25 at frame
+    # 105 with ends, 1.00 without), and a 15 px desk hand's blob at 320x240 is cut square by
+    # the support box around it, whose corners become "ends" (desk seed 7 lost both hands;
+    # at 14 px the 12-seed 320x240 rates stayed 0.92 / 0.75, other seeds failing).
+    tip_min_side: float = 17.0
+    # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
+    tip_gate: float = 1.0
 
     def to_dict(self) -> dict:
         return asdict(self)

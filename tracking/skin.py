@@ -148,7 +148,7 @@ def _check_frame(frame: np.ndarray) -> np.ndarray:
 
 def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinModel | None = None,
                      prior_weight: float = 20.0, inner: float = 1.0, keep_mass: float = 0.0,
-                     keep_recall: float = 0.5, threshold: float = 0.5) -> SkinModel:
+                     keep_recall: float = 0.5, threshold: float = 0.5, keep_min_side: float = 0.0) -> SkinModel:
     """Fit P(skin | Y, Cr, Cb) from corrected head/hand boxes (the prior's blur is kept).
 
     ``frames``: BGR frames; ``boxes``: for each frame a ``(K, 4)`` array of ``x, y, w, h``
@@ -167,8 +167,9 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
     when the same colour fills more of the frame elsewhere: on the synthetic desk (seeds
     2, 9) the forearms and the desk top next to the hands share the hands' bins, the ratio
     fell to ~0.4 and the refit model saw under 6% of each hand. Boxes the ratio already
-    sees keep the ratio's answer (it rejects same-coloured forearms that would pull a hand
-    blob's centre away).
+    sees keep the ratio's answer. Boxes with a side under ``keep_min_side`` pixels are not
+    kept: a distant walker's 8-pixel hand is mostly edge pixels blurred with the background,
+    whose bins would turn the floor into skin.
     """
     if not 0.0 <= keep_mass <= 1.0:
         raise ValueError(f"keep_mass must be in [0, 1], got {keep_mass}")
@@ -192,7 +193,7 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
             cv2.ellipse(one, (int(round(x + w / 2)), int(round(y + h / 2))),
                         (max(int(inner * w / 2), 1), max(int(inner * h / 2), 1)), 0, 0, 360, 255, -1)
             mask |= one
-            if keep_mass > 0:
+            if keep_mass > 0 and min(w, h) >= keep_min_side:
                 box_hists.append(cv2.calcHist([ycrcb], hist_args[0], one, *hist_args[1:]).ravel())
         skin += cv2.calcHist([ycrcb], hist_args[0], mask, *hist_args[1:])
     if n_frames == 0:

@@ -4,7 +4,8 @@ import cv2
 import numpy as np
 
 from tracking.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
-from tracking.limb_filter import Candidates, LimbFilter, blob_likelihood, candidate_modes, candidate_terms, silhouette_term
+from tracking.limb_filter import (Candidates, LimbFilter, blob_likelihood, blob_points, blob_tips, candidate_modes,
+                                  candidate_terms, nearest_per_parent, silhouette_term, tip_candidates)
 from tracking.params import LimbParams
 from tracking.skin import SkinModel, find_blobs
 
@@ -84,3 +85,46 @@ def test_candidate_modes_are_the_strong_nearby_components():
     cands = _cands([[0, 0], [30, 0], [200, 0], [15, 0]], [1.0, 0.8, 1.0, 0.01])
     m = candidate_modes(pts, w, cands, sigma_xy=5.0, radius=40.0)
     np.testing.assert_allclose(m, [[0, 0], [30, 0]])  # far one out of reach, weak one below 10 %
+
+
+def _blob(draw) -> np.ndarray:
+    mask = np.zeros((120, 160), np.uint8)
+    draw(mask)
+    (pts,) = blob_points(find_blobs(mask, 1, 1.0, 10))
+    return pts
+
+
+def test_an_arm_long_blob_gives_its_two_hand_sized_ends_and_a_hand_its_centre():
+    def arm(m):  # forearm (width 12) from an elbow at (30, 60) to a hand of radius 8 at (100, 60)
+        cv2.line(m, (30, 60), (100, 60), 255, 12)
+        cv2.circle(m, (100, 60), 8, 255, -1)
+    tips = blob_tips(_blob(arm), side=16, span=1.6, far=2.5, radius=0.8)
+    assert tips.shape == (2, 2)
+    tips = tips[np.argsort(tips[:, 0])]
+    assert np.allclose(tips[1], (100, 60), atol=3.0)  # the hand's centre, not the blob's (~67, 60)
+    assert abs(tips[0, 0] - 30) < 8 and abs(tips[0, 1] - 60) < 1
+    hand = _blob(lambda m: cv2.circle(m, (80, 50), 8, 255, -1))
+    assert np.allclose(blob_tips(hand, 16, 1.6, 2.5, 0.8), [[80, 50]], atol=0.5)
+
+
+def test_two_forearms_meeting_at_a_clap_give_the_meeting_point_as_a_third_end():
+    def v(m):
+        cv2.line(m, (20, 100), (80, 40), 255, 12)
+        cv2.line(m, (140, 100), (80, 40), 255, 12)
+    tips = blob_tips(_blob(v), side=16, span=1.6, far=2.5, radius=0.8)
+    assert len(tips) == 3
+    assert np.min(np.hypot(*(tips - np.array([80, 44])).T)) < 6.0
+
+
+def test_tip_candidates_keep_their_blob_and_prior_and_one_end_per_blob_is_chosen():
+    mask = np.zeros((120, 160), np.uint8)
+    cv2.line(mask, (20, 30), (90, 30), 255, 12)  # an arm
+    cv2.circle(mask, (130, 90), 8, 255, -1)  # a hand alone
+    blobs = find_blobs(mask, 1, 1.0, 10)
+    cands = Candidates(blobs.centres, blobs.boxes, blobs.areas, {"x": np.array([0.9, 0.5])}, np.array([0.9, 0.5]))
+    tc = tip_candidates(cands, blob_points(blobs), 16, LimbParams())
+    assert len(tc) == 3 and list(np.bincount(tc.parents)) == [2, 1]
+    assert np.allclose(tc.priors, [0.9, 0.9, 0.5]) and np.allclose(tc.terms["x"], tc.priors)
+    keep = nearest_per_parent(tc, (95, 35))
+    assert keep.sum() == 2
+    assert tc.centres[keep & (tc.parents == 0)][0, 0] > 70  # the arm's end near (95, 35)

@@ -198,3 +198,39 @@ def test_head_whose_confidence_stays_low_is_reacquired_by_the_face_detector():
     for h in heads[14:]:  # 3 low frames (10, 11, 12), re-acquired at 12
         assert np.hypot(*(np.array(h.box.centre) - (140, 25))) < 3.0
     assert heads[-1].state == "normal"
+
+
+def arm_scene(n=40):
+    """Short sleeves: each hand (radius 10, box 20) ends a forearm of the same skin colour
+    hanging from a sleeve; the person's right hand (image left) reaches out over frames
+    10-20 and comes back over frames 25-35."""
+    frames, rows = [], []
+    for t in range(n):
+        f = np.full((200, 260, 3), BG, np.uint8)
+        cv2.rectangle(f, (105, 50), (155, 185), SHIRT, -1)
+        reach = min(max(t - 10, 0), 10) - min(max(t - 25, 0), 10)  # 0 .. 10 .. 0
+        head, lh, rh = (130, 32), (165, 165), (int(85 - 4 * reach), int(165 - reach))
+        cv2.circle(f, head, 16, SKIN, -1)
+        for sh, el, hand in (((105, 60), (92, 110), rh), ((155, 60), (170, 110), lh)):
+            cv2.line(f, sh, el, SHIRT, 14)
+            cv2.line(f, el, hand, SKIN, 14)
+            cv2.circle(f, hand, 10, SKIN, -1)
+            cv2.circle(f, el, 8, SHIRT, -1)  # the sleeve's end
+        frames.append(f)
+        rows += [(t, 7, "head", head[0] - 16, head[1] - 16, 32, 32),
+                 (t, 7, "left_hand", lh[0] - 10, lh[1] - 10, 20, 20),
+                 (t, 7, "right_hand", rh[0] - 10, rh[1] - 10, 20, 20)]
+    return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def test_a_hand_on_its_forearm_is_tracked_at_the_arm_end_not_the_blob_centre():
+    frames, truth = arm_scene()
+    init = truth[truth.frame == 0]
+    err, m = centre_error(run(LimbTracker(P, np.random.default_rng(3), init=init), frames), truth)
+    hands = m.part.str.endswith("hand")
+    assert err[hands].max() < 5.0
+    assert (m.state[hands] == "normal").all()
+    # with blob centres the same clip pulls the hands up their forearms
+    centres = LimbParams(particles=150, tip_span=0.0)
+    err0, m0 = centre_error(run(LimbTracker(centres, np.random.default_rng(3), init=init), frames), truth)
+    assert err0[m0.part.str.endswith("hand")].max() > 10.0

@@ -113,5 +113,8 @@ def test_keep_mass_keeps_a_box_colour_that_fills_more_of_the_frame_elsewhere():
     assert kept.probability(_px(skin))[0, 0] == 1.0
     assert kept.probability(_px(bg))[0, 0] < 0.05
     assert kept.probability(_px(other))[0, 0] < 0.5  # colours not in the box still earn their ratio
+    # a box under keep_min_side pixels (a distant walker's hand) keeps the plain ratio
+    small = train_skin_model([f], box, bins=32, keep_mass=0.8, keep_min_side=21)
+    assert small.probability(_px(skin))[0, 0] == plain.probability(_px(skin))[0, 0]
     with pytest.raises(ValueError, match="keep_mass"):
         train_skin_model([f], box, bins=32, keep_mass=1.5)
