@@ -114,7 +114,13 @@ def adjust_person(tracker: "BodyTracker", person: "Person", verdict: FailureVerd
     velocity = person.velocity()  # the person's motion; a failed part's own velocity is not trusted
     boxes = {n: f[n].box for n in ("head", "torso", "hipleg")}
     failed = set(verdict.failed)
-    if verdict.multi or len(failed) >= 2:
+    # a multi-part verdict re-initialises the person only when at least two part SVMs say
+    # failed this frame: the multi SVM alone is weak (it separates single from multi-part
+    # failures at balanced accuracy ~0.75), and re-initialising a person who is not upright
+    # decomposes the wrong shape (measured on the bending walker: head and hip-leg lost)
+    scores = verdict.scores or {}
+    negative = {n for n, v in scores.items() if v < 0} | failed
+    if len(failed) >= 2 or (verdict.multi and len(negative) >= 2):
         predicted = minimum_bounding_rectangle(state_to_box(np.r_[person.prev[n][:2] + person.prev[n][4:6],
                                                                   person.prev[n][2:4]])
                                                for n in ("head", "torso", "hipleg"))
