@@ -8,9 +8,13 @@
     negative with y pointing down);
   - hip-leg: the same below the torso, keeping the upper half as in sec. 4.1;
   and its particles and appearance model are re-seeded from the new box;
-* two or three failed parts (``verdict.multi``): the person is re-initialised from the
-  foreground around its predicted position (sec. 4.3, first paragraph): the blob that
-  overlaps the predicted person box most, decomposed by sec. 4.1.
+  beyond the paper, a lost head or hip-leg is also looked for with its own model on the
+  foreground around the torso (:func:`search_on_body`): where that matches better, the part
+  moves there and keeps its model (a person bending forward, whom the upright geometry misses);
+* two or three failed parts: the person is re-initialised from the foreground around its
+  predicted position (sec. 4.3, first paragraph): the blob that overlaps the predicted
+  person box most, decomposed by sec. 4.1. A ``multi`` verdict counts only when at least two
+  part scores are negative too.
 
 Without usable foreground the rebuilt part keeps its previous size and sits above (head)
 or below (hip-leg) the torso, which is what the geometry alone says.
@@ -187,10 +191,7 @@ def search_on_body(pf, torso: np.ndarray, rebuilt: Box, ycc: np.ndarray, mask: n
 
 
 def _reseed(pf, box: Box, ycc: np.ndarray, velocity: np.ndarray | None, keep_model: bool = False) -> None:
-    reference = pf.reference
-    pf.reseed(Box(box.x, box.y, max(box.w, 2.0), max(box.h, 2.0)), ycc, n=pf.n, keep_velocity=True)
-    if keep_model:
-        pf.reference = reference
-        pf._refresh_map()
+    pf.reseed(Box(box.x, box.y, max(box.w, 2.0), max(box.h, 2.0)), ycc, n=pf.n, keep_velocity=True,
+              keep_model=keep_model)
     if velocity is not None:
         pf.set_velocity(velocity)

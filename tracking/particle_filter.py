@@ -66,9 +66,11 @@ class PartFilter:
         self.reseed(box, ycc, n=n)
 
     # -- initialisation -------------------------------------------------------------
-    def reseed(self, box: Box, ycc: np.ndarray, n: int | None = None, keep_velocity: bool = False) -> None:
+    def reseed(self, box: Box, ycc: np.ndarray, n: int | None = None, keep_velocity: bool = False,
+               keep_model: bool = False) -> None:
         """Restart at ``box``: new particles around it and a new appearance model from it
-        (initialisation, and the adjustment of sec. 4.3)."""
+        (initialisation, and the adjustment of sec. 4.3); ``keep_model``: keep the current
+        model (the adjustment found the part with it)."""
         velocity = self.state[4:6].copy() if keep_velocity and hasattr(self, "state") else np.zeros(2)
         self.state = box_to_state(box)
         self.state[4:6] = velocity
@@ -82,9 +84,11 @@ class PartFilter:
                           + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
         self._clip_sizes()
         self.weights = np.full(n, 1.0 / n)
+        self.similarity = 1.0
+        if keep_model and hasattr(self, "reference"):
+            return
         self.reference = _box_histogram(ycc, box)
         self._refresh_map()
-        self.similarity = 1.0
 
     def _refresh_map(self) -> None:
         p = self.params
