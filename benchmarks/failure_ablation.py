@@ -78,7 +78,8 @@ def main(argv=None) -> int:
     if "selection" in retrained.summary:
         from models.selection import selection_table
 
-        print("  validation on its training clips (components kept only if they raise the mean rate):")
+        print("  validation on its training clips (noise, extent kept only if they raise the mean rate, "
+              "the detector unless it lowers it):")
         print("  " + selection_table(retrained.summary["selection"]).replace("\n", "\n  "))
     conditions = {
         "none": (default.body_params, None),

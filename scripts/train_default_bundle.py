@@ -86,7 +86,8 @@ def main(argv=None) -> int:
     if "selection" in bundle.summary:
         from models.selection import selection_table
 
-        print("validation on the training clips (a component is kept only if it raises the mean rate):")
+        print("validation on the training clips (noise and extent kept only if they raise the mean rate, "
+              "the detector unless it lowers it):")
         print(selection_table(bundle.summary["selection"]))
     return 0
 

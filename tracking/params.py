@@ -172,6 +172,11 @@ class BodyParams:
     # Likewise vertically: head and hip-leg stay near their starting height relative to the
     # torso (in torso heights), sigma = coherence_y x torso height (bending changes it slowly).
     coherence_y: float = 0.5
+    # Adjustment (sec. 4.3) of a lost head or hip-leg: besides the paper's rebuild above/below the
+    # torso, the part's own model searches the foreground around the torso's centre (candidates
+    # spread by this many torso heights) and wins if it matches better; that finds the head of a
+    # person bending forward, where the paper's upright geometry cannot. 0: the paper's rebuild only.
+    adjust_search: float = 0.6
     # Part boxes given in an init table are shrunk to their inner rectangles (sec. 4.1's shrinking
     # applied to the given box) before tracking: a tight box around legs is half floor, and a
     # histogram that is half floor slides onto the floor. False tracks the boxes exactly as given.

@@ -66,9 +66,11 @@ class PartFilter:
         self.reseed(box, ycc, n=n)
 
     # -- initialisation -------------------------------------------------------------
-    def reseed(self, box: Box, ycc: np.ndarray, n: int | None = None, keep_velocity: bool = False) -> None:
+    def reseed(self, box: Box, ycc: np.ndarray, n: int | None = None, keep_velocity: bool = False,
+               keep_model: bool = False) -> None:
         """Restart at ``box``: new particles around it and a new appearance model from it
-        (initialisation, and the adjustment of sec. 4.3)."""
+        (initialisation, and the adjustment of sec. 4.3); ``keep_model``: keep the current
+        model (the adjustment found the part with it)."""
         velocity = self.state[4:6].copy() if keep_velocity and hasattr(self, "state") else np.zeros(2)
         self.state = box_to_state(box)
         self.state[4:6] = velocity
@@ -82,9 +84,11 @@ class PartFilter:
                           + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
         self._clip_sizes()
         self.weights = np.full(n, 1.0 / n)
+        self.similarity = 1.0
+        if keep_model and hasattr(self, "reference"):
+            return
         self.reference = _box_histogram(ycc, box)
         self._refresh_map()
-        self.similarity = 1.0
 
     def _refresh_map(self) -> None:
         p = self.params
@@ -165,18 +169,36 @@ class PartFilter:
         self.weights = normalise_weights(weights)
         self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
 
-    def probe(self, ycc: np.ndarray, spread: float, n: int = 200) -> tuple[np.ndarray, float]:
-        """Look for the part around the current estimate without changing the filter: ``n``
-        candidate centres within ``spread`` pixels (Gaussian), the one whose histogram matches
-        the (frozen) model best. Returns ``(state (6,), rho)``; used to end an occlusion when the
-        hidden person shows again away from where its dynamics put it."""
-        cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
-        cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
-        rects, rho, _ = self._similarities(ycc, cand)
-        full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
-        rho[full < 0.8 * float(self.state[2] * self.state[3])] = 0.0  # cut by the frame edge
+    def probe(self, ycc: np.ndarray, spread: float, n: int = 200,
+              centre: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
+        """Look for the part around the current estimate (or around ``centre``) without
+        changing the filter: ``n`` candidate centres within ``spread`` pixels (Gaussian), the
+        one whose histogram matches the (frozen) model best. Returns ``(state (6,), rho)``; used
+        to end an occlusion when the hidden person shows again away from where its dynamics
+        put it, and by the adjustment to find a lost part on its body (``tracking.adjustment``)."""
+        cand = self.candidates(spread, n, centre)
+        rho = self.similarities(ycc, cand)
         k = int(np.argmax(rho))
         return cand[k].astype(np.float64), float(rho[k])
+
+    def candidates(self, spread: float, n: int = 200, centre: tuple[float, float] | None = None) -> np.ndarray:
+        """``(n, 6) float32`` states of the estimate's size at centres drawn around ``centre``
+        (default: the estimate) with standard deviation ``spread`` pixels."""
+        cand = np.repeat(self.state[None, :].astype(np.float32), n, axis=0)
+        if centre is not None:
+            cand[:, 0:2] = np.asarray(centre, dtype=np.float32)
+        cand[:, 0:2] += self.rng.standard_normal((n, 2), dtype=np.float32) * np.float32(spread)
+        return cand
+
+    def similarities(self, ycc: np.ndarray, states: np.ndarray) -> np.ndarray:
+        """Bhattacharyya coefficients ``(N,)`` of ``states`` with the (frozen) model; 0 for a
+        rectangle cut to less than 0.8 of its area by the frame edge."""
+        states = np.asarray(states, dtype=np.float32)
+        rects, rho, _ = self._similarities(ycc, states)
+        full = ((rects[:, 2] - rects[:, 0]) * (rects[:, 3] - rects[:, 1])).astype(np.float32)
+        rho = np.array(rho, dtype=np.float64)
+        rho[full < 0.8 * states[:, 2] * states[:, 3]] = 0.0  # cut by the frame edge
+        return rho
 
     def _similarities(self, ycc: np.ndarray, states: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Rectangles ``(N, 4) int32``, Bhattacharyya coefficients ``(N,)`` with the model and

@@ -19,6 +19,8 @@ def _fake_runner(truths, shift: float = 0.0):
     def run(i, params, detector):
         calls.append((i, params, detector))
         t = truths[i].copy()
+        if detector == "harmful":  # its adjustments knock every head off
+            t.loc[t.part == "head", "x"] += t.loc[t.part == "head", "w"]
         for part, (sw, sh, dx, dy) in params.output_extent.items():
             bw, bh, bdx, bdy = DEFAULT.output_extent[part]
             m = t.part == part
@@ -49,24 +51,32 @@ def test_selection_drops_a_bad_extent_and_keeps_a_good_one():
     bad = replace(DEFAULT, output_extent={**DEFAULT.output_extent, "hipleg": (hip[0] * 3, hip[1] * 3, 0.0, 0.25)})
     run, calls = _fake_runner(truths)
     sel = select_components(run, truths, DEFAULT, bad, detector="svm")
-    assert sel.kept == {"noise": False, "extent": False, "detector": False}
-    assert sel.body_params.output_extent == DEFAULT.output_extent and sel.failure_detector is None
+    assert sel.kept == {"noise": False, "extent": False, "detector": True}
+    assert sel.body_params.output_extent == DEFAULT.output_extent and sel.failure_detector == "svm"
     assert sel.scores["builtin"]["mean"] == 1.0 and sel.scores["+extent"]["hipleg"] == 0.0
-    assert sel.scores["+detector"]["mean"] == 1.0  # a tie keeps the simpler model
+    assert sel.scores["+detector"]["mean"] == 1.0  # a tie: the detector did no harm, so it stays
     assert len(calls) == 3 * 2  # built-in, +extent, +detector (noise not fitted: no run)
     # (2) the tracker reports every box 0.6 widths to the right: all centres off the part;
-    # a fitted extent that shifts them back is kept, a useless detector still is not
+    # a fitted extent that shifts them back is kept, a detector that moves nothing stays (no harm)
     good = replace(DEFAULT, output_extent={p: (sw, sh, dx - 0.6, dy) for p, (sw, sh, dx, dy)
                                            in DEFAULT.output_extent.items()})
     run, calls = _fake_runner(truths, shift=0.6)
     base_tracks = [run(i, DEFAULT, None) for i in range(2)]
     sel = select_components(run, truths, DEFAULT, good, detector="svm", base_tracks=base_tracks)
     assert sel.scores["builtin"]["mean"] == 0.0 and sel.scores["+extent"]["mean"] == 1.0
-    assert sel.kept == {"noise": False, "extent": True, "detector": False}
+    assert sel.kept == {"noise": False, "extent": True, "detector": True}
     assert sel.body_params.output_extent["head"][2] == pytest.approx(-0.6)
     assert len(calls) == 2 + 2 * 2  # the base tracks were given: built-in not re-run
     text = selection_table(sel.to_dict())
-    assert "kept" in text and "dropped" in text and "not fitted" in text
+    assert "kept" in text and "not fitted" in text and "dropped" not in text
+
+
+def test_a_detector_that_lowers_the_rate_is_dropped():
+    truths = [walking_truth(1, 10, seed=2)]
+    run, _ = _fake_runner(truths)
+    sel = select_components(run, truths, DEFAULT, DEFAULT, detector="harmful")
+    assert sel.kept["detector"] is False and sel.failure_detector is None
+    assert sel.scores["+detector"]["head"] == 0.0 and sel.scores["builtin"]["mean"] == 1.0
 
 
 def test_noise_is_tried_first_and_kept_params_carry_on():
@@ -107,9 +117,9 @@ def test_train_bundle_validates_on_the_training_clips_and_records_it():
     runner = _inner_rect_runner([(c[0], t) for c, t in zip(clips, truths)])
     b = train_bundle(clips, seed=0, tracker_runner=runner, perturbed_per_person=100, fit_sharpness=False)
     sel = b.summary["selection"]
-    assert sel["kept"] == {"noise": False, "extent": True, "detector": False}
+    assert sel["kept"] == {"noise": False, "extent": True, "detector": False}  # no SVM could be fitted
     assert sel["scores"]["builtin"]["mean"] == 0.0 and sel["scores"]["+extent"]["mean"] == 1.0
     for part in ("head", "torso", "hipleg"):
         assert b.body_params.output_extent[part] == pytest.approx((1.0, 1.0, -0.3, 0.0), abs=1e-3)
     assert b.body_params.part_noise == DEFAULT.part_noise and b.failure_detector is None
-    assert "svms" in b.summary  # the SVMs were still fitted and reported, just not used
+    assert "svms" in b.summary

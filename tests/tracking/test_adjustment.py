@@ -85,3 +85,41 @@ def test_head_and_hipleg_regions_use_the_foreground_or_geometry():
     hl = hipleg_from_torso(torso, hip, Box(0, 0, 20, 30), mask, 100, 200)
     assert hl.y == pytest.approx(85.0) and hl.h == pytest.approx(30.0)
     assert hl.centre[0] == pytest.approx(50.0, abs=0.6)
+
+
+def _bent_person():
+    """A person bending forward, drawn flat: legs standing at x 40..60, the torso lying
+    horizontally from the hips to the right at shoulder height, the head hanging beside it."""
+    import cv2
+
+    frame = np.full((200, 200, 3), (120, 124, 120), np.uint8)   # grey floor/wall (BGR)
+    frame[100:180, 40:60] = (60, 50, 40)                         # trousers
+    frame[80:104, 40:120] = (200, 120, 60)                       # blue shirt, lying horizontal
+    cv2.circle(frame, (132, 92), 11, (120, 160, 220), -1)        # skin-coloured head beside it
+    frame[81:88, 124:141] = (30, 30, 30)                         # hair on top
+    mask = np.zeros((200, 200), np.uint8)
+    mask[np.any(frame != (120, 124, 120), axis=2)] = 255
+    ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    return ycc, mask
+
+
+def test_a_bending_persons_lost_head_is_found_by_its_model_not_put_above_the_torso():
+    from tracking.adjustment import adjust_person
+
+    ycc, mask = _bent_person()
+    head_true = Box(121, 81, 22, 22)
+    results = {}
+    for search in (0.0, 0.6):
+        params = BodyParams(shrink_given_parts=False, adjust_search=search)
+        tracker = BodyTracker(params, np.random.default_rng(3))
+        person = tracker.start_track(1, {"head": head_true, "torso": Box(90, 82, 24, 20),
+                                         "hipleg": Box(41, 104, 18, 40)}, ycc, mask, 0)
+        head = person.filters["head"]
+        head.shift(np.array([-60.0, 40.0]))                          # lost on the floor by the legs
+        adjust_person(tracker, person, FailureVerdict(failed=("head",)), ycc, mask)
+        results[search] = head.box
+    # the paper's rebuild puts it straight above the torso, where there is nothing
+    assert not correct(results[0.0], head_true) and results[0.0].y2 <= 83
+    # the search with the head's own model finds the hanging head, and keeps that model
+    assert correct(results[0.6], head_true)
+    assert results[0.6].centre == pytest.approx(head_true.centre, abs=8.0)  # within the head's radius (11 px)
