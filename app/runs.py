@@ -147,8 +147,10 @@ def training_truth(store: Store, clip_id: int) -> pd.DataFrame:
 
 
 def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
-                   make_default: bool = False) -> jobs.Job:
-    """Train a bundle from corrected clips in the background, save it and register it."""
+                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
+    """Train a bundle from corrected clips in the background, save it and register it.
+    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
+    worse, :func:`models.training.train_bundle`); None: the built-in parameters."""
     training = optional("models.training")
     bundle_mod = optional("models.bundle")
     if training is None or bundle_mod is None:
@@ -171,6 +173,7 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     runner_mod = optional("models.runner")  # the tracker's own failures are the paper's training samples
     runner = getattr(runner_mod, "body_tracker_runner", None)
     names = [store.clip(cid).name for cid in clip_ids]
+    start = _load_model(start_path)
 
     def work(progress):
         total = training.training_steps(len(clips), with_tracker=runner is not None)
@@ -180,7 +183,8 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
             progress(next(steps), total)
 
         progress(0, total)
-        bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names)
+        bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names,
+                                       start=start)
         bundle_mod.save_bundle(bundle, out)
         record = store.add_bundle(project_id, name, out, summary=bundle.summary)
         if make_default:

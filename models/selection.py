@@ -103,14 +103,18 @@ class Selection:
 
 def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: BodyParams, fitted: BodyParams,
                       detector=None, base_tracks: list[pd.DataFrame] | None = None,
-                      progress: Callable[[str], None] | None = None) -> Selection:
+                      progress: Callable[[str], None] | None = None, base_detector=None) -> Selection:
     """Add the fitted noise (incl. ``lam``), output extent and ``detector`` to ``base`` one at
     a time, keeping the parameters only if they raise the mean per-part rate on the training
-    clips and the detector unless it lowers it.
+    clips and the detector unless it lowers it. Fitted noise that raises some parts' rates and
+    lowers others' is also tried for the parts it raised only (per-part noise).
 
     ``run(i, params, detector)`` tracks training clip ``i``; ``truths[i]`` is its truth.
     ``base_tracks`` (optional): the tracks of ``base`` without a detector, if already run
-    (training runs exactly that), to save one run per clip.
+    (training runs exactly that), to save one run per clip. ``base_detector``: the detector
+    of the model training starts from (e.g. the shipped bundle's); the baseline then tracks
+    with it, the fitted parameters are tried with it, and the new ``detector`` replaces it
+    unless that lowers the rate, so the result never scores below the model it started from.
     """
     step = progress or (lambda _msg: None)
 
@@ -120,8 +124,10 @@ def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: Body
             tracks = [run(i, params, det) for i in range(len(truths))]
         return mean_rates([part_rates(t, g) for t, g in zip(tracks, truths)])
 
-    scores = {"builtin": score(base, None, "built-in", base_tracks)}
-    best, best_params, best_det = scores["builtin"]["mean"], base, None
+    if base_detector is not None:
+        base_tracks = None  # those were run without a detector
+    scores = {"builtin": score(base, base_detector, "built-in", base_tracks)}
+    best, best_params, best_det = scores["builtin"]["mean"], base, base_detector
     kept = {}
     for comp in COMPONENTS:
         if comp == "detector":
@@ -136,6 +142,21 @@ def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: Body
                 kept[comp] = False  # nothing fitted: the same model, no run needed
                 continue
         scores[f"+{comp}"] = s = score(params, det, comp)
+        if comp == "noise":
+            # the noise is fitted per part: where it raised some parts' rates and lowered others'
+            # (a bending walker's hip-leg wants more noise, its head less), try it for the parts
+            # it raised only, and go on with the better of the two
+            base_scores = scores["builtin"]
+            better = [n for n in BODY_PARTS if s[n] > base_scores[n]]
+            if better and any(s[n] < base_scores[n] for n in BODY_PARTS):
+                part_params = replace(best_params, part_noise={
+                    **best_params.part_noise, **{n: fitted.part_noise[n] for n in better}})
+                name = "+noise(" + ",".join(better) + ")"
+                scores[name] = s_part = score(part_params, det, "noise of " + ", ".join(better))
+                if s_part["mean"] > s["mean"]:
+                    params, s = part_params, s_part
+                else:
+                    del scores[name]  # the full fit stands; the table shows what was used
         # parameters must raise the rate; the detector must not lower it (see the module docstring)
         kept[comp] = bool(s["mean"] >= best) if comp == "detector" else bool(s["mean"] > best)
         if kept[comp]:
@@ -148,10 +169,19 @@ def selection_table(selection: dict) -> str:
     rows = []
     scores = selection.get("scores", {})
     order = ["builtin", *(f"+{c}" for c in COMPONENTS)]
-    for name, s in sorted(scores.items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order)):
-        comp = name.lstrip("+")
-        decision = "baseline" if name == "builtin" else ("kept" if selection["kept"].get(comp) else "dropped")
-        rows.append(dict(condition=name, **{k: round(s[k], 3) for k in (*BODY_PARTS, "mean") if k in s},
+    def key(kv):
+        base = kv[0].split("(")[0]
+        return (order.index(base) if base in order else len(order), kv[0] != base)
+
+    partial = {n.split("(")[0] for n in scores if "(" in n}  # "+noise(hipleg)": the noise of some parts
+    for name, s in sorted(scores.items(), key=key):
+        comp = name.lstrip("+").split("(")[0]
+        superseded = name in partial  # the full fit, replaced by the per-part one
+        decision = "baseline" if name == "builtin" else (
+            "kept" if selection["kept"].get(comp) and not superseded else "dropped")
+        label = "start (with its detector)" if name == "builtin" and selection.get("start_detector") else \
+            "start" if name == "builtin" and selection.get("started_from") == "a bundle" else name
+        rows.append(dict(condition=label, **{k: round(s[k], 3) for k in (*BODY_PARTS, "mean") if k in s},
                          decision=decision))
     for comp, k in selection.get("kept", {}).items():
         if f"+{comp}" not in scores:

@@ -131,7 +131,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
                  tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
                  perturbed_per_person: int = 300, body: BodyParams | None = None,
                  limb: LimbParams | None = None, dt: float = DEFAULT_DT,
-                 fit_sharpness: bool | None = None, validate: bool = True) -> Bundle:
+                 fit_sharpness: bool | None = None, validate: bool = True, start=None) -> Bundle:
     """Fit the four failure SVMs and the variance parameters from corrected clips.
 
     ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
@@ -142,9 +142,19 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     ``validate`` (with ``tracker_runner``): keep each fitted component only if it does not
     lower the tracking rate on the training clips (:func:`models.selection.select_components`;
     up to three more tracker runs per clip); without it, everything fitted is used.
+    ``start``: the bundle training starts from (e.g. :func:`models.bundle.default_bundle`):
+    its body parameters are the defaults the fits widen, and validation starts from its
+    parameters *and* its failure detector, which the new detector replaces only if that does
+    not lower the rate, so retraining never scores below ``start`` on the training clips.
+    None: the built-in parameters without a detector.
     """
     if not clips:
         raise ValueError("no clips to train from")
+    start_detector = None
+    if start is not None:
+        body = body or start.body_params
+        limb = limb or start.limb_params
+        start_detector = start.failure_detector
     names = list(names) if names is not None else [f"clip{i}" for i in range(len(clips))]
     if len(names) != len(clips):
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
@@ -231,12 +241,17 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         fitted = replace(base, part_noise=body_p.part_noise, output_extent=body_p.output_extent)
         chosen = select_components(run, truths, base, fitted, detector,
                                    base_tracks=[t for t, _ in tracked_runs] if body is None else None,
-                                   progress=step)
+                                   progress=step, base_detector=start_detector)
         body_p = replace(body_p, part_noise=chosen.body_params.part_noise,
                          output_extent=chosen.body_params.output_extent)
+        new_detector = detector
         detector = chosen.failure_detector
         selection = chosen.to_dict()
         selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output_extent.items()}
+        selection["started_from"] = "a bundle" if start is not None else "built-in"
+        selection["start_detector"] = start_detector is not None
+        selection["detector"] = ("new" if detector is not None and detector is new_detector else
+                                 "start's" if detector is not None else "none")
         if not chosen.kept["noise"]:  # the table's "applied" says what the bundle uses
             body_rows = table["tracker"] == "body"
             table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]

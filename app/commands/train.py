@@ -19,6 +19,11 @@ def add_arguments(p) -> None:
                    help="its corrected boxes, one per --clip in the same order")
     p.add_argument("-o", "--output", metavar="BUNDLE_DIR", required=True, help="model bundle directory to write")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--from", dest="start", metavar="MODEL", default="default",
+                   help="the model to improve on: 'default' (partlab's shipped bundle), a bundle directory, or "
+                        "'none' (the built-in parameters without a failure detector). Its parameters are the "
+                        "defaults the fits widen; its detector is kept unless the new one does no worse on "
+                        "these clips (default: default)")
     p.add_argument("--no-tracker", action="store_true",
                    help="learn from the corrected boxes only (perturbed truth and failure flags), "
                         "without running the body tracker on the clips")
@@ -60,6 +65,11 @@ def run(args) -> int:
             raise CommandError(f"{truth_path}: no boxes")
         clips.append((clip.frames, clip.info.fps, truth))
         names.append(Path(video).name)
+    start = None
+    if args.start != "none":
+        from app.commands.track import load_model
+
+        start = load_model(args.start)
     runner = None if args.no_tracker else _tracker_runner()
     if runner is None and not args.no_tracker:
         print("partlab train: the body tracker is not available; learning from corrected boxes only")
@@ -68,7 +78,8 @@ def run(args) -> int:
             bar.set_postfix_str(msg)
             bar.update(1)
         try:
-            bundle = train_bundle(clips, seed=args.seed, progress=progress, tracker_runner=runner, names=names)
+            bundle = train_bundle(clips, seed=args.seed, progress=progress, tracker_runner=runner, names=names,
+                                  start=start)
         except ValueError as exc:
             raise CommandError(str(exc)) from None
     try:
@@ -93,7 +104,7 @@ def run(args) -> int:
     if "selection" in bundle.summary:
         from models.selection import selection_table
 
-        print("\nvalidation on the training clips (tracking rate per part; a component is kept only if it "
-              "raises the mean):")
+        print(f"\nvalidation on the training clips, starting from {args.start!r} (tracking rate per part; noise "
+              "and extent are kept only if they raise the mean, the new detector unless it lowers it):")
         print(selection_table(bundle.summary["selection"]))
     return 0

@@ -6,7 +6,7 @@ import streamlit as st
 
 from app import state
 from app.views.common import job_panel, require_project
-from app.runs import missing, start_training
+from app.runs import SHIPPED, bundle_choices, missing, start_training
 from labelling.store import StoreError
 
 s = state.store()
@@ -27,12 +27,20 @@ with st.form("train"):
     name = c1.text_input("Bundle name", value=f"bundle-{len(s.bundles(project.id)) + 1}")
     seed = c2.number_input("Seed", min_value=0, value=0, step=1)
     make_default = c3.checkbox("Make it the project's default", value=True)
+    starts = bundle_choices(s, project)
+    labels = list(starts)
+    first = next((k for k in labels if k.endswith("(project default)")), SHIPPED if SHIPPED in starts else labels[0])
+    start_label = st.selectbox("Start from", labels, index=labels.index(first),
+                               help="The model to improve on: its failure detector stays unless the one trained "
+                                    "here does no worse on these clips, and fitted parameters are kept only if "
+                                    "they raise the tracking rate on them.")
     go_train = st.form_submit_button("Train", type="primary", disabled=bool(lacking) or not corrected)
 if not corrected:
     st.info("No clip has corrected frames yet: correct some boxes on the Correct page first.")
 if go_train:
     try:
-        job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default)
+        job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default,
+                             start_path=starts[start_label])
         st.success(f"Started: {job.label}")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))

@@ -79,6 +79,22 @@ def test_a_detector_that_lowers_the_rate_is_dropped():
     assert sel.scores["+detector"]["head"] == 0.0 and sel.scores["builtin"]["mean"] == 1.0
 
 
+def test_training_from_a_bundle_keeps_its_detector_unless_the_new_one_does_no_harm():
+    truths = [walking_truth(1, 10, seed=2)]
+    run, calls = _fake_runner(truths)
+    # the new detector knocks heads off: the start bundle's detector stays
+    sel = select_components(run, truths, DEFAULT, DEFAULT, detector="harmful", base_detector="shipped")
+    assert sel.failure_detector == "shipped" and sel.kept["detector"] is False
+    assert calls[0][2] == "shipped"  # the baseline was tracked with the start's detector
+    # a harmless new detector replaces it (it was trained on the user's own corrections)
+    sel = select_components(run, truths, DEFAULT, DEFAULT, detector="svm", base_detector="shipped")
+    assert sel.failure_detector == "svm" and sel.kept["detector"] is True
+    # and a detector the baseline would have ruined its baseline score with is measured as such
+    sel = select_components(run, truths, DEFAULT, DEFAULT, detector="svm", base_detector="harmful")
+    assert sel.scores["builtin"]["head"] == 0.0 and sel.failure_detector == "svm"
+    assert "start (with its detector)" in selection_table({**sel.to_dict(), "start_detector": True})
+
+
 def test_noise_is_tried_first_and_kept_params_carry_on():
     truths = [walking_truth(1, 10, seed=3)]
     noisy = replace(DEFAULT, part_noise={**DEFAULT.part_noise,
@@ -88,6 +104,29 @@ def test_noise_is_tried_first_and_kept_params_carry_on():
     # the fake tracker ignores the noise: a tie, so the built-in noise stays
     assert sel.kept["noise"] is False and sel.body_params.part_noise["head"].lam == DEFAULT.part_noise["head"].lam
     assert np.isclose(sel.scores["+noise"]["mean"], 1.0) and "+extent" not in sel.scores
+
+
+def test_noise_that_helps_one_part_and_hurts_another_is_kept_for_the_part_it_helps():
+    truths = [walking_truth(1, 10, seed=4)]
+    fitted = replace(DEFAULT, part_noise={**DEFAULT.part_noise,
+                                          "head": replace(DEFAULT.part_noise["head"], lam=35.0),
+                                          "hipleg": replace(DEFAULT.part_noise["hipleg"], lam=36.0)})
+
+    def run(i, params, detector):  # fitted head noise knocks heads off, built-in hip-leg noise hip-legs
+        t = truths[i].copy()
+        if params.part_noise["head"].lam == 35.0:
+            t.loc[t.part == "head", "x"] += t.loc[t.part == "head", "w"]
+        if params.part_noise["hipleg"].lam != 36.0:
+            t.loc[t.part == "hipleg", "x"] += t.loc[t.part == "hipleg", "w"]
+        return t
+
+    sel = select_components(run, truths, DEFAULT, fitted)
+    assert sel.kept["noise"] is True and sel.scores["+noise(hipleg)"]["mean"] == 1.0
+    assert sel.body_params.part_noise["hipleg"].lam == 36.0
+    assert sel.body_params.part_noise["head"].lam == DEFAULT.part_noise["head"].lam
+    text = selection_table(sel.to_dict())
+    assert [line.split()[-1] for line in text.splitlines()[1:3]] == ["baseline", "dropped"]
+    assert "+noise(hipleg)" in text.splitlines()[3] and text.splitlines()[3].split()[-1] == "kept"
 
 
 def _inner_rect_runner(truths):
