@@ -16,6 +16,7 @@ Named so as not to clash with the body developer's ``benchmarks/track_accuracy.p
 A script, not a test:
 
     PYTHONPATH=. python benchmarks/track_accuracy_limbs.py [--seeds 0 1 2] [--scenarios desk single] [--fg plate]
+                                                           [--video]   # through the mp4 codec, as partlab track
 """
 
 from __future__ import annotations
@@ -79,12 +80,31 @@ class PlateForeground:
         return (diff > self.threshold).astype(np.uint8) * 255
 
 
-def run_scene(scene, params: LimbParams, seed: int, fg: str = "model") -> tuple[pd.DataFrame, pd.DataFrame]:
+def through_codec(frames: np.ndarray, fps: float) -> list[np.ndarray]:
+    """The frames as a user's tracker sees them: written to an mp4 (``labelling.video.write_video``)
+    and decoded again. The codec shifts and blurs colours, which changes what the skin model sees."""
+    import tempfile
+    from pathlib import Path
+
+    from labelling.video import VideoClip, write_video
+
+    with tempfile.TemporaryDirectory() as tmp:
+        path = write_video(Path(tmp) / "clip.mp4", frames, fps)
+        clip = VideoClip(path)
+        try:
+            return [f for _, f in clip.frames(0, clip.frame_count)]
+        finally:
+            clip.close()
+
+
+def run_scene(scene, params: LimbParams, seed: int, fg: str = "model",
+              video: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
     init = scene.init[scene.init["part"].isin(LIMB_PARTS)]
     tracker = LimbTracker(params, np.random.default_rng(seed), init=init)
     bg = PlateForeground(scene.background) if fg == "plate" else foreground_model()
     recs = []
-    for i, frame in enumerate(scene.frames):
+    frames = through_codec(scene.frames, scene.fps) if video else scene.frames
+    for i, frame in enumerate(frames):
         recs += tracker.step(i, frame, bg.apply(frame))
     return records_to_frame(recs), tracker.events
 
@@ -132,7 +152,7 @@ def clap_end(truth: pd.DataFrame, gap: float) -> int:
 
 def limbs_table(scenarios=("desk", "single"), seeds=(0, 1, 2), n_frames: int = 150, width: int = 320,
                 height: int = 240, at: int = 105, params: LimbParams | None = None,
-                fg: str = "model") -> tuple[pd.DataFrame, pd.DataFrame]:
+                fg: str = "model", video: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Per (scenario, seed, part) rows and the per (scenario, part) summary (rate at ``at``, mean
     rate, swaps after the clap); ``benchmarks/track_accuracy.py`` prints the summary as its limbs table."""
     from labelling.synth import make_scene
@@ -142,7 +162,7 @@ def limbs_table(scenarios=("desk", "single"), seeds=(0, 1, 2), n_frames: int = 1
     for name in scenarios:
         for seed in tqdm(seeds, desc=name):
             scene = make_scene(name, seed, n_frames, width, height)
-            out, events = run_scene(scene, params, seed, fg)
+            out, events = run_scene(scene, params, seed, fg, video)
             m = score(out, scene.truth)
             hands = m[m.part.isin(["left_hand", "right_hand"])]
             gap = float(np.median(hands.w_t)) * 1.5 if len(hands) else 0.0
@@ -175,10 +195,13 @@ def main() -> None:
     ap.add_argument("--fg", choices=["model", "plate"], default="model",
                     help="foreground: the shared background model (MOG2 until tracking/background.py "
                          "lands) or the scene's empty-room plate")
+    ap.add_argument("--video", action="store_true",
+                    help="track the scene as written to an mp4 and decoded again (what `partlab track` sees), "
+                         "not the rendered frames")
     args = ap.parse_args()
     params = LimbParams.from_dict({**LimbParams().to_dict(), **json.loads(args.params)})
     df, summary = limbs_table(args.scenarios, args.seeds, args.frames, args.width, args.height, args.at,
-                              params, args.fg)
+                              params, args.fg, args.video)
     pd.set_option("display.width", 160)
     print(df.to_string(index=False, float_format="%.3f"))
     print()

@@ -305,8 +305,11 @@ class LimbParams:
     # On desk seeds 2 and 9 the plain refit sees under 6% of each hand (short sleeves: the
     # forearms share the hands' bins); kept, hands and forearms show, and hands see the arm's
     # end (tip_span), not the blob centre: desk 720x480 (12 seeds) right hand 1.00 vs 0.83 off.
+    # Only where the refit sees almost nothing of the box (recall < 0.1): through the mp4 codec
+    # (what `partlab track` decodes) the refit sees 10-50% of those hands, and keeping their bins
+    # there turned the forearms and desk into skin (hands 0.75 at 0.5; 0.92 at 0.1, as with none).
     skin_keep_mass: float = 0.8
-    skin_keep_recall: float = 0.5
+    skin_keep_recall: float = 0.1
     # ... for boxes with both sides at least this (pixels): the walker's 8 px hands have too
     # few pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without),
     # and at 320x240 (desk hands 13-16 px) it went with tip_min_side (below).
