@@ -1,7 +1,7 @@
 """Seed 002 sec. 5.2 ablation on the synthetic suite: per-part tracking rates at frame 105.
 
     PYTHONPATH=. python benchmarks/failure_ablation.py [--scenes distractors,bend,...] [--seed 0]
-                                                      [--fast] [--out /tmp/ablation.csv]
+                                                      [--fast] [--out /tmp/ablation.csv] [--video]
 
 For every test scene (``labelling.synth``, seeds not used by the default bundle) the
 body tracker runs from the truth's first boxes
@@ -60,6 +60,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", default="0,1,2,3", help="seeds of the test scenes")
     ap.add_argument("--fast", action="store_true", help="retrain from perturbed truth only")
     ap.add_argument("--out", default=None, help="write the per-scene table as CSV")
+    ap.add_argument("--video", action="store_true",
+                    help="track the test scenes as written to an mp4 and decoded again (what partlab track sees)")
     ap.add_argument("--from-builtin", action="store_true",
                     help="retrain from the built-in parameters (partlab train --from none), not the shipped bundle")
     args = ap.parse_args(argv)
@@ -69,6 +71,7 @@ def main(argv=None) -> int:
     from models.runner import body_tracker_runner, run_body_tracker
     from models.training import first_boxes, train_bundle
     from train_default_bundle import scene_clips
+    from track_accuracy_limbs import through_codec
 
     t0 = time.time()
     default = default_bundle()
@@ -96,7 +99,8 @@ def main(argv=None) -> int:
         for name in args.scenes.split(","):
             scene = make_scene(name, seed=seed)
             init = first_boxes(scene.truth)
-            frames = lambda: ((i, scene.frames[i]) for i in range(len(scene.frames)))  # noqa: E731
+            shown = through_codec(scene.frames, scene.fps) if args.video else scene.frames
+            frames = lambda: ((i, shown[i]) for i in range(len(shown)))  # noqa: E731
             for cond, (params, detector) in conditions.items():
                 t1 = time.time()
                 try:
