@@ -99,6 +99,7 @@ def interrupted() -> list[dict]:
 
 
 def _rewrite_journal(keep) -> None:
+    """Rewrite the journal with the last entries of the jobs ``keep(entry)`` accepts."""
     entries = [e for e in _read_journal().values() if keep(e)]
     try:
         with _JOURNAL_LOCK:
@@ -107,6 +108,8 @@ def _rewrite_journal(keep) -> None:
             os.replace(tmp, journal_path())
     except OSError:
         pass
+
+
 _LOCK = threading.Lock()
 _EXECUTOR: ThreadPoolExecutor | None = None
 

@@ -18,7 +18,7 @@ import pandas as pd
 from app.cli import CommandError
 from labelling.video import VideoClip, VideoError
 from tracking.background import BackgroundModel
-from tracking.identity import match_limb_people, merge_tracks
+from tracking.identity import match_limb_people, merge_tracks, remap_ids
 from tracking.params import BodyParams, LimbParams
 from tracking.tracks import TracksCSVError, empty_tracks, normalise_tracks, records_to_frame
 
@@ -127,7 +127,7 @@ def track_video(video_path: str | PathLike, tracker: str = "body", init: pd.Data
         if events is not None and len(events):
             events = events.copy()
             for col in ("track_id_a", "track_id_b"):
-                events[col] = [mapping.get(int(t), int(t) + offset) for t in events[col]]
+                events[col] = remap_ids(events[col], mapping, offset)
         out = merge_tracks(body, limbs, mapping, offset)
         out = out.sort_values(["frame", "track_id"], kind="stable").reset_index(drop=True)
     else:

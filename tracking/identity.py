@@ -40,13 +40,17 @@ def match_limb_people(body: pd.DataFrame, limbs: pd.DataFrame, min_frames: int =
     return out
 
 
+def remap_ids(ids, mapping: dict[int, int], offset: int) -> np.ndarray:
+    """Limb track ids as written: the matched body person's id, else ``id + offset``."""
+    return np.array([mapping.get(int(t), int(t) + offset) for t in ids], dtype=np.int64)
+
+
 def merge_tracks(body: pd.DataFrame, limbs: pd.DataFrame, mapping: dict[int, int], offset: int) -> pd.DataFrame:
     """Body and limb rows in one table: matched limb people take their body person's id, the
     others ``track_id + offset``; a limb head is dropped where the body tracker has that person's
     head in the same frame (one head box per person and frame)."""
     limbs = limbs.copy()
-    ids = limbs["track_id"].to_numpy()
-    limbs["track_id"] = np.array([mapping.get(int(t), int(t) + offset) for t in ids], dtype=np.int64)
+    limbs["track_id"] = remap_ids(limbs["track_id"], mapping, offset)
     body_heads = body.loc[body["part"] == "head", ["frame", "track_id"]]
     key = pd.MultiIndex.from_frame(body_heads)
     dup = (limbs["part"] == "head") & pd.MultiIndex.from_frame(limbs[["frame", "track_id"]]).isin(key)
