@@ -29,8 +29,8 @@ $(VENV)/.installed-test: pyproject.toml $(VENV)/.installed
 venv: $(VENV)/.installed
 
 run: $(VENV)/.installed
-	$(PY) -m app.demo
-	$(PY) -m app.cli app --host $(HOST) --port $(PORT)
+	$(PY) -m partlab.app.demo
+	$(PY) -m partlab app --host $(HOST) --port $(PORT)
 
 test: $(VENV)/.installed-test
 	$(PY) -m pytest $(PYTEST_ARGS)

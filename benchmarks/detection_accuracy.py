@@ -7,7 +7,7 @@ and the MOT metrics of its person boxes, on the synthetic suite and PETS09-S2L1.
 
 Per scene and seed: ``tracks`` started, ``people`` in the truth, MOTA, IDF1, identity switches,
 false positives and misses of the ``person`` boxes (motmetrics through
-``labelling.evaluation.mot_metrics``, IoU >= 0.5). A walker present in the first frame is
+``partlab.labelling.evaluation.mot_metrics``, IoU >= 0.5). A walker present in the first frame is
 learnt into the background model and leaves a "ghost" where it stood; a tracker that starts
 tracks on ghosts shows more tracks than people and false positives.
 """
@@ -25,11 +25,11 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from labelling.evaluation import mot_metrics  # noqa: E402
-from tracking.background import BackgroundModel  # noqa: E402
-from tracking.body import BodyTracker  # noqa: E402
-from tracking.params import BodyParams  # noqa: E402
-from tracking.tracks import records_to_frame  # noqa: E402
+from partlab.labelling.evaluation import mot_metrics  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
+from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.params import BodyParams  # noqa: E402
+from partlab.tracking.tracks import records_to_frame  # noqa: E402
 
 SCENES = ("single", "pair_cross", "crowd", "distractors", "bend", "pillar")
 PETS = ROOT.parent / "shared" / "data" / "pets09_s2l1_vtest"
@@ -63,7 +63,7 @@ def main(argv=None) -> int:
     ap.add_argument("--pets-frames", type=int, default=0, help="first N frames of PETS (0: all)")
     ap.add_argument("--pets-seeds", default="0,1,2,3", help="tracker seeds for PETS (single runs vary)")
     args = ap.parse_args(argv)
-    from labelling.synth import make_scene
+    from partlab.labelling.synth import make_scene
 
     rows = []
     t0 = time.time()
@@ -83,7 +83,7 @@ def main(argv=None) -> int:
         print(f"all: {per.tracks.sum()} tracks for {per.people.sum()} people, MOTA {df.mota.mean():.3f}, "
               f"IDF1 {df.idf1.mean():.3f}")
     if not args.skip_pets and (PETS / "vtest.avi").exists():
-        from labelling.video import VideoClip
+        from partlab.labelling.video import VideoClip
 
         clip = VideoClip(PETS / "vtest.avi")
         stop = args.pets_frames or clip.frame_count

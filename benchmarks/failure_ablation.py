@@ -3,7 +3,7 @@
     PYTHONPATH=. python benchmarks/failure_ablation.py [--scenes distractors,bend,...] [--seed 0]
                                                       [--fast] [--out /tmp/ablation.csv] [--video]
 
-For every test scene (``labelling.synth``, seeds not used by the default bundle) the
+For every test scene (``partlab.labelling.synth``, seeds not used by the default bundle) the
 body tracker runs from the truth's first boxes
 
 * ``none``     : the default bundle's parameters, no failure detector (no adjustment);
@@ -42,7 +42,7 @@ PARTS = ("head", "torso", "hipleg")
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame, at: int = AT) -> dict[str, tuple[int, int, float]]:
     """Per part ``(right at at, people with truth at at, mean rate over offsets 1..at)``,
     offsets counted from each truth track's first frame."""
-    from models.selection import right_after_start
+    from partlab.models.selection import right_after_start
 
     out = {}
     for part in PARTS:
@@ -66,10 +66,10 @@ def main(argv=None) -> int:
                     help="retrain from the built-in parameters (partlab train --from none), not the shipped bundle")
     args = ap.parse_args(argv)
 
-    from labelling.synth import make_scene
-    from models.bundle import default_bundle
-    from models.runner import body_tracker_runner, run_body_tracker
-    from models.training import first_boxes, train_bundle
+    from partlab.labelling.synth import make_scene
+    from partlab.models.bundle import default_bundle
+    from partlab.models.runner import body_tracker_runner, run_body_tracker
+    from partlab.models.training import first_boxes, train_bundle
     from train_default_bundle import scene_clips
     from track_accuracy_limbs import through_codec
 
@@ -83,7 +83,7 @@ def main(argv=None) -> int:
                              start=None if args.from_builtin else default)
     print(f"  done in {time.time() - t0:.0f} s")
     if "selection" in retrained.summary:
-        from models.selection import selection_table
+        from partlab.models.selection import selection_table
 
         print("  validation on its training clips (noise, extent kept only if they raise the mean rate, "
               "the detector unless it lowers it):")

@@ -27,10 +27,10 @@ def main() -> None:
     from datumaro.components.dataset import Dataset
     from pycocotools.coco import COCO
 
-    from labelling.evaluation import evaluate
-    from labelling.formats import export_dataset, import_dataset
-    from labelling.video import probe
-    from tracking.tracks import normalise_tracks
+    from partlab.labelling.evaluation import evaluate
+    from partlab.labelling.formats import export_dataset, import_dataset
+    from partlab.labelling.video import probe
+    from partlab.tracking.tracks import normalise_tracks
 
     pets = Path(args.data) / "pets09_s2l1_vtest"
     gt = pd.read_csv(pets / "gt.csv")

@@ -18,8 +18,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from labelling.synth import SCENARIOS, render_scenario
-from tracking.tracks import read_tracks_csv
+from partlab.labelling.synth import SCENARIOS, render_scenario
+from partlab.tracking.tracks import read_tracks_csv
 
 
 def camera_stats(path: Path, n: int = 60) -> tuple[float, float]:

@@ -13,7 +13,7 @@ The limbs table (issue 4) comes from ``benchmarks/track_accuracy_limbs.py``: hea
 hand rates of the limb tracker at frame 105 on the synthetic desk and walker (``single``) scenes
 over ``--limbs-seeds``, and the identity swaps of the hands after the clap.
 
-Synthetic scenes come from ``labelling.synth.make_scene`` (started from their ``init``);
+Synthetic scenes come from ``partlab.labelling.synth.make_scene`` (started from their ``init``);
 PETS09-S2L1 (``../shared/data/pets09_s2l1_vtest``; PETS 2009, University of Reading, truth by
 A. Milan via OpenTraj) is tracked from each person's first truth box, and with automatic
 detection (no init) where each truth box counts as found when some tracked person box is
@@ -33,10 +33,10 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from tracking.background import BackgroundModel  # noqa: E402
-from tracking.body import BodyTracker  # noqa: E402
-from tracking.params import BodyParams  # noqa: E402
-from tracking.tracks import records_to_frame  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
+from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.params import BodyParams  # noqa: E402
+from partlab.tracking.tracks import records_to_frame  # noqa: E402
 
 DATA = ROOT.parent.parent / "shared" / "data"
 if not DATA.exists():
@@ -87,9 +87,9 @@ def run_tracker(frames, init, whole=False, occluders=(), seed=0, params=None, fp
 
 def synth_suite(names, seed, n_frames):
     try:
-        from labelling.synth import make_scene
+        from partlab.labelling.synth import make_scene
     except ImportError:
-        print("labelling.synth is not available: synthetic suite skipped")
+        print("partlab.labelling.synth is not available: synthetic suite skipped")
         return
     rows = []
     for name in names:
@@ -123,7 +123,7 @@ PETS_OCCLUDERS = ((413, 203, 31, 40), (425, 150, 12, 242))
 
 
 def pets(video: Path, truth_csv: Path, stop: int | None):
-    from labelling.video import VideoClip
+    from partlab.labelling.video import VideoClip
 
     gt = pd.read_csv(truth_csv)
     if stop:
@@ -145,11 +145,11 @@ def pets(video: Path, truth_csv: Path, stop: int | None):
     tracks, spf = run_tracker(frames, None, fps=clip.fps)
     found, precise = detection_rates(tracks[tracks.part == "person"], gt)
     try:  # the project's evaluation (labelling/evaluation.py): MOT metrics of the person boxes
-        from labelling.evaluation import evaluate
+        from partlab.labelling.evaluation import evaluate
 
         rep = evaluate(gt, tracks[tracks.part == "person"], hota=False)
         mot = rep.mot.loc["person"]
-        print("automatic detection, MOT metrics of person boxes (labelling.evaluation): "
+        print("automatic detection, MOT metrics of person boxes (partlab.labelling.evaluation): "
               + ", ".join(f"{k} {mot[k]:.3f}" for k in mot.index if k in ("mota", "motp", "idf1", "num_switches")))
     except ImportError:
         pass

@@ -1,6 +1,6 @@
 """Accuracy of the limb tracker on the synthetic scenes (issue 4's limbs table).
 
-For each scenario and seed: render the scene (``labelling.synth.make_scene``), run
+For each scenario and seed: render the scene (``partlab.labelling.synth.make_scene``), run
 ``LimbTracker`` from the scene's init boxes with the shared background model, and
 report per part (head, left hand, right hand)
 
@@ -28,10 +28,10 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from tracking.limbs import LimbTracker
-from tracking.params import LimbParams
-from tracking.parts import LIMB_PARTS
-from tracking.tracks import records_to_frame
+from partlab.tracking.limbs.tracker import LimbTracker
+from partlab.tracking.params import LimbParams
+from partlab.tracking.parts import LIMB_PARTS
+from partlab.tracking.tracks import records_to_frame
 
 
 def box_correct(pred: np.ndarray, true: np.ndarray) -> np.ndarray:
@@ -51,7 +51,7 @@ def box_correct(pred: np.ndarray, true: np.ndarray) -> np.ndarray:
 def foreground_model():
     """The shared background model if it has landed, else OpenCV's MOG2 with its defaults."""
     try:
-        from tracking.background import BackgroundModel
+        from partlab.tracking.core.background import BackgroundModel
         return BackgroundModel()
     except ImportError:
         import cv2
@@ -81,12 +81,12 @@ class PlateForeground:
 
 
 def through_codec(frames: np.ndarray, fps: float) -> list[np.ndarray]:
-    """The frames as a user's tracker sees them: written to an mp4 (``labelling.video.write_video``)
+    """The frames as a user's tracker sees them: written to an mp4 (``partlab.labelling.video.write_video``)
     and decoded again. The codec shifts and blurs colours, which changes what the skin model sees."""
     import tempfile
     from pathlib import Path
 
-    from labelling.video import VideoClip, write_video
+    from partlab.labelling.video import VideoClip, write_video
 
     with tempfile.TemporaryDirectory() as tmp:
         path = write_video(Path(tmp) / "clip.mp4", frames, fps)
@@ -155,7 +155,7 @@ def limbs_table(scenarios=("desk", "single"), seeds=(0, 1, 2), n_frames: int = 1
                 fg: str = "model", video: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Per (scenario, seed, part) rows and the per (scenario, part) summary (rate at ``at``, mean
     rate, swaps after the clap); ``benchmarks/track_accuracy.py`` prints the summary as its limbs table."""
-    from labelling.synth import make_scene
+    from partlab.labelling.synth import make_scene
 
     params = params or LimbParams()
     rows = []

@@ -13,7 +13,7 @@ Then the limb tracker's rows (issue 4) with 1 and 4 people, from
 ``benchmarks/track_speed_limbs.py`` (``--skip-limbs`` to leave them out).
 
 Numbers depend on the machine and its load: read the ratios. The walkers come from
-``labelling.synth`` (a benchmark-only scenario with N walkers at spread depths).
+``partlab.labelling.synth`` (a benchmark-only scenario with N walkers at spread depths).
 """
 
 from __future__ import annotations
@@ -31,10 +31,10 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from labelling.video import VideoClip, write_video  # noqa: E402
-from tracking.background import BackgroundModel  # noqa: E402
-from tracking.body import BodyTracker  # noqa: E402
-from tracking.params import BodyParams  # noqa: E402
+from partlab.labelling.video import VideoClip, write_video  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
+from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.params import BodyParams  # noqa: E402
 
 PETS = Path("/work/shared/data/pets09_s2l1_vtest")
 _alt = ROOT.parent.parent / "shared" / "data" / "pets09_s2l1_vtest"
@@ -44,10 +44,10 @@ if _alt.exists():
 
 def walkers_scene(n: int, n_frames: int, seed: int = 0):
     """A synthetic 720x480 scene with ``n`` walkers crossing at depths 6.5..11 m."""
-    import labelling.synth.scene as scene
-    from labelling.synth.appearance import sample_appearances
-    from labelling.synth.motion import walk
-    from labelling.synth.scenarios import BUILDERS, Actor, Script
+    import partlab.labelling.synth.scene as scene
+    from partlab.labelling.synth.appearance import sample_appearances
+    from partlab.labelling.synth.motion import walk
+    from partlab.labelling.synth.scenarios import BUILDERS, Actor, Script
 
     def build(rng, camera, frames, fps):
         apps = sample_appearances(rng, min(n, 7))  # synth has 7 distinct outfits; repeat beyond
@@ -177,7 +177,7 @@ def main() -> None:
         sys.path.insert(0, str(Path(__file__).resolve().parent))
         from track_speed_limbs import limb_speed_rows
 
-        from tracking.params import LimbParams
+        from partlab.tracking.params import LimbParams
         print(f"\nLimb tracker (head and hands, {LimbParams().particles} particles per target; seated people "
               "clapping, 640x480, "
               f"{a.frames} frames; step only, a foreground of ones):")

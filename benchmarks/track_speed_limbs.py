@@ -15,8 +15,8 @@ import time
 import cv2
 import numpy as np
 
-from tracking.limbs import LimbTracker
-from tracking.params import LimbParams
+from partlab.tracking.limbs.tracker import LimbTracker
+from partlab.tracking.params import LimbParams
 
 SKIN = (105, 145, 195)
 

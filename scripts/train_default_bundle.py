@@ -2,7 +2,7 @@
 
     PYTHONPATH=. python scripts/train_default_bundle.py [--out models/default_bundle] [--no-tracker]
 
-Trains on synthetic scenes of walkers (``labelling.synth``) with fixed seeds: plain
+Trains on synthetic scenes of walkers (``partlab.labelling.synth``) with fixed seeds: plain
 walking, crossing, a crowd and a pillar. The ``bend`` and ``distractors`` scenarios
 are left out on purpose, so ``benchmarks/failure_ablation.py`` can show what
 retraining on them adds. The same code, seeds and library versions give the same
@@ -28,9 +28,9 @@ N_FRAMES, WIDTH, HEIGHT = 150, 720, 480
 
 
 def scene_clips(scenes, n_frames=N_FRAMES, width=WIDTH, height=HEIGHT):
-    """``(clips, names, occluders)`` for :func:`models.training.train_bundle`; frames are
+    """``(clips, names, occluders)`` for :func:`partlab.models.training.train_bundle`; frames are
     re-rendered on demand so that only one scene is in memory at a time."""
-    from labelling.synth import make_scene
+    from partlab.labelling.synth import make_scene
 
     clips, names, occluders = [], [], []
     for name, seed in scenes:
@@ -49,7 +49,7 @@ def scene_clips(scenes, n_frames=N_FRAMES, width=WIDTH, height=HEIGHT):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=str(ROOT / "models" / "default_bundle"))
+    ap.add_argument("--out", default=str(ROOT / "partlab" / "models" / "default_bundle"))
     ap.add_argument("--no-tracker", action="store_true", help="perturbed truth only (no body tracker runs)")
     ap.add_argument("--seed", type=int, default=0)
     args = ap.parse_args(argv)
@@ -58,16 +58,16 @@ def main(argv=None) -> int:
 
     from tqdm import tqdm
 
-    from models.bundle import save_bundle
-    from models.failure_svm import SVMReport, report_table
-    from models.training import train_bundle, training_steps
-    from models.variance import comparison_table
+    from partlab.models.bundle import save_bundle
+    from partlab.models.failure_svm import SVMReport, report_table
+    from partlab.models.training import train_bundle, training_steps
+    from partlab.models.variance import comparison_table
     import pandas as pd
 
     runner = None
     if not args.no_tracker:
         try:
-            from models.runner import body_tracker_runner as runner
+            from partlab.models.runner import body_tracker_runner as runner
         except ImportError:
             print("body tracker not available: perturbed truth only")
     t0 = time.time()
@@ -84,7 +84,7 @@ def main(argv=None) -> int:
     print(report_table({n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}))
     print(comparison_table(pd.DataFrame(bundle.summary["variances"])))
     if "selection" in bundle.summary:
-        from models.selection import selection_table
+        from partlab.models.selection import selection_table
 
         print("validation on the training clips (noise and extent kept only if they raise the mean rate, "
               "the detector unless it lowers it):")

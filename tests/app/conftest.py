@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labelling.video import write_video
+from partlab.labelling.video import write_video
 
 N_FRAMES, WIDTH, HEIGHT = 12, 96, 72
 
@@ -35,7 +35,7 @@ def walker_boxes(n: int = N_FRAMES) -> pd.DataFrame:
 @pytest.fixture(autouse=True)
 def _no_old_jobs():
     """Each test sees only its own background jobs (the registry is process-wide)."""
-    from app import jobs
+    from partlab.app import jobs
 
     yield
     for job in jobs.active():
@@ -56,7 +56,7 @@ def clip_file(tmp_path):
 
 @pytest.fixture
 def store():
-    from labelling.store import Store
+    from partlab.labelling.store import Store
 
     return Store()
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from app.cli import CommandError
-from app.commands.app import streamlit_command
+from partlab.cli import CommandError
+from partlab.commands.app import streamlit_command
 
 
 def _opt(cmd: list[str], name: str) -> str:

@@ -7,7 +7,7 @@ import base64
 import cv2
 import numpy as np
 
-from app.box_editor import PALETTE, boxes_payload, encode_image, track_colour
+from partlab.app.box_editor import PALETTE, boxes_payload, encode_image, track_colour
 
 
 def test_frame_is_sent_as_a_jpeg_of_the_same_size(boxes):

@@ -18,8 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from app.commands.app import streamlit_command
-from app.runs import missing
+from partlab.commands.app import streamlit_command
+from partlab.app.runs import missing
 
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).resolve().parents[2]
@@ -79,8 +79,8 @@ def _wait_for(predicate, timeout=30.0, what="condition"):
 @pytest.fixture
 def scene(tmp_path):
     """A short synthetic clip (one walker) with its exact boxes."""
-    from labelling.synth import render_scenario
-    from tracking.tracks import read_tracks_csv
+    from partlab.labelling.synth import render_scenario
+    from partlab.tracking.tracks import read_tracks_csv
 
     out = render_scenario("single", tmp_path / "scene", seed=1, n_frames=12, width=320, height=240)
     clip = out / "walker.mp4"
@@ -143,12 +143,12 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     # track: start from the init boxes of frame 0 (or, until the tracker lands, import all boxes)
     page.get_by_role("link", name="Track").click()
     page.get_by_test_id("stExpander").get_by_text("Import boxes from a tracks CSV").click()
-    init = boxes if missing("app.pipeline") else boxes[boxes.frame == 0]
+    init = boxes if missing("partlab.app.pipeline") else boxes[boxes.frame == 0]
     init.to_csv(tmp_path / "init.csv", index=False)
     page.locator("input[type=file]").last.set_input_files(str(tmp_path / "init.csv"))
     page.get_by_role("button", name="Store these boxes as a tracker run").click()
     page.get_by_text(f"Stored {len(init)} boxes as run").wait_for()
-    if not missing("app.pipeline"):
+    if not missing("partlab.app.pipeline"):
         page.get_by_text("the stored boxes of frame 0").click()
         page.get_by_role("button", name="Track the whole clip").click()
         page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)

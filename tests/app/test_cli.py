@@ -1,7 +1,7 @@
 import subprocess
 import sys
 
-from app.cli import COMMANDS, build_parser, main
+from partlab.cli import COMMANDS, build_parser, main
 
 
 def test_every_contract_command_is_there():
@@ -12,7 +12,7 @@ def test_every_contract_command_is_there():
 
 
 def test_console_script_help():
-    out = subprocess.run([sys.executable, "-m", "app.cli", "--help"], capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-m", "partlab.cli", "--help"], capture_output=True, text=True)
     assert out.returncode == 0
     for name in COMMANDS:
         assert name in out.stdout

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from app.editing import EditHistory, apply_events
+from partlab.app.editing import EditHistory, apply_events
 
 
 def _box(store, clip_id, frame, part, track=1):

@@ -7,8 +7,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from app.cli import main
-from tracking.tracks import read_tracks_csv, write_tracks_csv
+from partlab.cli import main
+from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
 
 # the tiny synthetic clip of the format tests
 _spec = importlib.util.spec_from_file_location(
@@ -20,7 +20,7 @@ make_truth, render = _scene.make_truth, _scene.render
 
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
-    from labelling.video import write_video
+    from partlab.labelling.video import write_video
 
     d = tmp_path_factory.mktemp("cli")
     truth = make_truth()

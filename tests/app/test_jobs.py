@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import threading
 
-from app import jobs
+from partlab.app import jobs
 
 
 def test_job_progress_result_and_failure():

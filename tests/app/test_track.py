@@ -1,4 +1,4 @@
-"""``partlab track`` and ``app.pipeline.track_video`` on a small drawn clip."""
+"""``partlab track`` and ``partlab.app.pipeline.track_video`` on a small drawn clip."""
 
 from __future__ import annotations
 
@@ -8,12 +8,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from app.cli import CommandError, main
-from app.pipeline import track_video
-from labelling.video import write_video
+from partlab.cli import CommandError, main
+from partlab.app.pipeline import track_video
+from partlab.labelling.video import write_video
 from tests.tracking.walkers import background, correct, draw_walker
-from tracking.box import Box
-from tracking.tracks import read_tracks_csv, write_tracks_csv
+from partlab.tracking.core.box import Box
+from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +70,7 @@ def test_pipeline_same_seed_same_output_and_start_stop(clip):
 ])
 def test_track_command_refuses_with_clear_messages(clip, capsys, argv_extra, message):
     d, path, _ = clip
-    if "--model" in argv_extra and importlib.util.find_spec("models.bundle") is not None:
+    if "--model" in argv_extra and importlib.util.find_spec("partlab.models.bundle") is not None:
         argv_extra = ["--model", str(d / "not-a-bundle")]
     assert main(["track", str(path), "-o", str(d / "x.csv"), "--no-progress"] + argv_extra) == 2
     assert message in capsys.readouterr().err
@@ -93,7 +93,7 @@ def test_bad_inputs_are_reported(clip, tmp_path, capsys):
 
 
 def test_all_trackers_write_one_head_per_person_and_the_events(tmp_path, capsys):
-    from labelling.synth import render_scenario
+    from partlab.labelling.synth import render_scenario
 
     d = render_scenario("desk", tmp_path / "desk", seed=3, n_frames=70, width=360, height=240)
     out, ev = tmp_path / "all.csv", tmp_path / "events.csv"
@@ -126,9 +126,9 @@ def test_limb_tracker_keeps_both_hands_of_the_desk_clip_through_the_codec(tmp_pa
     # what `partlab track` sees is the decoded mp4, whose colours differ from the rendered frames:
     # keeping an init box's own colours as skin wherever the refit saw under half of it turned
     # this clip's forearms and desk into skin and lost both hands (0.0 at frame 105)
-    from app.pipeline import track_video
-    from labelling.evaluation import evaluate
-    from labelling.synth import render_scenario
+    from partlab.app.pipeline import track_video
+    from partlab.labelling.evaluation import evaluate
+    from partlab.labelling.synth import render_scenario
 
     d = render_scenario("desk", tmp_path / "desk", seed=2)
     events = []

@@ -3,10 +3,10 @@ from pathlib import Path
 
 import numpy as np
 
-from app.cli import main
-from labelling.video import write_video
-from models.bundle import load_bundle
-from tracking.tracks import write_tracks_csv
+from partlab.cli import main
+from partlab.labelling.video import write_video
+from partlab.models.bundle import load_bundle
+from partlab.tracking.tracks import write_tracks_csv
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "models"))
 from walkers import walking_truth  # noqa: E402

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from app.uploads import UploadRefused, check_upload, max_upload_mb, save_upload
+from partlab.app.uploads import UploadRefused, check_upload, max_upload_mb, save_upload
 
 
 def test_limit_comes_from_the_environment(monkeypatch):

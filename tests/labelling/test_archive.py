@@ -4,7 +4,7 @@ import zipfile
 
 import pytest
 
-from labelling.archive import ArchiveError, safe_extract
+from partlab.labelling.archive import ArchiveError, safe_extract
 
 
 def _zip(path, members):

@@ -5,9 +5,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labelling.evaluation import (EvaluationError, box_correct, evaluate, iou_distance, match_tracks,
+from partlab.labelling.evaluation import (EvaluationError, box_correct, evaluate, iou_distance, match_tracks,
                                   rate_curve_figure)
-from tracking.tracks import normalise_tracks
+from partlab.tracking.tracks import normalise_tracks
 
 
 def tracks(rows):
@@ -96,10 +96,10 @@ def test_mota_and_idf1_known_by_hand():
 
 def test_eval_agrees_with_motmetrics_own_pipeline(tmp_path, monkeypatch):
     """Export truth and a noisy run as MOTChallenge files, let motmetrics load and match them."""
-    from labelling.formats import export_dataset
-    from labelling.formats.mot import mot_id
-    from labelling.video import VideoInfo
-    from tracking.parts import PART_NAMES
+    from partlab.labelling.formats import export_dataset
+    from partlab.labelling.formats.mot import mot_id
+    from partlab.labelling.video import VideoInfo
+    from partlab.tracking.parts import PART_NAMES
 
     rng = np.random.default_rng(4)
     rows = []
@@ -161,7 +161,7 @@ def test_eval_matches_motmetrics_published_numbers_on_tud():
     devkit's numbers in its own tests; our MOT importer and evaluate must reproduce them."""
     from pathlib import Path
 
-    from labelling.formats import import_dataset
+    from partlab.labelling.formats import import_dataset
 
     data = Path(mm.__file__).parent / "data"
     published = {"TUD-Campus": (0.526462, 0.557659, 0.277201, 7, 13, 150),

@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labelling.store import StaleEditError, Store, StoreError
-from labelling.video import VideoError, write_video
-from tracking.box import Box
-from tracking.tracks import read_tracks_csv, write_tracks_csv
+from partlab.labelling.store import StaleEditError, Store, StoreError
+from partlab.labelling.video import VideoError, write_video
+from partlab.tracking.core.box import Box
+from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
 
 
 def _clip(path, n=10):
@@ -144,8 +144,8 @@ def test_killed_writer_loses_no_committed_edit(tmp_path, store_and_clip):
     store, clip = store_and_clip
     script = textwrap.dedent(f"""
         import sys
-        from labelling.store import Store
-        from tracking.box import Box
+        from partlab.labelling.store import Store
+        from partlab.tracking.core.box import Box
         s = Store()
         revs = [0] * 10
         for i in range(100000):

@@ -4,11 +4,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from app.cli import main
-from labelling.synth import SCENARIOS, make_scene, render_scenario
-from labelling.synth.figure import colour_table, FACE, HAIR, SHOES, TROUSERS, TROUSERS_FAR
-from tracking.parts import PART_NAMES
-from tracking.tracks import read_tracks_csv
+from partlab.cli import main
+from partlab.labelling.synth import SCENARIOS, make_scene, render_scenario
+from partlab.labelling.synth.figure import colour_table, FACE, HAIR, SHOES, TROUSERS, TROUSERS_FAR
+from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.tracks import read_tracks_csv
 
 
 @pytest.fixture(scope="module")
@@ -208,7 +208,7 @@ def test_cli_writes_the_files(tmp_path, capsys):
     assert main(["synth", str(out), "--scenario", "bend", "--seed", "4", "--frames", "6", "--size", "160x120"]) == 0
     for f in ("clip.mp4", "truth.csv", "init.csv", "scene.json"):
         assert (out / f).exists(), f
-    from labelling.video import probe
+    from partlab.labelling.video import probe
 
     info = probe(out / "clip.mp4")
     assert (info.width, info.height, info.frame_count) == (160, 120, 6)
@@ -224,7 +224,7 @@ def test_cli_writes_the_files(tmp_path, capsys):
 
 def test_decoded_clip_frames_match_the_truth_frames(tmp_path):
     """Frame i of the mp4 as OpenCV decodes it is truth frame i (no codec off-by-one)."""
-    from labelling.video import open_video
+    from partlab.labelling.video import open_video
 
     n = 10
     out = render_scenario("single", tmp_path, seed=2, n_frames=n, width=240, height=160)
@@ -260,8 +260,8 @@ def test_owner_maps_agree_with_the_truth_and_the_background():
 
 
 def test_single_walker_turns_back_through_facing_the_camera_and_waves(clean_single):
-    from labelling.synth.camera import Camera
-    from labelling.synth.motion import walk
+    from partlab.labelling.synth.camera import Camera
+    from partlab.labelling.synth.motion import walk
 
     camera = Camera.for_frame(480, 320)
     m = walk(camera, 100, [(0.0, -0.8, 8.0), (0.6, 0.6, 7.0), (0.8, 0.6, 7.0), (1.0, 0.0, 8.5)])
@@ -281,9 +281,9 @@ def test_single_walker_turns_back_through_facing_the_camera_and_waves(clean_sing
 
 
 def test_left_hand_is_the_persons_own_left():
-    from labelling.synth.appearance import Appearance
-    from labelling.synth.camera import LocalView
-    from labelling.synth.figure import FigurePose, draw_figure
+    from partlab.labelling.synth.appearance import Appearance
+    from partlab.labelling.synth.camera import LocalView
+    from partlab.labelling.synth.figure import FigurePose, draw_figure
 
     app = Appearance((0, 0, 200), (100, 50, 0), (150, 180, 220), (20, 20, 20), (30, 30, 30))
     view = LocalView(200.0, 300.0, 100.0, 0.4)

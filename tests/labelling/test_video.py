@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from labelling.video import VideoError, open_video, probe, store_by_hash, write_video
+from partlab.labelling.video import VideoError, open_video, probe, store_by_hash, write_video
 
 
 def _clip(path, n=12, w=64, h=48):

@@ -17,9 +17,9 @@ def truth_df() -> pd.DataFrame:
 @pytest.fixture(scope="session")
 def trained_svms():
     """The four SVMs trained once on perturbed walking truth (small: a few seconds)."""
-    from models.failure_svm import train_failure_svms
-    from models.features import person_histories
-    from models.perturb import perturbed_samples
+    from partlab.models.failure_svm import train_failure_svms
+    from partlab.models.features import person_histories
+    from partlab.models.perturb import perturbed_samples
 
     rng = np.random.default_rng(0)
     xs, ys = [], []

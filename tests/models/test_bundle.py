@@ -5,9 +5,9 @@ import pickle
 import numpy as np
 import pytest
 
-from models.bundle import Bundle, BundleError, load_bundle, save_bundle, MANIFEST
-from models.failure_svm import SVMFailureDetector
-from tracking.params import BodyParams, LimbParams, PartNoise
+from partlab.models.bundle import Bundle, BundleError, load_bundle, save_bundle, MANIFEST
+from partlab.models.failure_svm import SVMFailureDetector
+from partlab.tracking.params import BodyParams, LimbParams, PartNoise
 
 
 @pytest.fixture
@@ -95,7 +95,7 @@ def test_pickles_in_a_bundle_are_never_executed(bundle, tmp_path):
         np.savez(fh, mean=arr, scale=arr, support_vectors=arr, dual_coef=arr)
     m = json.loads((root / MANIFEST).read_text())
     m["files"]["svm_head.npz"] = hashlib.sha256(f.read_bytes()).hexdigest()
-    from models.bundle import _canonical
+    from partlab.models.bundle import _canonical
     m["manifest_sha256"] = hashlib.sha256(_canonical(m)).hexdigest()
     (root / MANIFEST).write_text(json.dumps(m))
     with pytest.raises(BundleError, match="other than plain numeric arrays"):
@@ -118,8 +118,8 @@ def test_same_bundle_gives_the_same_bytes(bundle, tmp_path):
 
 
 def test_default_bundle_ships_and_keeps_only_what_validation_approved():
-    from models.bundle import default_bundle
-    from tracking.params import BodyParams
+    from partlab.models.bundle import default_bundle
+    from partlab.tracking.params import BodyParams
 
     b = default_bundle()
     r = b.summary["svms"]["torso"]
@@ -145,8 +145,8 @@ def test_a_bundle_applies_what_was_learned_over_the_installed_defaults(tmp_path)
     """Hand-set tunables follow the installed partlab; fitted ones come from the bundle."""
     from dataclasses import replace
 
-    from models.bundle import Bundle, load_bundle, save_bundle
-    from tracking.params import BodyParams, LimbParams, PartNoise
+    from partlab.models.bundle import Bundle, load_bundle, save_bundle
+    from partlab.tracking.params import BodyParams, LimbParams, PartNoise
 
     noise = dict(BodyParams().part_noise, head=PartNoise(x=9.0, y=8.0, w=1.0, h=1.0, vx=1.0, vy=1.0, lam=7.0))
     body = replace(BodyParams(), part_noise=noise, output_extent={"head": (2.0, 2.0, 0.0, 0.0)},

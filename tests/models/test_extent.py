@@ -2,7 +2,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from models.extent import fit_output_extent
+from partlab.models.extent import fit_output_extent
 
 
 def _truth(n=40):

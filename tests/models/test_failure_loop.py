@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from labelling.synth import make_scene
-from models.bundle import default_bundle
-from models.runner import run_body_tracker
-from models.selection import part_rates
-from models.training import first_boxes
+from partlab.labelling.synth import make_scene
+from partlab.models.bundle import default_bundle
+from partlab.models.runner import run_body_tracker
+from partlab.models.selection import part_rates
+from partlab.models.training import first_boxes
 
 
 @pytest.mark.parametrize("seed", [3, 4])

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from models.failure_svm import SVMFailureDetector, SVMModel, choose_threshold, report_table
-from models.features import person_histories
+from partlab.models.failure_svm import SVMFailureDetector, SVMModel, choose_threshold, report_table
+from partlab.models.features import person_histories
 
 
 def test_numpy_decision_matches_sklearn():

@@ -2,9 +2,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from models.features import (FEATURE_NAMES, dt_frames, features_from_history, features_from_tracks,
+from partlab.models.features import (FEATURE_NAMES, dt_frames, features_from_history, features_from_tracks,
                              newest_features, person_scale, relative_states)
-from tracking.tracks import normalise_tracks
+from partlab.tracking.tracks import normalise_tracks
 
 
 def _history():

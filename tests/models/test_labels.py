@@ -1,8 +1,8 @@
 import numpy as np
 import pandas as pd
 
-from models.labels import inside_fraction, label_states, label_tracks, svm_targets, LabelRule
-from tracking.tracks import normalise_tracks
+from partlab.models.labels import inside_fraction, label_states, label_tracks, svm_targets, LabelRule
+from partlab.tracking.tracks import normalise_tracks
 
 
 def test_inside_fraction_and_labels():

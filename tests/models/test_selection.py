@@ -3,8 +3,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from models.selection import mean_rates, part_rates, select_components, selection_table
-from tracking.params import BodyParams
+from partlab.models.selection import mean_rates, part_rates, select_components, selection_table
+from partlab.tracking.params import BodyParams
 from walkers import walking_truth
 
 DEFAULT = BodyParams()
@@ -130,7 +130,7 @@ def test_noise_that_helps_one_part_and_hurts_another_is_kept_for_the_part_it_hel
 
 
 def _inner_rect_runner(truths):
-    """A deterministic 'tracker' for :func:`models.training.train_bundle`: its inner rectangle is the
+    """A deterministic 'tracker' for :func:`partlab.models.training.train_bundle`: its inner rectangle is the
     true box moved right by 0.3 of its width, reported through ``params.output_extent``; with the
     built-in extent the boxes are too large and off-centre (under half of them on the part)."""
     truth_of = {id(f): g for f, g in truths}
@@ -149,7 +149,7 @@ def _inner_rect_runner(truths):
 
 
 def test_train_bundle_validates_on_the_training_clips_and_records_it():
-    from models.training import iterate_frames, train_bundle
+    from partlab.models.training import iterate_frames, train_bundle
 
     truths = [walking_truth(2, 30, seed=s) for s in (4, 5)]
     clips = [(iterate_frames(np.zeros((30, 8, 8, 3), np.uint8)), 25.0, t) for t in truths]

@@ -1,6 +1,6 @@
 import numpy as np
 
-from models.sharpness import fit_lam
+from partlab.models.sharpness import fit_lam
 
 
 def test_fit_lam_recovers_the_sharpness_of_sampled_distances():
@@ -16,8 +16,8 @@ def test_fit_lam_recovers_the_sharpness_of_sampled_distances():
 
 
 def test_colour_distances_on_a_synthetic_walker():
-    from labelling.synth import make_scene
-    from models.sharpness import colour_distances
+    from partlab.labelling.synth import make_scene
+    from partlab.models.sharpness import colour_distances
 
     scene = make_scene("single", seed=3, n_frames=30, width=360, height=240)
     frames = lambda: ((i, scene.frames[i]) for i in range(len(scene.frames)))  # noqa: E731

@@ -2,9 +2,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from models.variance import comparison_figure, comparison_table, fit_body_noise, fit_constant_velocity, fit_limb_sigmas
-from tracking.params import BodyParams, LimbParams
-from tracking.tracks import normalise_tracks
+from partlab.models.variance import comparison_figure, comparison_table, fit_body_noise, fit_constant_velocity, fit_limb_sigmas
+from partlab.tracking.params import BodyParams, LimbParams
+from partlab.tracking.tracks import normalise_tracks
 
 
 def _simulate(rng, n, s_pos, s_vel, x0=100.0):
@@ -77,7 +77,7 @@ def test_limb_sigmas_from_known_residuals():
 
 
 def test_noise_from_the_trackers_prediction_errors():
-    from models.variance import prediction_residuals
+    from partlab.models.variance import prediction_residuals
 
     rng = np.random.default_rng(4)
     truth_rows, tracked_rows = [], []

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from tracking.tracks import normalise_tracks
+from partlab.tracking.tracks import normalise_tracks
 
 
 def walking_truth(n_people: int = 2, n_frames: int = 60, seed: int = 0) -> pd.DataFrame:

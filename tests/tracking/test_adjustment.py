@@ -7,11 +7,11 @@ import pytest
 
 from tests.tracking.test_body import _init, _run, _scene
 from tests.tracking.walkers import correct
-from tracking.adjustment import head_from_torso, hipleg_from_torso, torso_from_head_and_hipleg
-from tracking.body import BodyTracker
-from tracking.box import Box
-from tracking.frame_tracker import FailureVerdict
-from tracking.params import BodyParams
+from partlab.tracking.body.adjustment import head_from_torso, hipleg_from_torso, torso_from_head_and_hipleg
+from partlab.tracking.body.tracker import BodyTracker
+from partlab.tracking.core.box import Box
+from partlab.tracking.frame_tracker import FailureVerdict
+from partlab.tracking.params import BodyParams
 
 
 class DisplacingDetector:
@@ -104,7 +104,7 @@ def _bent_person():
 
 
 def test_a_bending_persons_lost_head_is_found_by_its_model_not_put_above_the_torso():
-    from tracking.adjustment import adjust_person
+    from partlab.tracking.body.adjustment import adjust_person
 
     ycc, mask = _bent_person()
     head_true = Box(121, 81, 22, 22)

@@ -7,13 +7,13 @@ import pandas as pd
 import pytest
 
 from tests.tracking.walkers import background, correct, draw_walker
-from tracking.background import BackgroundModel
-from tracking.box import Box
-from tracking.body import BodyTracker, init_starts
-from tracking.decomposition import decompose
-from tracking.histogram import to_ycc
-from tracking.params import BodyParams
-from tracking.tracks import records_to_frame
+from partlab.tracking.core.background import BackgroundModel
+from partlab.tracking.core.box import Box
+from partlab.tracking.body.tracker import BodyTracker, init_starts
+from partlab.tracking.body.decomposition import decompose
+from partlab.tracking.core.histogram import to_ycc
+from partlab.tracking.params import BodyParams
+from partlab.tracking.tracks import records_to_frame
 
 W, H = 320, 200
 
@@ -214,8 +214,8 @@ def test_automatic_start_decomposes_the_blob_that_found_the_person():
     # the synthetic walker is found around frame 8, while the background model is young; its
     # parts must come from that foreground blob (colour contrast puts the head across the wall's
     # dark stripe: head rate 0.0-0.3 on these seeds)
-    from labelling.evaluation import evaluate
-    from labelling.synth import make_scene
+    from partlab.labelling.evaluation import evaluate
+    from partlab.labelling.synth import make_scene
 
     rates = []
     for seed in (0, 1, 2):

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from tracking.box import Box, iou_xywh
+from partlab.tracking.core.box import Box, iou_xywh
 
 
 def test_iou_area_intersection_centre():

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracking.histogram import (
+from partlab.tracking.core.histogram import (
     bhattacharyya,
     binned_histogram,
     equalization_map,
@@ -15,7 +15,7 @@ from tracking.histogram import (
     uniform_map,
     update_reference,
 )
-from tracking.integral_histogram import particle_rectangles, rectangle_histograms
+from partlab.tracking.core.integral_histogram import particle_rectangles, rectangle_histograms
 
 
 def _patch(rng, means, sd=5.0, shape=(40, 30)):
@@ -81,7 +81,7 @@ def test_integral_histograms_match_direct_counts():
 
 
 def test_strided_integral_histograms_count_the_sampled_pixels():
-    from tracking.integral_histogram import sampled_areas
+    from partlab.tracking.core.integral_histogram import sampled_areas
 
     rng = np.random.default_rng(4)
     ycc = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)

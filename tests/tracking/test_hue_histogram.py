@@ -3,7 +3,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tracking.hue_histogram import (back_projection, bhattacharyya_distance, box_histograms, hue_bin_image,
+from partlab.tracking.core.hue_histogram import (back_projection, bhattacharyya_distance, box_histograms, hue_bin_image,
                                     hue_confidence, integral_histogram, mean_shift, reference_histogram)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from tracking.identity import match_limb_people, merge_tracks
+from partlab.tracking.identity import match_limb_people, merge_tracks
 
 
 def _rows(track_id, part, boxes):

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracking import kernels
-from tracking.histogram import bhattacharyya_counts, equalization_map, fused_lut, level_histogram
-from tracking.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
+from partlab.tracking.core import kernels
+from partlab.tracking.core.histogram import bhattacharyya_counts, equalization_map, fused_lut, level_histogram
+from partlab.tracking.core.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 
 pytestmark = pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
 
@@ -59,8 +59,8 @@ def test_level_histogram_box_and_drift_match_numpy():
 
 
 def test_weigh_equalize_similarity_resampling_match_numpy():
-    from tracking.histogram import bhattacharyya, binned_histogram, likelihood
-    from tracking.resampling import adaptive_particle_count, normalise_weights, systematic_resample
+    from partlab.tracking.core.histogram import bhattacharyya, binned_histogram, likelihood
+    from partlab.tracking.core.resampling import adaptive_particle_count, normalise_weights, systematic_resample
 
     ycc, mapping, sqrt_target, states = _scene(7)
     rects = kernels.rectangles(states, 90, 70)

@@ -6,8 +6,8 @@ import cv2
 import numpy as np
 import pytest
 
-from tracking import kernels
-from tracking.lazy_ycc import LazyYcc, as_array, cover
+from partlab.tracking.core import kernels
+from partlab.tracking.core.lazy_ycc import LazyYcc, as_array, cover
 
 
 def test_lazy_ycc_matches_opencv_where_converted():

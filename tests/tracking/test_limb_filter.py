@@ -3,11 +3,11 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tracking.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
-from tracking.limb_filter import (Candidates, LimbFilter, blob_likelihood, blob_points, blob_tips, candidate_modes,
+from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from partlab.tracking.limbs.filter import (Candidates, LimbFilter, blob_likelihood, blob_points, blob_tips, candidate_modes,
                                   candidate_terms, nearest_per_parent, silhouette_term, tip_candidates)
-from tracking.params import LimbParams
-from tracking.skin import SkinModel, find_blobs
+from partlab.tracking.params import LimbParams
+from partlab.tracking.core.skin import SkinModel, find_blobs
 
 SKIN = (110, 150, 210)
 BG = (90, 110, 70)

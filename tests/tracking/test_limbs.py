@@ -7,9 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tracking.limbs import EVENT_COLUMNS, LimbTracker, event_kind, load_face_detector, write_events
-from tracking.params import LimbParams
-from tracking.tracks import records_to_frame
+from partlab.tracking.limbs.tracker import EVENT_COLUMNS, LimbTracker, event_kind, load_face_detector, write_events
+from partlab.tracking.params import LimbParams
+from partlab.tracking.tracks import records_to_frame
 
 SKIN = (110, 150, 210)
 BG = (90, 110, 70)

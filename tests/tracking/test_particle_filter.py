@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracking.box import Box
-from tracking.histogram import to_ycc
-from tracking.params import BodyParams, PartNoise
-from tracking.particle_filter import PartFilter, box_to_state, state_to_box
+from partlab.tracking.core.box import Box
+from partlab.tracking.core.histogram import to_ycc
+from partlab.tracking.params import BodyParams, PartNoise
+from partlab.tracking.body.part_filter import PartFilter, box_to_state, state_to_box
 
 W, H = 160, 120
 
@@ -32,8 +32,8 @@ def test_state_box_round_trip():
 
 @pytest.mark.parametrize("compiled", [True, False], ids=["numba", "numpy"])
 def test_filter_follows_a_moving_rectangle(compiled, monkeypatch):
-    from tracking import kernels
-    from tracking.lazy_ycc import LazyYcc
+    from partlab.tracking.core import kernels
+    from partlab.tracking.core.lazy_ycc import LazyYcc
 
     if compiled and not kernels.HAVE_NUMBA:
         pytest.skip("numba not installed")

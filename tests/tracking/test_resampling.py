@@ -1,6 +1,6 @@
 import numpy as np
 
-from tracking.resampling import adaptive_particle_count, systematic_resample
+from partlab.tracking.core.resampling import adaptive_particle_count, systematic_resample
 
 
 def test_systematic_resample_follows_weights():

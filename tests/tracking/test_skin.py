@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 
-from tracking.skin import SkinModel, find_blobs, train_skin_model
+from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
 
 SKIN_BGR = [(110, 150, 210), (60, 90, 140), (150, 180, 230), (45, 70, 105)]  # light to dark skin tones
 NON_SKIN_BGR = [(90, 110, 70), (200, 60, 40), (128, 128, 128), (20, 200, 20), (255, 255, 255)]

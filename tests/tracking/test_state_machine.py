@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tracking.params import LimbParams
-from tracking.state_machine import LimbState, LimbStateMachine, Observation, assign_by_direction
+from partlab.tracking.params import LimbParams
+from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation, assign_by_direction
 
 P = LimbParams(combine_distance=20.0, split_distance=30.0, lost_likelihood=0.15, recover_likelihood=0.3,
                lost_frames=3, start_frames=3, start_prior=0.5, history_frames=10)

@@ -3,8 +3,8 @@ import io
 import pandas as pd
 import pytest
 
-from tracking.box import Box
-from tracking.tracks import (COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
+from partlab.tracking.core.box import Box
+from partlab.tracking.tracks import (COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
                              records_to_frame, write_tracks_csv)
 
 HEADER = "frame,track_id,part,x,y,w,h"

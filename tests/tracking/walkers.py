@@ -5,7 +5,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from tracking.box import Box
+from partlab.tracking.core.box import Box
 
 SKIN = (90, 140, 200)
 

@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labelling.video import probe, write_video
-from tracking.tracks import normalise_tracks
+from partlab.labelling.video import probe, write_video
+from partlab.tracking.tracks import normalise_tracks
 
 W, H, N = 160, 120, 20
 

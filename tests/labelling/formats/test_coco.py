@@ -4,7 +4,7 @@ import pandas as pd
 import pytest
 from pycocotools.coco import COCO
 
-from labelling.formats import FormatError, export_dataset, import_dataset
+from partlab.labelling.formats import FormatError, export_dataset, import_dataset
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "score", "failure", "occluded", "state", "source"]
 

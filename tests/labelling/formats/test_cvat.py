@@ -3,8 +3,8 @@ import pandas as pd
 import pytest
 from datumaro.components.dataset import Dataset
 
-from labelling.formats import FormatError, export_dataset, import_dataset
-from tracking.parts import PART_NAMES
+from partlab.labelling.formats import FormatError, export_dataset, import_dataset
+from partlab.tracking.parts import PART_NAMES
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +84,7 @@ def test_wrong_files_say_what_was_expected(tmp_path):
 
 
 def test_import_refuses_a_clip_with_another_frame_count(tmp_path, exported, truth, clip):
-    from labelling.video import write_video
+    from partlab.labelling.video import write_video
 
     short = write_video(tmp_path / "short.avi", [np.zeros((120, 160, 3), np.uint8)] * 12, fps=10.0)
     with pytest.raises(FormatError, match="the clip has 12 frames but the annotations were made on a clip of 20"):

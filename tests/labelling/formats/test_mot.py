@@ -5,10 +5,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labelling.evaluation import iou_distance
-from labelling.formats import FormatError, export_dataset, import_dataset
-from labelling.formats.mot import mot_id
-from tracking.parts import PART_NAMES
+from partlab.labelling.evaluation import iou_distance
+from partlab.labelling.formats import FormatError, export_dataset, import_dataset
+from partlab.labelling.formats.mot import mot_id
+from partlab.tracking.parts import PART_NAMES
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "occluded"]
 

@@ -1,7 +1,7 @@
 import pandas as pd
 
-from labelling.formats import export_dataset, import_dataset
-from tracking.tracks import read_tracks_csv
+from partlab.labelling.formats import export_dataset, import_dataset
+from partlab.tracking.tracks import read_tracks_csv
 
 
 def test_parquet_and_csv_round_trip_exactly(tmp_path, truth, clip):
@@ -18,7 +18,7 @@ def test_parquet_and_csv_round_trip_exactly(tmp_path, truth, clip):
 def test_export_replaces_a_previous_export_but_not_other_files(tmp_path, truth, clip):
     import pytest
 
-    from labelling.formats import FormatError
+    from partlab.labelling.formats import FormatError
 
     _, info = clip
     out = export_dataset(truth, "parquet", tmp_path / "p", info)

@@ -1,7 +1,7 @@
 import pandas as pd
 
-from labelling.formats import export_project, import_dataset
-from labelling.store import Store
+from partlab.labelling.formats import export_project, import_dataset
+from partlab.labelling.store import Store
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "failure", "occluded"]
 

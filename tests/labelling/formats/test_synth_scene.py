@@ -1,16 +1,16 @@
-"""Formats and evaluation on a synthetic scene of labelling.synth (every part, hands included)."""
+"""Formats and evaluation on a synthetic scene of partlab.labelling.synth (every part, hands included)."""
 
 import pandas as pd
 import pytest
 
-from labelling.evaluation import evaluate
-from labelling.formats import export_dataset, import_dataset
-from labelling.video import probe, write_video
+from partlab.labelling.evaluation import evaluate
+from partlab.labelling.formats import export_dataset, import_dataset
+from partlab.labelling.video import probe, write_video
 
 
 @pytest.fixture(scope="module")
 def scene(tmp_path_factory):
-    from labelling.synth import make_scene
+    from partlab.labelling.synth import make_scene
 
     s = make_scene("pair_cross", seed=1, n_frames=12, width=160, height=120)
     path = write_video(tmp_path_factory.mktemp("synth") / "clip.avi", list(s.frames), fps=s.fps)

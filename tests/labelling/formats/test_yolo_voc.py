@@ -3,8 +3,8 @@ import pytest
 import yaml
 from datumaro.components.dataset import Dataset
 
-from labelling.formats import FormatError, export_dataset, import_dataset
-from tracking.parts import PART_NAMES
+from partlab.labelling.formats import FormatError, export_dataset, import_dataset
+from partlab.tracking.parts import PART_NAMES
 
 
 def _clipped(t, w=160, h=120):

@@ -1,0 +1,218 @@
+"""Start the app's long work as background jobs: tracking, re-tracking, training.
+
+This is glue only: the algorithms are ``partlab.app.pipeline.track_video`` (trackers),
+``partlab.models.training.train_bundle`` (SVMs and variances) and the store. Modules that
+have not landed yet are looked up lazily, so a page can say "not available yet"
+instead of failing to import.
+"""
+
+from __future__ import annotations
+
+import importlib
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from partlab.app import jobs
+from partlab.labelling.config import data_dir
+from partlab.labelling.store import Clip, Store
+from partlab.labelling.video import VideoClip
+
+TRACKERS: tuple[str, ...] = ("body", "limbs", "all")
+
+
+def optional(module: str):
+    """The module, or None when it is not there yet (or fails to import)."""
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        return None
+
+
+def missing(*modules: str) -> list[str]:
+    """Which of ``modules`` cannot be imported."""
+    return [m for m in modules if optional(m) is None]
+
+
+def _load_model(bundle_path: str | Path | None):
+    if not bundle_path:
+        return None
+    bundle = optional("partlab.models.bundle")
+    if bundle is None:
+        raise RuntimeError("model bundles are not available yet (partlab.models.bundle has not landed)")
+    return bundle.load_bundle(bundle_path)
+
+
+BUILTIN = "built-in parameters"
+SHIPPED = "partlab's shipped bundle"
+
+
+def bundle_choices(store: Store, project) -> dict[str, str | None]:
+    """Model bundles to track with, label -> directory (None: the trackers' built-in
+    parameters); the project's default first, then built-in, the shipped bundle
+    (what ``partlab track --model default`` uses) and the project's other bundles."""
+    bundles = store.bundles(project.id)
+    default = next((b for b in bundles if b.id == project.default_bundle_id), None)
+    out: dict[str, str | None] = {}
+    if default is not None:
+        out[f"{default.name} (project default)"] = str(default.path)
+    out[BUILTIN] = None
+    bundle_mod = optional("partlab.models.bundle")
+    if bundle_mod is not None and (bundle_mod.default_bundle_path() / bundle_mod.MANIFEST).is_file():
+        out[SHIPPED] = str(bundle_mod.default_bundle_path())
+    for b in bundles:
+        if b is not default:
+            out[b.name] = str(b.path)
+    return out
+
+
+def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
+    """The first human-corrected frame after ``after`` (re-tracking stops there)."""
+    later = [f for f in store.human_frames(clip_id) if f > after]
+    return later[0] if later else None
+
+
+def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path: str | Path | None = None,
+                   seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False,
+                   init: pd.DataFrame | None = None) -> jobs.Job:
+    """Track a clip in the background and store the result as a tracker run.
+
+    With ``retrack``, the tracker starts from the effective boxes at frame ``start``
+    (the user's fix) and runs to the next human-corrected frame or the end; tracker
+    boxes of other frames and every human edit stay as they are. With
+    ``init_from_boxes``, a whole-clip run starts from the stored boxes of frame
+    ``start`` instead of detecting people; ``init`` gives such boxes directly (e.g. a
+    synthetic scene's init.csv).
+    """
+    pipeline = optional("partlab.app.pipeline")
+    if pipeline is None:
+        raise RuntimeError("tracking is not available yet (partlab.app.pipeline has not landed)")
+    if tracker not in TRACKERS:
+        raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
+    stop = None
+    if retrack or init_from_boxes:
+        init = store.frame_boxes(clip.id, start)
+        if not len(init):
+            raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
+        init = init.drop(columns=["revision"], errors="ignore")
+    if retrack:
+        stop = next_human_frame(store, clip.id, start)
+    occluders = tuple(store.occluders(clip.id))
+
+    def work(progress):
+        model = _load_model(bundle_path)
+        df = pipeline.track_video(str(clip.path), tracker=tracker, init=init, model=model, occluders=occluders,
+                                  seed=seed, progress=progress, start=start, stop=stop)
+        run_id = store.save_tracker_run(clip.id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
+                                        start_frame=start, stop_frame=stop)
+        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
+
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
+        else f"track {clip.name} ({tracker})"
+    return jobs.submit("track", what, work, clip_id=clip.id, project_id=clip.project_id)
+
+
+def clip_state(store: Store, clip: Clip, runs: pd.DataFrame | None = None) -> str:
+    """untracked, tracked, corrected n%, exported (the clip list's state column)."""
+    progress = store.progress(clip.id)
+    if progress["corrected_frames"]:
+        state = f"corrected {100 * progress['fraction']:.0f}%"
+    else:
+        runs = store.runs(clip.id) if runs is None else runs
+        state = "tracked" if len(runs) else "untracked"
+    return f"exported ({state})" if clip.exported else state
+
+
+def safe_name(name: str) -> str:
+    """A file-system-safe version of a user-given name."""
+    cleaned = re.sub(r"[^A-Za-z0-9._-]+", "-", name.strip()).strip("-.")
+    if not cleaned:
+        raise ValueError("the name needs at least one letter or digit")
+    return cleaned[:80]
+
+
+def frames_factory(path: Path):
+    """A callable giving a fresh iterator of ``(index, BGR frame)`` over a clip (decode order)."""
+    def frames():
+        return VideoClip(path).frames()
+    return frames
+
+
+def training_truth(store: Store, clip_id: int) -> pd.DataFrame:
+    """The boxes a clip teaches from: every effective box of its corrected frames."""
+    tracks = store.tracks(clip_id)
+    human = set(store.human_frames(clip_id))
+    return tracks[tracks.frame.isin(human)].drop(columns=["revision"]).reset_index(drop=True)
+
+
+def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
+                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
+    """Train a bundle from corrected clips in the background, save it and register it.
+    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
+    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    training = optional("partlab.models.training")
+    bundle_mod = optional("partlab.models.bundle")
+    if training is None or bundle_mod is None:
+        raise RuntimeError("training is not available yet (partlab.models.training / partlab.models.bundle have not landed)")
+    if not clip_ids:
+        raise ValueError("pick at least one corrected clip")
+    folder = safe_name(name)
+    if any(b.name == name for b in store.bundles(project_id)):
+        raise ValueError(f"a bundle named {name!r} exists already in this project")
+    clips = []
+    for cid in clip_ids:
+        clip = store.clip(cid)
+        truth = training_truth(store, cid)
+        if not len(truth):
+            raise ValueError(f"clip {clip.name!r} has no corrected frames yet")
+        clips.append((frames_factory(clip.path), clip.fps, truth))
+    out = data_dir() / "bundles" / str(project_id) / folder
+    if out.exists():
+        raise ValueError(f"{out} exists already; choose another bundle name")
+    runner_mod = optional("partlab.models.runner")  # the tracker's own failures are the paper's training samples
+    runner = getattr(runner_mod, "body_tracker_runner", None)
+    names = [store.clip(cid).name for cid in clip_ids]
+    start = _load_model(start_path)
+
+    def work(progress):
+        total = training.training_steps(len(clips), with_tracker=runner is not None)
+        steps = iter(range(1, 10**6))
+
+        def step(_message: str) -> None:  # train_bundle reports named steps; the bar counts them
+            progress(next(steps), total)
+
+        progress(0, total)
+        bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names,
+                                       start=start)
+        bundle_mod.save_bundle(bundle, out)
+        record = store.add_bundle(project_id, name, out, summary=bundle.summary)
+        if make_default:
+            store.set_default_bundle(project_id, record.id)
+        return dict(bundle_id=record.id, path=str(out))
+
+    return jobs.submit("train", f"train bundle {name}", work, project_id=project_id)
+
+
+def first_boxes(truth: pd.DataFrame) -> pd.DataFrame:
+    """Every truth track's boxes at its first frame: where a fair comparison starts
+    (seed 002 sec. 5.3 counts frames after each person's initialisation)."""
+    first = truth.groupby("track_id")["frame"].transform("min")
+    return truth[truth["frame"] == first].reset_index(drop=True)
+
+
+def start_comparison_run(clip: Clip, tracker: str, bundle_name: str, bundle_path: str | Path | None,
+                         seed: int = 0, init: pd.DataFrame | None = None) -> jobs.Job:
+    """Track a clip with one bundle without storing the result (Evaluate page), from
+    ``init`` boxes when given; the job's result is the tracks DataFrame."""
+    pipeline = optional("partlab.app.pipeline")
+    if pipeline is None:
+        raise RuntimeError("tracking is not available yet (partlab.app.pipeline has not landed)")
+
+    def work(progress):
+        start = int(init.frame.min()) if init is not None and len(init) else 0
+        return pipeline.track_video(str(clip.path), tracker=tracker, model=_load_model(bundle_path), init=init,
+                                    seed=seed, progress=progress, start=start)
+
+    return jobs.submit("compare", f"{clip.name} with {bundle_name}", work, clip_id=clip.id, bundle=bundle_name,
+                       tracker=tracker, seed=seed)

@@ -1,0 +1,81 @@
+"""Entry script of the Streamlit labelling app: project picker, job list and page navigation.
+
+Run with ``partlab app`` (or ``make run``). Every page is a short script under
+``app/views/`` that calls library functions; long work runs in :mod:`partlab.app.jobs`.
+"""
+
+import streamlit as st
+
+st.set_page_config(page_title="partlab", layout="wide")
+
+from partlab.app import jobs, state  # noqa: E402
+from partlab.app.demo import ensure_demo  # noqa: E402
+from partlab.app.views.common import bound_widget  # noqa: E402
+from partlab.labelling.config import data_dir  # noqa: E402
+
+
+@st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
+def _demo_ready(data: str) -> bool:
+    """Once per server process and data directory."""
+    return ensure_demo()
+
+
+_demo_ready(str(data_dir()))
+store = state.store()
+
+PROJECTS = st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects")
+PAGES = [
+    PROJECTS,
+    st.Page("views/track.py", title="Track", icon=":material/directions_run:", url_path="track"),
+    st.Page("views/correct.py", title="Correct", icon=":material/edit:", url_path="correct"),
+    st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
+    st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
+    st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
+]
+
+
+def _home():
+    """``/`` opens the projects page under its own address, so /projects works as a link too
+    (Streamlit serves a default page only at ``/``)."""
+    st.switch_page(PROJECTS)
+
+
+# the navigation is drawn by hand (page links) so that the hidden home page is not listed
+current = st.navigation([st.Page(_home, title="partlab", default=True), *PAGES], position="hidden")
+
+
+with st.sidebar:
+    for page in PAGES:
+        st.page_link(page)
+    st.divider()
+    st.markdown("### partlab")
+    projects = store.projects()
+    if projects:
+        state.project_id(store)
+        names = {p.id: p.name for p in projects}
+        bound_widget(st.selectbox, state.PROJECT, "project_select", "Project", list(names), format_func=names.get)
+    st.session_state.setdefault(state.AUTHOR, "")
+    bound_widget(st.text_input, state.AUTHOR, "author_input", "Your name (saved with your edits)")
+
+    @st.fragment(run_every=2 if jobs.active() else None)
+    def _job_list():
+        running = jobs.active()
+        recent = [j for j in jobs.jobs() if not j.active][:3]
+        stopped = jobs.interrupted()[:3]
+        if running or recent or stopped:
+            st.caption("Background jobs")
+        for j in running:
+            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
+        for j in recent:
+            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
+                       (f" ({j.error})" if j.error else ""))
+        for e in stopped:
+            st.caption(f"INTERRUPTED: {e['label']} (the app stopped at {e['done']}/{e['total'] or '?'}; "
+                       "start it again from its page)")
+        if recent or stopped:
+            st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
+
+    _job_list()
+    st.caption(f"Data: {data_dir()}")
+
+current.run()

@@ -1,0 +1,81 @@
+"""Small page helpers shared by the page scripts (choosing a project and a clip)."""
+
+from __future__ import annotations
+
+import streamlit as st
+
+from partlab.app import state
+from partlab.labelling.store import Clip, Store
+
+
+def require_project(s: Store):
+    """The current project, or stop the page with a hint."""
+    pid = state.project_id(s)
+    if pid is None:
+        st.info("No project yet: create one on the Projects page.")
+        st.stop()
+    return s.project(pid)
+
+
+def bound_widget(widget, persistent_key: str, widget_key: str, *args, **kwargs):
+    """Show ``widget`` whose value lives under ``persistent_key`` (which survives page
+    switches, unlike a widget's own key, which Streamlit drops when it is not shown)."""
+    st.session_state[widget_key] = st.session_state[persistent_key]
+
+    def copy():
+        st.session_state[persistent_key] = st.session_state[widget_key]
+
+    return widget(*args, key=widget_key, on_change=copy, **kwargs)
+
+
+def pick_clip(s: Store, project_id: int, label: str = "Clip") -> Clip:
+    """A clip chooser bound to the session's current clip; stops the page when there are none."""
+    clips = s.clips(project_id)
+    if not clips:
+        st.info("This project has no clips yet: upload one on the Projects page.")
+        st.stop()
+    ids = [c.id for c in clips]
+    state.clip_id(ids)
+    names = {c.id: f"{c.name} (#{c.id})" for c in clips}
+    bound_widget(st.selectbox, state.CLIP, "clip_select", label, ids, format_func=names.get)
+    return s.clip(st.session_state[state.CLIP])
+
+
+def job_panel(kind: str, limit: int = 5, **meta) -> None:
+    """Progress of this kind of background job, refreshed every second while one runs;
+    when a job this session watched ends, the whole page reruns to show its result."""
+    from partlab.app import jobs
+
+    watched = st.session_state.setdefault("watched_jobs", set())
+    for job in jobs.active(kind, **meta):
+        watched.add(job.id)
+
+    @st.fragment(run_every=1 if jobs.active(kind, **meta) else None)
+    def panel():
+        ended = False
+        for job in jobs.jobs(kind, **meta)[:limit]:
+            if job.active:
+                st.progress(job.fraction, text=f"{job.label}: {job.done} of {job.total or '?'}")
+                continue
+            if job.id in watched:
+                watched.discard(job.id)
+                ended = True
+            if job.status == "done":
+                st.success(f"{job.label}: done" + (f" ({describe(job.result)})" if describe(job.result) else "."))
+            else:
+                st.error(f"{job.label}: failed: {job.error}")
+        if ended:
+            st.rerun()
+
+    panel()
+
+
+def describe(result) -> str:
+    """A one-line account of a job's result dict."""
+    if not isinstance(result, dict):
+        return ""
+    if "run_id" in result:
+        return f"{result['boxes']} boxes stored as run {result['run_id']}"
+    if "bundle_id" in result:
+        return f"bundle saved in {result['path']}"
+    return ""

@@ -1,0 +1,38 @@
+"""``partlab import PATH --format FMT -o TRACKS.csv``."""
+
+from __future__ import annotations
+
+import sys
+
+from partlab.cli import CommandError
+
+FORMATS = ["mot", "cvat", "coco", "parquet"]
+
+
+def add_arguments(p) -> None:
+    p.add_argument("path", metavar="PATH",
+                   help="the format's file or directory, our export directory, or a zip/tar of one")
+    p.add_argument("--format", choices=FORMATS, required=True)
+    p.add_argument("-o", "--output", metavar="TRACKS.csv", required=True)
+    p.add_argument("--mapping", metavar="MAP", default=None,
+                   help="their labels (or class ids) to our parts: 'face=head,1=person', a JSON object or a .json file")
+    p.add_argument("--video", metavar="VIDEO", default=None,
+                   help="refuse the import when this clip's decoded frame count differs from the annotated one")
+
+
+def run(args) -> int:
+    from partlab.labelling.formats import FormatError, import_dataset
+    from partlab.labelling.video import VideoError
+    from partlab.tracking.tracks import write_tracks_csv
+
+    try:
+        df = import_dataset(args.path, args.format, mapping=args.mapping, video=args.video)
+    except (FormatError, VideoError) as exc:
+        raise CommandError(str(exc)) from None
+    write_tracks_csv(df, args.output)
+    for label, n in sorted(df.attrs.get("skipped", {}).items()):
+        print(f"partlab import: skipped {n} boxes labelled {label!r} (no matching part; see --mapping)",
+              file=sys.stderr)
+    print(f"imported {len(df)} boxes of {df['track_id'].nunique()} tracks, frames "
+          f"{int(df['frame'].min())}..{int(df['frame'].max())}, to {args.output}")
+    return 0

@@ -1,0 +1,114 @@
+"""``partlab track VIDEO -o TRACKS.csv``: run the trackers over a clip, write a tracks CSV."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+from pathlib import Path
+
+from partlab.cli import CommandError
+
+
+def add_arguments(p) -> None:
+    p.add_argument("video", metavar="VIDEO", help="input clip (any format OpenCV decodes)")
+    p.add_argument("-o", "--output", metavar="TRACKS.csv", required=True, help="tracks CSV to write")
+    p.add_argument("--tracker", choices=["body", "limbs", "all", "whole"], default="body",
+                   help="body: head/torso/hip-leg; limbs: head and hands; all: both; whole: one box per person")
+    p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
+    p.add_argument("--model", metavar="BUNDLE_DIR",
+                   help="model bundle from partlab train, or 'default' for the one shipped with partlab "
+                        "(failure detection and adjustment on); without it: the built-in parameters, no "
+                        "failure detection")
+    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
+    p.add_argument("--events", metavar="EVENTS.csv",
+                   help="limbs/all: write the limbs' join and separation events (claps, handshakes, ...)")
+    p.add_argument("--occluders", metavar="FILE",
+                   help="CSV with columns x,y,w,h: fixed regions (pillars, doors) that can hide people")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
+                   help="show a progress bar (default: on; --no-progress to hide it)")
+
+
+def read_occluders(path: str | Path):
+    """Occluder regions from a CSV with a header containing x,y,w,h (pixels)."""
+    from partlab.tracking.core.box import Box
+
+    p = Path(path)
+    if not p.is_file():
+        raise CommandError(f"{p}: no such occluders file")
+    out = []
+    with p.open(newline="", encoding="utf-8-sig") as fh:
+        reader = csv.DictReader(fh)
+        cols = [c.strip() for c in (reader.fieldnames or [])]
+        missing = [c for c in ("x", "y", "w", "h") if c not in cols]
+        if missing:
+            raise CommandError(f"{p} line 1: missing column(s) {', '.join(missing)}; expected a header x,y,w,h")
+        for lineno, row in enumerate(reader, start=2):
+            row = {k.strip(): v for k, v in row.items() if k is not None}
+            try:
+                x, y, w, h = (float(row[c]) for c in ("x", "y", "w", "h"))
+            except (TypeError, ValueError):
+                raise CommandError(f"{p} line {lineno}: x,y,w,h must be numbers, got "
+                                   f"{','.join(str(row.get(c)) for c in ('x', 'y', 'w', 'h'))}") from None
+            if w <= 0 or h <= 0:
+                raise CommandError(f"{p} line {lineno}: occluder size must be positive, got {w:g} x {h:g}")
+            out.append(Box(x, y, w, h))
+    return out
+
+
+def load_model(path: str | Path):
+    """A model bundle by directory, or the shipped one by the name ``default``."""
+    from partlab.models import bundle
+
+    try:
+        if str(path) == "default" and not Path(path).exists():
+            return bundle.default_bundle()
+        return bundle.load_bundle(path)
+    except (OSError, ValueError) as exc:
+        raise CommandError(f"{path}: cannot load model bundle: {exc}") from None
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from partlab.app.pipeline import track_video
+    from partlab.tracking.tracks import TracksCSVError, read_tracks_csv, write_tracks_csv
+
+    init = None
+    if args.init:
+        try:
+            init = read_tracks_csv(args.init)
+        except TracksCSVError as exc:
+            raise CommandError(str(exc)) from None
+        if init.empty:
+            raise CommandError(f"{args.init}: no boxes to start from")
+    occluders = read_occluders(args.occluders) if args.occluders else ()
+    model = load_model(args.model) if args.model else None
+    events: list = []
+    bar = None
+
+    def progress(done: int, total: int) -> None:
+        nonlocal bar
+        if bar is None:
+            bar = tqdm(total=total, unit="frame", desc="tracking")
+        bar.update(done - bar.n)
+
+    try:
+        tracks = track_video(args.video, tracker=args.tracker, init=init, model=model, occluders=occluders,
+                             seed=args.seed, progress=progress if args.progress else None, events_out=events)
+    finally:
+        if bar is not None:
+            bar.close()
+    try:
+        write_tracks_csv(tracks, args.output)
+    except OSError as exc:
+        raise CommandError(f"{args.output}: cannot write: {exc}") from None
+    people = tracks["track_id"].nunique() if len(tracks) else 0
+    print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
+    if args.events:
+        if args.tracker not in ("limbs", "all"):
+            raise CommandError("--events needs --tracker limbs or all (events are the limbs' joins)")
+        from partlab.tracking.limbs.tracker import write_events
+
+        write_events(events[0], args.events)
+        print(f"wrote {len(events[0])} event(s) to {args.events}")
+    return 0

@@ -1,0 +1,110 @@
+"""``partlab train --clip VIDEO --truth TRUTH.csv [...] -o BUNDLE_DIR``.
+
+Fits the four failure SVMs and the variance parameters from corrected clips
+(:func:`partlab.models.training.train_bundle`), writes a model bundle and prints the
+cross-validation table, the fitted-vs-default variances and which fitted components
+validation on the training clips kept (:mod:`partlab.models.selection`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from partlab.cli import CommandError
+
+
+def add_arguments(p) -> None:
+    p.add_argument("--clip", metavar="VIDEO", action="append", required=True, help="a corrected clip (repeatable)")
+    p.add_argument("--truth", metavar="TRUTH.csv", action="append", required=True,
+                   help="its corrected boxes, one per --clip in the same order")
+    p.add_argument("-o", "--output", metavar="BUNDLE_DIR", required=True, help="model bundle directory to write")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--from", dest="start", metavar="MODEL", default="default",
+                   help="the model to improve on: 'default' (partlab's shipped bundle), a bundle directory, or "
+                        "'none' (the built-in parameters without a failure detector). Its parameters are the "
+                        "defaults the fits widen; its detector is kept unless the new one does no worse on "
+                        "these clips (default: default)")
+    p.add_argument("--no-tracker", action="store_true",
+                   help="learn from the corrected boxes only (perturbed truth and failure flags), "
+                        "without running the body tracker on the clips")
+
+
+def _tracker_runner():
+    """The body tracker as a training runner, or None when it is not available."""
+    try:
+        from partlab.models.runner import body_tracker_runner
+    except ImportError:
+        return None
+    return body_tracker_runner
+
+
+def run(args) -> int:
+    from tqdm import tqdm
+
+    from partlab.labelling.video import VideoClip, VideoError
+    from partlab.models.bundle import BundleError, save_bundle
+    from partlab.models.failure_svm import SVMReport, report_table
+    from partlab.models.training import train_bundle, training_steps
+    from partlab.models.variance import comparison_table
+    from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
+    import pandas as pd
+
+    if len(args.clip) != len(args.truth):
+        raise CommandError(f"{len(args.clip)} --clip but {len(args.truth)} --truth; give one --truth per --clip")
+    out = Path(args.output)
+    if out.exists() and (not out.is_dir() or (any(out.iterdir()) and not (out / "bundle.json").is_file())):
+        raise CommandError(f"{out}: exists and is not a model bundle; choose another --output")
+    clips, names = [], []
+    for video, truth_path in zip(args.clip, args.truth):
+        try:
+            clip = VideoClip(video)
+            truth = read_tracks_csv(truth_path)
+        except (VideoError, TracksCSVError) as exc:
+            raise CommandError(str(exc)) from None
+        if truth.empty:
+            raise CommandError(f"{truth_path}: no boxes")
+        clips.append((clip.frames, clip.info.fps, truth))
+        names.append(Path(video).name)
+    start = None
+    if args.start != "none":
+        from partlab.commands.track import load_model
+
+        start = load_model(args.start)
+    runner = None if args.no_tracker else _tracker_runner()
+    if runner is None and not args.no_tracker:
+        print("partlab train: the body tracker is not available; learning from corrected boxes only")
+    with tqdm(total=training_steps(len(clips), runner is not None), desc="training", unit="step") as bar:
+        def progress(msg: str) -> None:
+            bar.set_postfix_str(msg)
+            bar.update(1)
+        try:
+            bundle = train_bundle(clips, seed=args.seed, progress=progress, tracker_runner=runner, names=names,
+                                  start=start)
+        except ValueError as exc:
+            raise CommandError(str(exc)) from None
+    try:
+        save_bundle(bundle, out)
+    except BundleError as exc:
+        raise CommandError(str(exc)) from None
+    reports = {n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}
+    print(f"wrote {out}  ({bundle.summary['samples']})")
+    print("\nfailure SVMs (5-fold cross-validation; negative = failure):")
+    print(report_table(reports))
+    print("\nvariance parameters (fitted vs default; '-' = default kept):")
+    print(comparison_table(pd.DataFrame(bundle.summary["variances"])))
+    if "output_extent" in bundle.summary:
+        from partlab.models.extent import extent_table
+        from partlab.tracking.params import BodyParams
+
+        print("\nreported box extent per part (fitted vs default: scale of the tracked inner rectangle, "
+              "shift in its size):")
+        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output_extent)
+        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output_extent)
+        print(table.pivot(index="part", columns="term", values="fitted").round(3).to_string())
+    if "selection" in bundle.summary:
+        from partlab.models.selection import selection_table
+
+        print(f"\nvalidation on the training clips, starting from {args.start!r} (tracking rate per part; noise "
+              "and extent are kept only if they raise the mean, the new detector unless it lowers it):")
+        print(selection_table(bundle.summary["selection"]))
+    return 0

@@ -1,0 +1,135 @@
+"""COCO detection JSON (``annotations.json``) with its frames in ``images/``.
+
+One image entry per exported frame (``id = frame + 1``, our decoder index in
+``frame_id``), one annotation per box with ``track_id``, the part as its category
+(``id = part_index + 1``) and our flags in ``attributes`` (``occluded`` as a boolean
+the way CVAT and Datumaro write it, the exact fraction in ``occlusion``). ``info``
+states the fps and frame count of the clip. Importing a foreign file takes the frame
+from ``frame_id``, else from the digits ending the file name, else from the image's
+position; the track from ``track_id`` (top level or in ``attributes``), else each box
+is its own track.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import pandas as pd
+
+from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
+                                    thinned_tracks)
+from partlab.labelling.formats.frames import frame_name, write_frames
+from partlab.labelling.video import VideoInfo
+from partlab.tracking.parts import PART_NAMES
+
+NAME = "coco"
+FILE_NAME = "annotations.json"
+
+
+def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
+           frames: bool = True) -> Path:
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
+    images = [{"id": int(f) + 1, "file_name": f"{frame_name(f)}.jpg", "width": info.width,
+               "height": info.height, "frame_id": int(f)} for f in keep]
+    categories = [{"id": i + 1, "name": p, "supercategory": "person"} for i, p in enumerate(PART_NAMES)]
+    cat = {p: i + 1 for i, p in enumerate(PART_NAMES)}
+    annotations = []
+    for k, r in enumerate(df.itertuples(index=False), start=1):
+        annotations.append({
+            "id": k, "image_id": int(r.frame) + 1, "category_id": cat[r.part],
+            "bbox": [float(r.x), float(r.y), float(r.w), float(r.h)], "area": float(r.w * r.h),
+            "iscrowd": 0, "segmentation": [], "track_id": int(r.track_id),
+            "attributes": {"occluded": bool(r.occluded > 0), "occlusion": float(r.occluded),
+                           "failure": bool(r.failure), "source": str(r.source),
+                           "score": None if math.isnan(r.score) else float(r.score), "state": str(r.state),
+                           "track_id": int(r.track_id)},
+        })
+    doc = {
+        "info": {"description": "partlab export", "fps": info.fps, "frame_count": info.frame_count,
+                 "frame_numbering": "frame_id is the 0-based decoder index; image id = frame_id + 1",
+                 "every": every},
+        "licenses": [],
+        "images": images,
+        "annotations": annotations,
+        "categories": categories,
+    }
+    (out_dir / FILE_NAME).write_text(json.dumps(doc, indent=1), encoding="utf-8")
+    if frames:
+        write_frames(video_path, info, keep, out_dir / "images", name=frame_name)
+    ExportManifest.for_video(NAME, info, every, frames).write(out_dir)
+    return out_dir
+
+
+def _find_json(path: Path) -> Path:
+    if path.is_file():
+        return path
+    if (path / FILE_NAME).is_file():
+        return path / FILE_NAME
+    found = sorted(path.glob("*.json")) + sorted((path / "annotations").glob("*.json"))
+    found = [p for p in found if p.name != "partlab.json"]
+    if len(found) == 1:
+        return found[0]
+    raise FormatError(f"{path}: expected a COCO JSON file ({FILE_NAME}, or one .json in annotations/)")
+
+
+def annotated_frame_count(path: Path) -> int | None:
+    info = _load(_find_json(path)).get("info") or {}
+    n = info.get("frame_count") if isinstance(info, dict) else None
+    return int(n) if isinstance(n, int) else None
+
+
+def _load(js: Path) -> dict:
+    try:
+        doc = json.loads(js.read_text(encoding="utf-8"))
+    except (ValueError, UnicodeDecodeError) as exc:
+        raise FormatError(f"{js}: not a JSON file ({exc}); expected COCO detection JSON") from None
+    if not isinstance(doc, dict) or not all(isinstance(doc.get(k), list)
+                                            for k in ("images", "annotations", "categories")):
+        raise FormatError(f"{js}: expected COCO detection JSON with lists 'images', 'annotations' and "
+                          "'categories'")
+    return doc
+
+
+def import_(path: Path, mapping=None) -> pd.DataFrame:
+    js = _find_json(path)
+    doc = _load(js)
+    names = parse_mapping(mapping)
+    cats = {c.get("id"): str(c.get("name", c.get("id"))) for c in doc["categories"] if isinstance(c, dict)}
+    images = sorted((im for im in doc["images"] if isinstance(im, dict)), key=lambda im: im.get("id", 0))
+    frame_of: dict = {}
+    for position, im in enumerate(images):
+        if isinstance(im.get("frame_id"), int):
+            frame_of[im.get("id")] = im["frame_id"]
+        else:
+            m = re.search(r"(\d+)$", Path(str(im.get("file_name", ""))).stem)
+            frame_of[im.get("id")] = int(m.group(1)) if m else position
+    rows: list[dict] = []
+    skipped: dict[str, int] = {}
+    for a in doc["annotations"]:
+        if not isinstance(a, dict) or a.get("image_id") not in frame_of:
+            raise FormatError(f"{js}: annotation {a.get('id') if isinstance(a, dict) else a!r} refers to no image")
+        label = cats.get(a.get("category_id"), str(a.get("category_id")))
+        part = map_label(label, names)
+        if part is None:
+            skipped[label] = skipped.get(label, 0) + 1
+            continue
+        bbox = a.get("bbox")
+        if not (isinstance(bbox, list) and len(bbox) == 4):
+            raise FormatError(f"{js}: annotation {a.get('id')} has no [x, y, w, h] bbox")
+        attrs = a.get("attributes") if isinstance(a.get("attributes"), dict) else {}
+        track_id = a.get("track_id", attrs.get("track_id"))
+        if track_id is None:
+            track_id = a.get("id", len(rows))
+        score = attrs.get("score", a.get("score"))
+        occlusion = attrs.get("occlusion", 1.0 if attrs.get("occluded") else 0.0)
+        rows.append({
+            "frame": frame_of[a["image_id"]], "track_id": int(track_id), "part": part,
+            "x": bbox[0], "y": bbox[1], "w": bbox[2], "h": bbox[3],
+            "score": float("nan") if score is None else float(score),
+            "failure": bool(attrs.get("failure", False)), "occluded": float(occlusion),
+            "state": str(attrs.get("state", "")), "source": str(attrs.get("source", NAME)),
+        })
+    return finish_import(rows, skipped, str(js))

@@ -1,0 +1,165 @@
+"""MOTChallenge ground truth: ``seqinfo.ini``, ``gt/gt.txt``, ``gt/labels.txt`` and optional ``img1/``.
+
+``gt.txt`` rows are ``frame, id, x, y, w, h, conf, class, visibility`` (MOT16/17
+layout): frames, ids and pixel coordinates count from 1 (the devkit's Matlab convention,
+which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider the box), ``class`` is the
+1-based line of ``gt/labels.txt`` naming the part (where Datumaro's ``mot_seq`` reads
+it), and ``visibility = 1 - occluded``.
+MOT ids must be unique per object, and each of our people has several parts, so the id
+of (track_id, part) is ``10 * track_id + part_index + 1`` (part_index in
+:data:`partlab.tracking.parts.PART_NAMES`); the importer inverts this for our own exports
+(recognised by ``partlab.json``). Foreign files keep their ids as track ids; rows with
+``conf == 0`` in a ``gt.txt`` are ignored boxes in MOTChallenge and are skipped, and
+10-column MOT15 files (no class) are read as ``pedestrian``. Datumaro copies MOT
+coordinates without the 1-pixel shift, so boxes it converted from another format into
+MOT come in one pixel up and left.
+"""
+
+from __future__ import annotations
+
+import configparser
+import csv
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
+                                    thinned_tracks)
+from partlab.labelling.formats.frames import all_frames, write_frames
+from partlab.labelling.video import VideoInfo
+from partlab.tracking.parts import PART_NAMES
+
+NAME = "mot"
+ID_STRIDE = 10  # > len(PART_NAMES): ids of one person's parts share all digits but the last
+ID_RULE = f"MOT id = {ID_STRIDE} * track_id + part_index + 1, part_index in {list(PART_NAMES)}"
+
+
+def mot_id(track_id: np.ndarray, part_index: np.ndarray) -> np.ndarray:
+    """1-based MOT object id of each (track_id, part_index)."""
+    return ID_STRIDE * np.asarray(track_id, dtype=np.int64) + np.asarray(part_index, dtype=np.int64) + 1
+
+
+def _num(v: float) -> str:
+    return f"{float(v):.10g}"
+
+
+def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
+           frames: bool = True) -> Path:
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
+    (out_dir / "gt").mkdir(exist_ok=True)
+    part_index = df["part"].map({p: i for i, p in enumerate(PART_NAMES)}).to_numpy()
+    ids = mot_id(df["track_id"].to_numpy(), part_index)
+    vis = np.clip(1.0 - df["occluded"].to_numpy(dtype=float), 0.0, 1.0)
+    with open(out_dir / "gt" / "gt.txt", "w", encoding="utf-8") as f:
+        for r, i, c, v in zip(df.itertuples(index=False), ids, part_index, vis):
+            f.write(f"{r.frame + 1},{i},{_num(r.x + 1)},{_num(r.y + 1)},{_num(r.w)},{_num(r.h)},1,{c + 1},{_num(v)}\n")
+    (out_dir / "gt" / "labels.txt").write_text("".join(f"{p}\n" for p in PART_NAMES), encoding="utf-8")
+    seq = configparser.ConfigParser()
+    seq.optionxform = str  # MOT keys are camelCase
+    seq["Sequence"] = {
+        "name": Path(info.path).stem if info.path else out_dir.name,
+        "imDir": "img1",
+        "frameRate": _num(info.fps),
+        "seqLength": str(info.frame_count),
+        "imWidth": str(info.width),
+        "imHeight": str(info.height),
+        "imExt": ".jpg",
+    }
+    with open(out_dir / "seqinfo.ini", "w", encoding="utf-8") as f:
+        seq.write(f, space_around_delimiters=False)
+    if frames:  # img1/ is the whole sequence (seqLength frames), thinned by --every
+        write_frames(video_path, info, all_frames(info, every), out_dir / "img1", name=lambda i: f"{i + 1:06d}")
+    ExportManifest.for_video(NAME, info, every, frames, notes=ID_RULE).write(out_dir)
+    return out_dir
+
+
+def _find_gt(path: Path) -> Path:
+    if path.is_file():
+        return path
+    for candidate in (path / "gt" / "gt.txt", path / "gt.txt", path / "det" / "det.txt"):
+        if candidate.is_file():
+            return candidate
+    raise FormatError(f"{path}: not a MOTChallenge sequence; expected gt/gt.txt (and seqinfo.ini) in the "
+                      "directory, or a MOT txt file")
+
+
+def read_seqinfo(directory: Path) -> dict[str, str]:
+    """The ``[Sequence]`` section of ``seqinfo.ini`` in ``directory`` ({} when absent)."""
+    path = directory / "seqinfo.ini"
+    if not path.is_file():
+        return {}
+    seq = configparser.ConfigParser()
+    seq.optionxform = str
+    try:
+        seq.read(path, encoding="utf-8")
+    except configparser.Error as exc:
+        raise FormatError(f"{path}: not a MOTChallenge seqinfo.ini ({exc})") from None
+    if "Sequence" not in seq:
+        raise FormatError(f"{path}: no [Sequence] section; expected a MOTChallenge seqinfo.ini")
+    return dict(seq["Sequence"])
+
+
+def annotated_frame_count(path: Path) -> int | None:
+    """The frame count a MOT sequence states (partlab.json or seqinfo.ini seqLength)."""
+    root = path if path.is_dir() else (path.parent.parent if path.parent.name == "gt" else path.parent)
+    manifest = ExportManifest.read(root)
+    if manifest is not None:
+        return manifest.frame_count
+    seq = read_seqinfo(root)
+    return int(seq["seqLength"]) if seq.get("seqLength", "").isdigit() else None
+
+
+def import_(path: Path, mapping=None) -> pd.DataFrame:
+    gt = _find_gt(path)
+    root = path if path.is_dir() else (gt.parent.parent if gt.parent.name == "gt" else gt.parent)
+    manifest = ExportManifest.read(root)
+    ours = manifest is not None and manifest.format == NAME
+    labels_path = next((p for p in (gt.parent / "labels.txt", root / "labels.txt") if p.is_file()), None)
+    labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path else []
+    names = parse_mapping(mapping)
+    names.setdefault("1", "person")  # MOT16/17 class 1 is 'pedestrian'
+    is_gt = gt.name == "gt.txt"
+    rows: list[dict] = []
+    skipped: dict[str, int] = {}
+    with open(gt, newline="", encoding="utf-8") as f:
+        for lineno, cells in enumerate(csv.reader(f), start=1):
+            cells = [c.strip() for c in cells]
+            while cells and cells[-1] == "":  # trailing commas
+                cells.pop()
+            if not cells:
+                continue
+            if len(cells) < 6:
+                raise FormatError(f"{gt} line {lineno}: {len(cells)} values; expected MOTChallenge rows "
+                                  "frame,id,x,y,w,h,conf,class,visibility")
+            try:
+                v = [float(c) for c in cells]
+            except ValueError:
+                raise FormatError(f"{gt} line {lineno}: non-numeric value in {','.join(cells)}; expected "
+                                  "MOTChallenge rows frame,id,x,y,w,h,conf,class,visibility") from None
+            frame, oid = int(v[0]), int(v[1])
+            if frame < 1:
+                raise FormatError(f"{gt} line {lineno}: frame {frame}; MOTChallenge frames count from 1")
+            conf = v[6] if len(v) > 6 else 1.0
+            if len(v) == 9 or (len(v) == 8 and not ours):
+                cls = int(v[7])
+                label = labels[cls - 1] if labels and 1 <= cls <= len(labels) else str(cls)
+            else:  # 6, 7 or 10 columns (MOT15: 3D position instead of class)
+                label = "pedestrian"
+            if is_gt and conf == 0:
+                skipped["conf=0 (ignored)"] = skipped.get("conf=0 (ignored)", 0) + 1
+                continue
+            part = map_label(label, names)
+            if part is None:
+                skipped[label] = skipped.get(label, 0) + 1
+                continue
+            vis = v[8] if len(v) == 9 else 1.0
+            rows.append({
+                "frame": frame - 1,
+                "track_id": (oid - 1) // ID_STRIDE if ours else oid,
+                "part": part, "x": v[2] - 1.0, "y": v[3] - 1.0, "w": v[4], "h": v[5],
+                "score": float("nan") if is_gt else conf,
+                "occluded": float(np.clip(1.0 - vis, 0.0, 1.0)) if 0.0 <= vis <= 1.0 else 0.0,
+                "source": NAME,
+            })
+    return finish_import(rows, skipped, str(gt))

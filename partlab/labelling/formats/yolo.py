@@ -1,0 +1,60 @@
+"""YOLO (Ultralytics layout) for detector training: ``data.yaml``, ``images/train/``, ``labels/train/``.
+
+One text file per exported frame, a line ``class cx cy w h`` per box with the centre
+and size divided by the frame size; class ``k`` is ``PART_NAMES[k]``. Boxes are clipped
+to the frame first (YOLO coordinates must lie in [0, 1]) and boxes with nothing inside
+the frame are left out. Track ids and flags are not representable: export CVAT or
+Parquet to keep them.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from partlab.labelling.formats.base import ExportManifest, thinned_tracks
+from partlab.labelling.formats.frames import frame_name, write_frames
+from partlab.labelling.video import VideoInfo
+from partlab.tracking.parts import PART_NAMES
+
+NAME = "yolo"
+SUBSET = "train"
+
+
+def clipped_xyxy(df: pd.DataFrame, width: int, height: int) -> np.ndarray:
+    """``(N, 4)`` corners ``x1, y1, x2, y2`` of the boxes clipped to a ``width`` x ``height`` frame."""
+    x1 = np.clip(df["x"].to_numpy(float), 0, width)
+    y1 = np.clip(df["y"].to_numpy(float), 0, height)
+    x2 = np.clip((df["x"] + df["w"]).to_numpy(float), 0, width)
+    y2 = np.clip((df["y"] + df["h"]).to_numpy(float), 0, height)
+    return np.stack([x1, y1, x2, y2], axis=1).reshape(-1, 4)
+
+
+def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
+           frames: bool = True) -> Path:
+    df, keep = thinned_tracks(df, info, video_path, every, out_dir)
+    labels_dir = out_dir / "labels" / SUBSET
+    labels_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "images" / SUBSET).mkdir(parents=True, exist_ok=True)
+    cls = df["part"].map({p: i for i, p in enumerate(PART_NAMES)}).to_numpy()
+    xyxy = clipped_xyxy(df, info.width, info.height)
+    cx = (xyxy[:, 0] + xyxy[:, 2]) / 2 / info.width
+    cy = (xyxy[:, 1] + xyxy[:, 3]) / 2 / info.height
+    bw = (xyxy[:, 2] - xyxy[:, 0]) / info.width
+    bh = (xyxy[:, 3] - xyxy[:, 1]) / info.height
+    lines: dict[int, list[str]] = {int(f): [] for f in keep}
+    for f, c, a, b, w, h in zip(df["frame"].to_numpy(), cls, cx, cy, bw, bh):
+        if w > 0 and h > 0:
+            lines[int(f)].append(f"{c} {a:.6f} {b:.6f} {w:.6f} {h:.6f}\n")
+    for f, ls in lines.items():
+        (labels_dir / f"{frame_name(f)}.txt").write_text("".join(ls), encoding="utf-8")
+    data = {"path": ".", "train": f"images/{SUBSET}", "val": f"images/{SUBSET}",
+            "nc": len(PART_NAMES), "names": {i: p for i, p in enumerate(PART_NAMES)}}
+    (out_dir / "data.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    if frames:
+        write_frames(video_path, info, keep, out_dir / "images" / SUBSET, name=frame_name)
+    ExportManifest.for_video(NAME, info, every, frames).write(out_dir)
+    return out_dir

@@ -1,0 +1,229 @@
+"""Compose a scenario into frames with exact per-part ground truth.
+
+Per frame, people are drawn far to near (by depth), each into an ``owner`` image
+that records who is visible at every pixel; fixed occluders (the pillar) are drawn
+last. A part's pixels are those the figure shows of it, as the person would look
+alone (where the person's own parts overlap, e.g. the near arm over the torso or the
+torso over the top of the trousers, the pixels go to the part in front); a part the
+person's own body hides completely (a far hand behind the hips) falls back to its
+whole drawn shape. A truth row's box is the tight extent of those pixels inside the
+frame (``x, y`` the first column/row, ``w, h`` the number of columns/rows spanned),
+and ``occluded`` is the fraction of them where another person or an occluder is
+visible instead. Hidden parts keep their rows; parts entirely outside the frame have
+none. ``person`` is the extent of the whole drawn figure (head, torso, hip-leg, arms
+and hands).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from tqdm import tqdm
+
+from partlab.labelling.synth.appearance import Appearance
+from partlab.labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
+from partlab.labelling.synth.camera import Camera
+from partlab.labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
+                                    colour_table, draw_figure)
+from partlab.labelling.synth.scenarios import BUILDERS, Script
+from partlab.tracking.core.box import Box
+from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.tracks import normalise_tracks
+
+SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
+FPS = 25.0
+OCCLUDER_ID = 255
+SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A rendered scenario.
+
+    ``frames: (T, H, W, 3) uint8`` BGR before codec compression; ``truth``: tracks table
+    (``source = "truth"``) with rows for every person and part at every frame;
+    ``init``: the rows of each track's first frame; ``occluders``: fixed occluder boxes
+    (the pillar), else empty; ``fps``: frame rate; ``appearances``: each track's
+    colours (track ``k`` is ``appearances[k - 1]``); ``background``: the empty room;
+    ``owners``: per-pixel visibility maps (only with ``make_scene(..., owners=True)``),
+    e.g. the true foreground for testing a background model is ``owners[t] % 255 > 0``.
+    """
+
+    frames: np.ndarray
+    truth: pd.DataFrame
+    init: pd.DataFrame
+    occluders: list[Box]
+    fps: float
+    appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
+    background: np.ndarray | None = None  # (H, W, 3) uint8: the empty room (no shadows, flicker or noise)
+    owners: np.ndarray | None = None  # (T, H, W) uint8 who is seen where: 0 room, k track k, 255 occluder
+
+
+def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
+    if name not in SCENARIOS:
+        raise ValueError(f"unknown scenario {name!r}; expected one of {', '.join(SCENARIOS)}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+    if n_frames < 1:
+        raise ValueError(f"n_frames must be at least 1, got {n_frames}")
+    if width < 64 or height < 48:
+        raise ValueError(f"frame size {width}x{height} is too small (at least 64x48)")
+
+
+def _pose(actor, i: int, fps: float) -> FigurePose:
+    m = actor.motion
+    hands = m.hands[i]
+    return FigurePose(
+        facing=float(m.facing[i]), phase=float(m.phase[i]), gait=float(m.gait[i]), wave=float(m.wave[i]),
+        wave_phase=2 * np.pi * 2.2 * i / fps, bend=float(m.bend[i]), head_yaw=float(m.head_yaw[i]),
+        hands=None if not np.all(np.isfinite(hands)) else hands, seated=m.seated, seat_cut=actor.seat_cut)
+
+
+def _pillar_texture(rng: np.random.Generator, box: Box, colour) -> np.ndarray:
+    w, h = int(box.w), int(box.h)
+    tex = np.empty((h, w, 3), np.float32)
+    tex[:] = colour
+    xs = np.linspace(-1, 1, w, dtype=np.float32)
+    tex *= (1.0 - 0.25 * xs**2 + 0.08 * xs)[None, :, None]  # a round column lit from the right
+    tex += 5.0 * smooth_noise(rng, h, w, 6)[..., None]
+    return np.clip(tex, 0, 255).astype(np.uint8)
+
+
+def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: float) -> None:
+    """Darken the floor under a person's feet (a soft contact shadow; never part of the truth)."""
+    cx, cy = camera.floor_point(x, z)
+    s = float(camera.scale(z))
+    ax, ay = 0.28 * height_m * s, 0.28 * height_m * s * camera.cam_height / z
+    x1, x2 = int(max(cx - ax - 2, 0)), int(min(cx + ax + 2, frame.shape[1]))
+    y1, y2 = int(max(cy - ay - 2, 0)), int(min(cy + ay + 2, frame.shape[0]))
+    if x1 >= x2 or y1 >= y2:
+        return
+    yy, xx = np.mgrid[y1:y2, x1:x2]
+    r2 = ((xx - cx) / ax) ** 2 + ((yy - cy) / ay) ** 2
+    gain = 1.0 - 0.35 * np.clip(1.0 - r2, 0.0, 1.0)
+    frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
+
+
+def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
+               *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
+    """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
+
+    ``clean`` leaves out every photometric effect (cloth shading, flicker, sensor noise)
+    so that each pixel has its label's exact colour (for tests that check drawn colours);
+    ``owners`` keeps every frame's visibility map in :attr:`Scene.owners`.
+    """
+    _check(name, seed, n_frames, width, height)
+    rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
+    camera = Camera.for_frame(width, height)
+    script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
+    background = draw_props(room(rng, camera), script.props)
+    effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
+    occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
+    luts = [colour_table(a.appearance) for a in script.actors]
+    # cloth folds and lighting: a gain field per person that moves with them (none when clean)
+    folds = [None if clean else 0.045 * smooth_noise(rng, height + 64, width + 64, max(3, height // 40))
+             for _ in script.actors]
+    frames = np.empty((n_frames, height, width, 3), np.uint8)
+    owner = np.zeros((height, width), np.uint8)
+    owner_maps = np.zeros((n_frames, height, width), np.uint8) if owners else None
+    rows: list[tuple] = []
+    for i in tqdm(range(n_frames), desc=f"synth {name}", unit="frame", disable=not progress):
+        frame = background.copy()
+        owner[:] = 0
+        for actor in script.actors:
+            if actor.view is None:
+                _shadow(frame, camera, float(actor.motion.x[i]), float(actor.motion.z[i]), actor.appearance.height_m)
+        order = sorted(range(len(script.actors)), key=lambda a: -script.actors[a].motion.z[i])
+        drawn = []
+        for a in order:
+            actor = script.actors[a]
+            m = actor.motion
+            view = actor.view or camera.local_view(float(m.x[i]), float(m.z[i]))
+            fig = draw_figure(_pose(actor, i, FPS), actor.appearance, view)
+            x0, y0 = fig.origin
+            fh, fw = fig.labels.shape
+            cx1, cy1, cx2, cy2 = max(x0, 0), max(y0, 0), min(x0 + fw, width), min(y0 + fh, height)
+            if cx1 >= cx2 or cy1 >= cy2:
+                continue
+            crop = (slice(cy1 - y0, cy2 - y0), slice(cx1 - x0, cx2 - x0))
+            lab = fig.labels[crop]
+            on = lab > 0
+            colours = luts[a][lab[on]]
+            if folds[a] is not None:  # lit from above: brighter shoulders, darker feet, plus folds
+                ry = (np.arange(cy1 - y0, cy2 - y0, dtype=np.float32) / max(fh, 1))[:, None]
+                fold = folds[a]
+                if fold.shape[0] < fh or fold.shape[1] < fw:  # a figure larger than the frame
+                    fold = np.pad(fold, ((0, max(0, fh - fold.shape[0])), (0, max(0, fw - fold.shape[1]))), "wrap")
+                cloth = ~np.isin(lab, SKIN_LABELS)  # folds in clothes and hair, smooth skin
+                gain = (1.06 - 0.14 * ry) * (1.0 + fold[: fh, : fw][crop] * cloth)
+                colours = np.clip(colours * gain[on][:, None], 0, 255).astype(np.uint8)
+            frame[cy1:cy2, cx1:cx2][on] = colours
+            owner[cy1:cy2, cx1:cx2][on] = a + 1
+            drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
+        for o, tex in zip(script.occluders, occ_tex):
+            x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
+            frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
+            owner[y:y + h, x:x + w] = OCCLUDER_ID
+        for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
+            own = owner[cy1:cy2, cx1:cx2]
+            lab = fig.labels[crop]
+            parts = {"person": lab > 0}
+            for p in FIGURE_PARTS:
+                if p in fig.masks:
+                    whole = fig.masks[p][crop]
+                    shown = whole & np.isin(lab, PART_LABELS[p])
+                    parts[p] = shown if shown.any() else whole
+            for part, mask in parts.items():
+                total = int(mask.sum())
+                if total == 0:
+                    continue
+                cols = np.flatnonzero(mask.any(axis=0))
+                rws = np.flatnonzero(mask.any(axis=1))
+                visible = int(np.count_nonzero(own[mask] == a + 1))
+                rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
+                             rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+        frames[i] = frame if effects is None else effects.apply(frame, i)
+        if owner_maps is not None:
+            owner_maps[i] = owner
+    truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded"])
+    truth["source"] = "truth"
+    order = {p: k for k, p in enumerate(PART_NAMES)}
+    truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
+    truth = normalise_tracks(truth.drop(columns="_p"))
+    first = truth.groupby("track_id")["frame"].transform("min")
+    init = truth[truth["frame"] == first].reset_index(drop=True)
+    return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
+                 tuple(a.appearance for a in script.actors), background, owner_maps)
+
+
+def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,
+                    height: int = 480, *, progress: bool = False) -> Path:
+    """Render ``name`` into ``outdir``: clip.mp4, truth.csv, init.csv, scene.json (+ occluders.csv)."""
+    from partlab.labelling.video import write_video
+    from partlab.tracking.tracks import write_tracks_csv
+
+    scene = make_scene(name, seed, n_frames, width, height, progress=progress)
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    write_video(out / "clip.mp4", scene.frames, scene.fps)
+    write_tracks_csv(scene.truth, out / "truth.csv")
+    write_tracks_csv(scene.init, out / "init.csv")
+    occ = out / "occluders.csv"
+    if scene.occluders:
+        pd.DataFrame([b.as_tuple() for b in scene.occluders], columns=["x", "y", "w", "h"]).to_csv(
+            occ, index=False, lineterminator="\n")
+    elif occ.exists():
+        occ.unlink()
+    meta = {"name": name, "seed": seed, "fps": scene.fps, "size": f"{width}x{height}", "width": width,
+            "height": height, "n_frames": n_frames, "tracks": int(scene.truth["track_id"].nunique()),
+            "occluders": [list(b.as_tuple()) for b in scene.occluders],
+            "people": [{"track_id": k + 1, "shirt": list(p.shirt), "trousers": list(p.trousers), "skin": list(p.skin),
+                        "hair": list(p.hair), "height_m": round(p.height_m, 3)}
+                       for k, p in enumerate(scene.appearances)]}
+    (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
+    return out

@@ -1,0 +1,278 @@
+"""Training a model bundle from corrected clips (seed 002 sec. 4.2, seed 000 sec. 6.4).
+
+Samples for the four SVMs come from three sources:
+
+1. **the tracker's own output**: each clip is tracked from the truth's first boxes
+   (``tracker_runner``) and every tracked part is labelled against the corrected
+   box (:func:`partlab.models.labels.label_tracks`), as the paper does by hand;
+2. **hand-set failure flags**: truth rows with ``failure`` set and ``source == "human"``
+   are tracker boxes a user marked as failed without moving them; they are
+   negatives (the other parts of that person and frame are positives) and are left
+   out of everything else;
+3. **perturbed states** (:mod:`partlab.models.perturb`): simulated single and multi-part
+   failures, so that a few clips give enough failures of every kind. With the
+   tracker, its own output is perturbed (so the SVMs learn its box geometry) and
+   labelled against the truth; without it, the truth is.
+
+The variance parameters are fitted from the truth (:mod:`partlab.models.variance`), the
+colour likelihood's sharpness ``lam`` from the corrected boxes on the frames
+(:mod:`partlab.models.sharpness`; only where the body tracker's histograms are installed).
+
+With the tracker, every fitted component (noise and ``lam``, output extent, SVM
+detector) is then validated on the training clips (:mod:`partlab.models.selection`) and kept
+only if it raises the tracking rate there; the summary's ``selection`` records the
+scores and decisions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable, Iterable, Iterator
+
+import numpy as np
+import pandas as pd
+
+from partlab.models.bundle import Bundle
+from partlab.models.failure_svm import SVMFailureDetector, TNR_TARGETS, train_failure_svms
+from partlab.models.features import BODY_PARTS, DEFAULT_DT, features_from_tracks, person_histories
+from partlab.models.labels import NEGATIVE, POSITIVE, SVM_NAMES, label_tracks, labels_for_keys
+from partlab.models.perturb import PerturbConfig, perturbed_samples
+from partlab.models.variance import fit_variances
+from partlab.tracking.params import BodyParams, LimbParams
+from partlab.tracking.tracks import normalise_tracks
+
+FramesFactory = Callable[[], Iterator[tuple[int, np.ndarray]]]
+Clip = tuple[FramesFactory, float, pd.DataFrame]
+#: ``runner(frames_factory, fps, init, seed, params=None, failure_detector=None) -> tracks DataFrame``
+#: of the body tracker (``params=None``: built-in parameters).
+TrackerRunner = Callable[[FramesFactory, float, pd.DataFrame, int], pd.DataFrame]
+
+
+def first_boxes(truth: pd.DataFrame) -> pd.DataFrame:
+    """The truth rows of every track at its first frame (the tracker's ``init``)."""
+    truth = normalise_tracks(truth)
+    first = truth.groupby("track_id")["frame"].transform("min")
+    return truth[truth["frame"] == first].reset_index(drop=True)
+
+
+def split_human_flags(truth: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """``(truth without flagged rows, flagged rows)``; flagged = failure set by a human."""
+    truth = normalise_tracks(truth)
+    flagged = truth["failure"] & (truth["source"] == "human")
+    return truth[~flagged].reset_index(drop=True), truth[flagged].reset_index(drop=True)
+
+
+def human_flag_samples(truth: pd.DataFrame, fps: float, dt: float = DEFAULT_DT) -> tuple[np.ndarray, np.ndarray]:
+    """Features and labels of every person and frame where a user flagged a part as failed."""
+    truth = normalise_tracks(truth)
+    flagged = truth["failure"] & (truth["source"] == "human") & truth["part"].isin(BODY_PARTS)
+    if not flagged.any():
+        return np.zeros((0, 24)), np.zeros((0, 3), dtype=np.int8)
+    keys, x = features_from_tracks(truth, fps, dt)
+    flags = truth[flagged][["track_id", "frame", "part"]]
+    wanted = pd.MultiIndex.from_frame(keys).isin(pd.MultiIndex.from_frame(flags[["track_id", "frame"]]))
+    keys, x = keys[wanted].reset_index(drop=True), x[wanted]
+    labels = np.full((len(keys), 3), POSITIVE, dtype=np.int8)
+    for k, part in enumerate(BODY_PARTS):
+        f = flags[flags["part"] == part]
+        labels[pd.MultiIndex.from_frame(keys).isin(pd.MultiIndex.from_frame(f[["track_id", "frame"]])), k] = NEGATIVE
+    return x, labels
+
+
+def tracker_samples(tracked: pd.DataFrame, truth: pd.DataFrame, fps: float,
+                    dt: float = DEFAULT_DT) -> tuple[np.ndarray, np.ndarray]:
+    """Features of the tracker's output and its part labels against the truth."""
+    tracked = normalise_tracks(tracked)
+    keys, x = features_from_tracks(tracked, fps, dt)
+    if len(keys) == 0:
+        return x, np.zeros((0, 3), dtype=np.int8)
+    labels = labels_for_keys(label_tracks(tracked, truth), keys)
+    return x, labels
+
+
+def sharpness_available() -> bool:
+    """Whether ``lam`` can be fitted (it needs the body tracker's ``partlab.tracking.core.histogram``)."""
+    try:
+        import partlab.tracking.core.histogram  # noqa: F401  (only whether it imports)
+    except ImportError:
+        return False
+    return True
+
+
+def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None = None) -> int:
+    """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
+    if with_sharpness is None:
+        with_sharpness = sharpness_available()
+    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
+
+
+def _apply_lam(body: BodyParams, table: pd.DataFrame,
+               d2: dict[str, list[np.ndarray]]) -> tuple[BodyParams, pd.DataFrame]:
+    """Put the ML ``lam`` of every part with enough distances into ``body`` and the table."""
+    from partlab.models.sharpness import fit_lam
+    from partlab.models.variance import MIN_SAMPLES
+
+    noise = dict(body.part_noise)
+    table = table.copy()
+    for part, chunks in d2.items():
+        values = np.concatenate(chunks) if chunks else np.zeros(0)
+        row = (table["tracker"] == "body") & (table["part"] == part) & (table["parameter"] == "lam")
+        table.loc[row, "n"] = len(values)
+        if len(values) < MIN_SAMPLES or part not in noise:
+            continue
+        lam = fit_lam(values)
+        noise[part] = replace(noise[part], lam=lam)
+        table.loc[row, "fitted"] = lam
+        table.loc[row, "applied"] = lam
+    return replace(body, part_noise=noise), table
+
+
+def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], None] | None = None,
+                 tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
+                 perturbed_per_person: int = 300, body: BodyParams | None = None,
+                 limb: LimbParams | None = None, dt: float = DEFAULT_DT,
+                 fit_sharpness: bool | None = None, validate: bool = True, start=None) -> Bundle:
+    """Fit the four failure SVMs and the variance parameters from corrected clips.
+
+    ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
+    ``(index, frame)``. Without ``tracker_runner`` (or where it fails on a clip) only
+    perturbed-truth and hand-flag samples are used; the summary records how many of
+    each. ``progress`` is called once per step with a short description.
+    ``fit_sharpness`` (default: when available) decodes each clip once more to fit ``lam``.
+    ``validate`` (with ``tracker_runner``): keep each fitted component only if it does not
+    lower the tracking rate on the training clips (:func:`partlab.models.selection.select_components`;
+    up to three more tracker runs per clip); without it, everything fitted is used.
+    ``start``: the bundle training starts from (e.g. :func:`partlab.models.bundle.default_bundle`):
+    its body parameters are the defaults the fits widen, and validation starts from its
+    parameters *and* its failure detector, which the new detector replaces only if that does
+    not lower the rate, so retraining never scores below ``start`` on the training clips.
+    None: the built-in parameters without a detector.
+    """
+    if not clips:
+        raise ValueError("no clips to train from")
+    start_detector = None
+    if start is not None:
+        body = body or start.body_params
+        limb = limb or start.limb_params
+        start_detector = start.failure_detector
+    names = list(names) if names is not None else [f"clip{i}" for i in range(len(clips))]
+    if len(names) != len(clips):
+        raise ValueError(f"{len(names)} names for {len(clips)} clips")
+    rng = np.random.default_rng(seed)
+    step = progress or (lambda _msg: None)
+    xs, ys, truths, clip_info, tracked_runs = [], [], [], [], []
+    counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
+    if fit_sharpness is None:
+        fit_sharpness = sharpness_available()
+    d2: dict[str, list[np.ndarray]] = {}
+    for i, ((factory, fps, truth), name) in enumerate(zip(clips, names)):
+        truth_clean, _ = split_human_flags(truth)
+        truths.append(truth_clean)
+        info = {"name": name, "fps": float(fps), "people": int(truth_clean["track_id"].nunique()),
+                "frames": int(truth_clean["frame"].nunique())}
+        if tracker_runner is not None:
+            step(f"tracking {name}")
+            tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
+            tracked_runs.append((tracked, truth_clean))
+            x, y = tracker_samples(tracked, truth_clean, fps, dt)
+            xs.append(x), ys.append(y)
+            counts["tracker"] += len(x)
+            info["tracker_samples"] = len(x)
+            info["tracker_failures"] = int(np.sum(np.any(y == NEGATIVE, axis=1)))
+        if fit_sharpness:
+            from partlab.models.sharpness import colour_distances
+            step(f"colours of {name}")
+            for part, values in colour_distances(factory, truth_clean, body or BodyParams()).items():
+                d2.setdefault(part, []).append(values)
+        step(f"samples of {name}")
+        x, y = human_flag_samples(truth, fps, dt)
+        xs.append(x), ys.append(y)
+        counts["human_flags"] += len(x)
+        n_pert = 0
+        true_hist = person_histories(truth_clean)
+        if tracker_runner is not None:
+            # failures simulated on the tracker's own boxes (its geometry), labelled against the truth
+            for tid, (frames, hist) in person_histories(tracked).items():
+                aligned = np.full(hist.shape, np.nan)
+                if tid in true_hist:
+                    tf, th = true_hist[tid]
+                    pos = np.searchsorted(tf, frames)
+                    hit = (pos < len(tf)) & (tf[np.minimum(pos, len(tf) - 1)] == frames)
+                    aligned[hit] = th[pos[hit]]
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt,
+                                         truth=aligned)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
+        else:
+            for _tid, (frames, hist) in true_hist.items():
+                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt)
+                xs.append(x), ys.append(y)
+                n_pert += len(x)
+        counts["perturbed"] += n_pert
+        clip_info.append(info)
+    x_all = np.concatenate(xs, axis=0)
+    y_all = np.concatenate(ys, axis=0)
+    if len(x_all) == 0:
+        raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
+    models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
+    step("variance parameters")
+    # the tracker's prediction errors are not used for the noise (measured worse, see partlab.models.variance)
+    body_p, limb_p, table = fit_variances(truths, body, limb)
+    if fit_sharpness:
+        body_p, table = _apply_lam(body_p, table, d2)
+    if tracked_runs:
+        from partlab.models.extent import fit_output_extent
+
+        step("output extent")
+        current = (body or BodyParams()).output_extent
+        body_p = replace(body_p, output_extent=fit_output_extent([t for t, _ in tracked_runs],
+                                                                 [g for _, g in tracked_runs], current))
+    detector = SVMFailureDetector(models, dt=dt) if models else None
+    selection = None
+    if tracked_runs and validate:
+        from partlab.models.selection import select_components
+
+        base = body or BodyParams()
+        inits = [first_boxes(g) for g in truths]
+
+        def run(i, params, det):
+            return tracker_runner(clips[i][0], clips[i][1], inits[i], seed + i, params=params, failure_detector=det)
+
+        fitted = replace(base, part_noise=body_p.part_noise, output_extent=body_p.output_extent)
+        chosen = select_components(run, truths, base, fitted, detector,
+                                   base_tracks=[t for t, _ in tracked_runs] if body is None else None,
+                                   progress=step, base_detector=start_detector)
+        body_p = replace(body_p, part_noise=chosen.body_params.part_noise,
+                         output_extent=chosen.body_params.output_extent)
+        new_detector = detector
+        detector = chosen.failure_detector
+        selection = chosen.to_dict()
+        selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output_extent.items()}
+        selection["started_from"] = "a bundle" if start is not None else "built-in"
+        selection["start_detector"] = start_detector is not None
+        selection["detector"] = ("new" if detector is not None and detector is new_detector else
+                                 "start's" if detector is not None else "none")
+        if not chosen.kept["noise"]:  # the table's "applied" says what the bundle uses
+            body_rows = table["tracker"] == "body"
+            table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]
+    summary = {
+        "seed": seed,
+        "clips": clip_info,
+        "samples": {**counts, "total": int(len(x_all))},
+        "svms": {n: r.to_dict() for n, r in reports.items()},
+        "tnr_targets": dict(TNR_TARGETS),
+        "thresholds": {n: r.threshold for n, r in reports.items()},
+        "variances": table.to_dict(orient="records"),
+        "output_extent": {k: list(v) for k, v in body_p.output_extent.items()},
+        "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
+    }
+    if selection is not None:
+        summary["selection"] = selection
+    return Bundle(body_p, limb_p, detector, summary)
+
+
+def iterate_frames(frames: np.ndarray) -> FramesFactory:
+    """A frames factory over an in-memory ``(T, H, W, 3)`` array (synthetic scenes)."""
+    def factory():
+        return ((i, frames[i]) for i in range(len(frames)))
+    return factory

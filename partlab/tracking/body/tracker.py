@@ -1,0 +1,533 @@
+"""The multi-person three-part body tracker (seed 002 sec. 4).
+
+Every tracked person has three part filters (head, torso, hip-leg; or one ``person``
+filter in whole-body mode, the paper's baseline of Fig. 4(d)). Each frame:
+
+1. tracks listed in ``init`` start at their first frame (a person row is decomposed
+   by sec. 4.1; part rows are used as given, shrunk to their inner rectangles); without
+   ``init``, person-size foreground blobs seen for ``start_frames`` frames running start
+   tracks;
+2. every part is predicted; parts behind a given occluder region (pillars, doors,
+   sec. 4.3.2) and persons hidden behind another person (sec. 4.3.1) follow their
+   dynamics with the appearance model frozen; the others are measured, the torso first,
+   then head and hip-leg carried by the torso's motion and kept near their place on the
+   body (``shared_motion``, ``coherence``: additions to the paper's independent filters);
+3. when parts of two measured persons touch, the one whose touching parts match their
+   models worse is the occluded one: it goes back to its dynamics until the two separate,
+   or until its torso shows clearly again clear of the other person;
+4. the failure detector (if any) judges the unoccluded persons and
+   ``partlab.tracking.body.adjustment`` repairs failed parts (sec. 4.3);
+5. models are updated by eq. (1), particles resampled by eq. (2), tracks that leave
+   the frame (or, when detecting automatically, lose their foreground) end.
+
+The output of a frame is one row per part and a ``person`` row holding the minimum
+bounding rectangle of the three parts (sec. 5.3). All numbers come from ``BodyParams``.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from partlab.tracking.core.box import Box, iou_xywh
+from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
+from partlab.tracking.body.detection import edge_contrast, person_blobs
+from partlab.tracking.frame_tracker import FailureDetector, FailureVerdict
+from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
+from partlab.tracking.params import BodyParams
+from partlab.tracking.body.part_filter import PartFilter
+from partlab.tracking.parts import BODY_PARTS
+from partlab.tracking.tracks import TrackRecord, normalise_tracks
+
+
+@dataclass
+class TrackStart:
+    """Boxes a track starts from (rows of an init CSV at the track's first frame)."""
+
+    frame: int
+    boxes: dict[str, Box]
+
+
+def init_starts(init: pd.DataFrame, whole: bool = False) -> dict[int, TrackStart]:
+    """Per track id, its first listed frame and the boxes given there.
+
+    Rows of parts this tracker does not track (hands) are ignored; a track with neither
+    a person row nor a body-part row at its first frame is refused with a clear message.
+    """
+    df = normalise_tracks(init)
+    wanted = ("person",) + BODY_PARTS
+    df = df[df["part"].isin(wanted)]
+    starts: dict[int, TrackStart] = {}
+    for tid, rows in df.groupby("track_id", sort=True):
+        first = int(rows["frame"].min())
+        at = rows[rows["frame"] == first]
+        boxes = {}
+        for r in at.itertuples(index=False):
+            if r.w < 2 or r.h < 2:
+                raise ValueError(f"init track {tid} frame {first}: the {r.part} box {r.w:g} x {r.h:g} is too small "
+                                 f"to track (at least 2 x 2 pixels)")
+            boxes[str(r.part)] = Box(float(r.x), float(r.y), float(r.w), float(r.h))
+        starts[int(tid)] = TrackStart(first, boxes)
+    return starts
+
+
+@dataclass
+class Person:
+    """One tracked person: its part filters and the bookkeeping of occlusion and failure."""
+
+    track_id: int
+    filters: dict[str, PartFilter]
+    history: deque = field(default_factory=deque)
+    occluded_by: int | None = None          # track id of the person in front (sec. 4.3.1)
+    hidden_parts: tuple[str, ...] = ()      # parts behind an occluder region (sec. 4.3.2)
+    failed: tuple[str, ...] = ()
+    adjusted: bool = False
+    unsupported: int = 0
+    started: int = 0
+    scores: dict[str, float] = field(default_factory=dict)
+    prev: dict[str, np.ndarray] = field(default_factory=dict)
+    observed: dict[str, np.ndarray] = field(default_factory=dict)
+    centres: deque = field(default_factory=lambda: deque(maxlen=11))  # (frame, cx, cy), clean frames
+    touching: bool = False                  # parts touch another person's this frame
+    occluded_frames: int = 0
+    offsets: dict[str, float] = field(default_factory=dict)  # part Y - torso Y, in torso heights
+
+    def velocity(self) -> np.ndarray | None:
+        """Median per-frame motion of the person box's centre over its recent *clean* frames
+        (not touching anyone, not occluded: another person passing in front drags the
+        estimate before the occlusion is decided); None if too few."""
+        if len(self.centres) < 3:
+            return None
+        c = np.asarray(self.centres, dtype=np.float64)
+        dt = np.diff(c[:, 0])
+        return np.median(np.diff(c[:, 1:], axis=0) / dt[:, None], axis=0)
+
+    def part_boxes(self) -> dict[str, Box]:
+        return {name: f.box for name, f in self.filters.items()}
+
+    def box(self) -> Box:
+        return minimum_bounding_rectangle(f.box for f in self.filters.values())
+
+
+def _moved(first: Box, now: Box, by: float) -> bool:
+    """Both side edges (or both the top and bottom edge) moved at least ``by`` pixels the same
+    way: a walker moves, while a walker separating from its ghost has one edge held by the ghost."""
+    for a, b in (((first.x, first.x2), (now.x, now.x2)), ((first.y, first.y2), (now.y, now.y2))):
+        d1, d2 = b[0] - a[0], b[1] - a[1]
+        if d1 * d2 > 0 and min(abs(d1), abs(d2)) >= by:
+            return True
+    return False
+
+
+def _piece_of(blob: Box, person: Box, p: BodyParams) -> bool:
+    """A blob beside a tracked person box that is a part of that person the box does not cover
+    (legs or head above or below it, within its width; an arm or a leg beside it, within its
+    height and shorter than the person), not someone new."""
+    near = p.detection_margin * person.h * 2
+    across = max(0.0, min(blob.x2, person.x2) - max(blob.x, person.x))
+    if across >= 0.5 * blob.w and max(person.y - blob.y2, blob.y - person.y2, 0.0) <= near:
+        return True
+    along = max(0.0, min(blob.y2, person.y2) - max(blob.y, person.y))
+    return (along >= 0.5 * blob.h and blob.h < 0.7 * person.h
+            and max(person.x - blob.x2, blob.x - person.x2, 0.0) <= near)
+
+
+def _overlap_fraction(a: Box, b: Box) -> float:
+    """Share of ``a``'s area covered by ``b``."""
+    return a.intersection(b) / a.area if a.area > 0 else 0.0
+
+
+class BodyTracker:
+    """Three-part (or whole-body) colour particle-filter tracker of every person in a clip.
+
+    ``init``: a tracks table (person and/or part rows) to start tracks from instead of
+    detecting people; ``occluders``: fixed regions (``Box``) that hide people;
+    ``failure_detector``: a :class:`partlab.tracking.frame_tracker.FailureDetector` called each
+    frame for every person not in occlusion; ``whole``: one box per person.
+    """
+
+    def __init__(self, params: BodyParams | None = None, rng: np.random.Generator | None = None,
+                 init: pd.DataFrame | None = None, occluders=(), failure_detector: FailureDetector | None = None,
+                 whole: bool = False, fps: float = 25.0):
+        self.params = params or BodyParams()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        self.whole = whole
+        self.parts = ("person",) if whole else BODY_PARTS
+        self.occluders = [b if isinstance(b, Box) else Box(*b) for b in occluders]
+        self.failure_detector = failure_detector
+        self.fps = float(fps)
+        self.auto = init is None
+        self.starts = {} if init is None else init_starts(init, whole)
+        self.pending = dict(self.starts)
+        self.people: dict[int, Person] = {}
+        self.next_id = max(self.starts, default=0) + 1
+        self.candidates: list[tuple[Box, int, Box]] = []  # (box, frames seen running, box when first seen)
+        self.frames_seen = 0
+        self._ycc = LazyYcc()
+
+    # -- starting tracks --------------------------------------------------------------
+    def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
+        if self.whole:
+            if "person" in boxes:
+                return {"person": boxes["person"]}
+            return {"person": minimum_bounding_rectangle(boxes[p] for p in BODY_PARTS if p in boxes)}
+        parts = {p: boxes[p] for p in BODY_PARTS if p in boxes}
+        if self.params.shrink_given_parts:
+            parts = {p: shrink_part(ycc, mask, b, p) for p, b in parts.items()}
+        if len(parts) < 3:
+            person = boxes.get("person")
+            if person is None:  # some parts only: their MBR stands in for the person
+                person = minimum_bounding_rectangle(parts.values())
+            decomposed = decompose(ycc, mask, person, self.params)
+            for p in BODY_PARTS:
+                parts.setdefault(p, decomposed[p])
+        return parts
+
+    def start_track(self, track_id: int, boxes: dict[str, Box], ycc: np.ndarray, mask: np.ndarray | None,
+                    index: int, from_mask: bool = False) -> Person:
+        """Start tracking a person from its boxes (person and/or part boxes); ``from_mask``: the
+        boxes come from the foreground mask itself (automatic detection), so it is trusted even
+        while the background model is young."""
+        if not from_mask and self.frames_seen < self.params.background_warmup // 2:
+            mask = None  # the background model has not learnt the scene yet: decompose by contrast
+        ycc = as_array(ycc)
+        parts = self._part_boxes_for_start(boxes, ycc, mask)
+        H, W = ycc.shape[:2]
+        filters = {}
+        for name in self.parts:
+            b = parts[name].clip(W, H)
+            if b.w < 2 or b.h < 2:
+                b = Box(b.x, b.y, max(b.w, 2.0), max(b.h, 2.0))
+            filters[name] = PartFilter(b, ycc, self.params, self.params.part_noise[name], self.rng)
+        person = Person(track_id, filters, deque(maxlen=self.params.history_frames), started=index)
+        if "torso" in filters:
+            t = filters["torso"].state
+            person.offsets = {n: float((f.state[1] - t[1]) / max(t[3], 1.0))
+                              for n, f in filters.items() if n != "torso"}
+        self.people[track_id] = person
+        return person
+
+    def _start_pending(self, index: int, ycc, mask) -> None:
+        for tid in sorted(self.pending):
+            start = self.pending[tid]
+            if start.frame <= index:
+                del self.pending[tid]
+                self.start_track(tid, start.boxes, ycc, mask, index)
+
+    def _detect(self, index: int, frame: np.ndarray, ycc, mask) -> None:
+        """Start tracks on person-size blobs of the foreground no tracked person covers, once
+        they have been seen ``start_frames`` frames running, have moved and have an outline on
+        image edges (ghosts do neither)."""
+        p = self.params
+        tracked = [self._reported_person_box(person) for person in self.people.values()]
+        free = mask
+        if tracked and p.detection_margin >= 0:
+            free = mask.copy()
+            H, W = mask.shape[:2]
+            for t in tracked:
+                m = p.detection_margin
+                c = t.transformed(1 + 2 * m, 1 + 2 * m, 0.0, 0.0).clip(W, H)
+                free[int(c.y):int(np.ceil(c.y2)), int(c.x):int(np.ceil(c.x2))] = 0
+        fresh: list[tuple[Box, int, Box]] = []
+        for blob in person_blobs(free, p):
+            if any(blob.intersection(t) > p.detection_overlap * blob.area or _piece_of(blob, t, p) for t in tracked):
+                continue
+            count, first = 1, blob
+            if self.candidates:
+                prev = np.array([c[0].as_tuple() for c in self.candidates])
+                ious = iou_xywh(np.array([blob.as_tuple()]), prev)[0]
+                k = int(np.argmax(ious))
+                if ious[k] > 0.3:
+                    count, first = self.candidates[k][1] + 1, self.candidates[k][2]
+            if (count >= p.start_frames and _moved(first, blob, p.start_min_motion * blob.h)
+                    and edge_contrast(frame, mask, blob) >= p.ghost_edge_contrast):
+                self.start_track(self.next_id, {"person": blob}, ycc, mask, index, from_mask=True)
+                tracked.append(blob)
+                self.next_id += 1
+            else:
+                fresh.append((blob, count, first))
+        self.candidates = fresh
+
+    def _reported_person_box(self, person: Person) -> Box:
+        """The person box as written: the MBR of its parts' reported boxes."""
+        return minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.filters.items())
+
+    # -- one frame ----------------------------------------------------------------------
+    def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None) -> list[TrackRecord]:
+        p = self.params
+        ycc = self._ycc.load(frame)  # converted to YCrCb only where the filters look
+        H, W = ycc.shape[:2]
+        self.frame_size = (W, H)
+        self.frames_seen += 1
+        mask = foreground
+        new_ids = set()
+        if self.pending:
+            before = set(self.people)
+            self._start_pending(index, ycc, mask)
+            new_ids = set(self.people) - before
+        active = [self.people[t] for t in sorted(self.people) if t not in new_ids]
+
+        # predict every part; decide who is hidden; measure the others
+        for person in active:
+            person.observed.clear()
+            person.prev = {n: f.state.copy() for n, f in person.filters.items()}
+            person.failed = ()
+            person.adjusted = False
+            for f in person.filters.values():
+                f.predict()
+        for person in active:
+            self._update_person_occlusion(person)
+            self._measure(person, ycc)
+        self._resolve_inter_person_occlusion(active)
+
+        # failure detection and adjustment (sec. 4.2-4.3) for persons not in occlusion
+        for person in active:
+            if self.whole:
+                continue
+            # the detector sees the boxes as reported (and as corrected by people), not the
+            # inner rectangles, so that what it was trained on and what it judges agree
+            reported = [self.report_box(n, person.filters[n].box) for n in BODY_PARTS]
+            person.history.append(np.array([[*b.centre, b.w, b.h] for b in reported]))
+            if self.failure_detector is None or person.occluded_by is not None or person.hidden_parts:
+                continue
+            verdict = self.failure_detector.detect(np.stack(person.history), self.fps)
+            if verdict.failed or verdict.multi:
+                self._adjust(person, verdict, ycc, mask)
+
+        # model update (eq. 1) and resampling (eq. 2)
+        for person in active:
+            for name, f in person.filters.items():
+                if person.occluded_by is not None or name in person.hidden_parts:
+                    continue
+                q = person.observed.pop(name, None)
+                if q is not None and person.scores[name] >= p.update_min_similarity and not person.adjusted:
+                    f.update_model(q)
+                f.resample()
+
+        for person in active:
+            if not person.touching and person.occluded_by is None and not person.hidden_parts:
+                person.centres.append((index, *person.box().centre))
+        self._end_tracks(active, mask, W, H)
+        if self.auto and mask is not None:
+            self._detect(index, frame, ycc, mask)
+        return self._records(index, new_ids)
+
+    def _update_person_occlusion(self, person: Person) -> None:
+        """Sec. 4.3.1: stay occluded while the person in front still overlaps; sec. 4.3.2:
+        which parts are behind an occluder region."""
+        person.touching = False
+        if person.occluded_by is not None:
+            person.occluded_frames += 1
+            front = self.people.get(person.occluded_by)
+            predicted = {n: f.predicted_box() for n, f in person.filters.items()}
+            if (front is None or not self._touching(predicted, front.part_boxes())[0]
+                    or person.occluded_frames > self.params.occlusion_max_frames):
+                person.occluded_by = None
+                person.occluded_frames = 0
+        hidden = []
+        for name, f in person.filters.items() if self.occluders else ():
+            b = f.predicted_box()
+            if any(_overlap_fraction(b, o) >= self.params.occluder_overlap for o in self.occluders):
+                hidden.append(name)
+        person.hidden_parts = tuple(hidden)
+
+    def _measure(self, person: Person, ycc: np.ndarray) -> None:
+        if person.occluded_by is not None:
+            for f in person.filters.values():
+                f.coast()
+            self._probe_occluded(person, ycc)
+            return
+        visible = [n for n in person.filters if n not in person.hidden_parts]
+        # the torso first: head and hip-leg are then kept near its centre line (coherence)
+        visible.sort(key=lambda n: n != "torso")
+        torso = None
+        for name in visible:
+            f = person.filters[name]
+            if torso is None or name not in person.offsets:
+                f.measure(ycc)
+            else:
+                s = self.params.shared_motion
+                if s > 0:  # one body moves as one: the torso's motion carries the other parts
+                    step = torso[0:2] - person.prev["torso"][0:2]
+                    delta = np.float32(s) * (step.astype(np.float32) - f.particles[:, 4:6])
+                    f.particles[:, 0:2] += delta
+                    f.particles[:, 4:6] += delta
+                ax, ay = torso[0], torso[1] + person.offsets[name] * torso[3]
+                f.measure(ycc, ax, self.params.coherence * torso[2], ay, self.params.coherence_y * torso[3])
+            if name == "torso":
+                torso = f.state.copy()
+            person.observed[name] = q = f.appearance(ycc)
+            person.scores[name] = f.score(q)
+        if person.hidden_parts:
+            # hidden parts follow the visible parts' motion (they belong to one body); when all
+            # are hidden, the person's own recent motion
+            if visible:
+                v = np.mean([person.filters[n].state[4:6] for n in visible], axis=0)
+            else:
+                v = person.velocity()
+            for name in person.hidden_parts:
+                f = person.filters[name]
+                if v is not None:
+                    f.set_velocity(v)
+                f.coast()
+            if not visible:
+                self._probe_hidden(person, ycc)
+
+    def _probe_hidden(self, person: Person, ycc: np.ndarray) -> None:
+        """A person wholly behind occluder regions whose torso shows clearly again away from
+        them (similarity at least ``release_similarity``) is moved there: a walker may speed
+        up or slow down behind a pillar."""
+        p = self.params
+        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
+        f = person.filters[anchor]
+        if p.release_similarity <= 0:
+            return
+        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
+        if rho < p.release_similarity:
+            return
+        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        if any(_overlap_fraction(found, o) >= p.occluder_overlap for o in self.occluders):
+            return
+        delta = state[0:2] - f.state[0:2]
+        for g in person.filters.values():
+            g.shift(delta)
+
+    def _probe_occluded(self, person: Person, ycc: np.ndarray) -> None:
+        """An occluded person whose torso shows clearly again (similarity at least
+        ``release_similarity``, clear of the front person's box) near its prediction is released
+        there, all parts moved with it: dynamics cannot foresee a stop or a turn behind
+        someone, and the two may walk on together without ever separating."""
+        p = self.params
+        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
+        f = person.filters[anchor]
+        if person.occluded_frames < 2 or p.release_similarity <= 0:
+            return
+        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
+        if rho < p.release_similarity:
+            return
+        front = self.people.get(person.occluded_by)
+        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        if front is not None and found.intersection(front.box()) > 0:
+            return  # still behind (or beside and touching) the front person: keep waiting
+        delta = state[0:2] - f.state[0:2]
+        for g in person.filters.values():
+            g.shift(delta)
+            g.set_velocity(np.zeros(2))
+        person.occluded_by = None
+        person.occluded_frames = 0
+
+    def _resolve_inter_person_occlusion(self, active: list[Person]) -> None:
+        """Sec. 4.3.1: when parts of two measured persons touch, the one whose touching parts
+        look less like their models is behind; it goes back to its dynamics-only prediction.
+        While the two similarities differ by less than ``occlusion_margin`` nobody is hidden
+        yet (both still fully visible); the decision waits for a frame that tells them apart."""
+        p = self.params
+        visible = [q for q in active if q.occluded_by is None]
+        p_boxes = {q.track_id: q.box() for q in visible}
+        pad = 1 + 2 * p.occlusion_pad
+        for i, a in enumerate(visible):
+            for b in visible[i + 1:]:
+                if a.occluded_by is not None or b.occluded_by is not None:
+                    continue
+                ba, bb = p_boxes[a.track_id], p_boxes[b.track_id]
+                if abs(ba.centre[0] - bb.centre[0]) * 2 > pad * (ba.w + bb.w) or ba.y > bb.y2 or bb.y > ba.y2:
+                    continue  # person boxes far apart: no part can touch
+                touching_a, touching_b = self._touching(a.part_boxes(), b.part_boxes())
+                if not touching_a:
+                    continue
+                a.touching = b.touching = True
+                sa = min(a.scores.get(n, 1.0) for n in touching_a)
+                sb = min(b.scores.get(n, 1.0) for n in touching_b)
+                if abs(sa - sb) < p.occlusion_margin:
+                    continue
+                behind, front = (a, b) if sa < sb else (b, a)
+                behind.occluded_by = front.track_id
+                behind.observed.clear()
+                v = behind.velocity()
+                for name, f in behind.filters.items():
+                    f.state = behind.prev[name].copy()
+                    if v is not None:
+                        f.set_velocity(v)
+                    f.coast()
+
+    def _touching(self, boxes_a: dict[str, Box], boxes_b: dict[str, Box]) -> tuple[set, set]:
+        """Parts of two persons that overlap by more than ``occlusion_overlap`` of the smaller."""
+        ta, tb = set(), set()
+        pad = self.params.occlusion_pad
+        if pad > 0:  # inner rectangles are narrower than the parts they stand for
+            grow = lambda b: Box(b.x - pad * b.w, b.y, b.w * (1 + 2 * pad), b.h)  # noqa: E731
+            boxes_a = {n: grow(b) for n, b in boxes_a.items()}
+            boxes_b = {n: grow(b) for n, b in boxes_b.items()}
+        for na, ba in boxes_a.items():
+            for nb, bb in boxes_b.items():
+                smaller = min(ba.area, bb.area)
+                if smaller > 0 and ba.intersection(bb) > self.params.occlusion_overlap * smaller:
+                    ta.add(na)
+                    tb.add(nb)
+        return ta, tb
+
+    def _similarity(self, person: Person) -> float:
+        return float(np.mean([person.scores.get(n, 1.0) for n in person.filters]))
+
+    def _adjust(self, person: Person, verdict: FailureVerdict, ycc: np.ndarray, mask) -> None:
+        from partlab.tracking.body.adjustment import adjust_person
+
+        adjust_person(self, person, verdict, as_array(ycc), mask)
+        person.failed = tuple(verdict.failed) if verdict.failed else (BODY_PARTS if verdict.multi else ())
+        person.adjusted = True
+
+    def _end_tracks(self, active: list[Person], mask, W: int, H: int) -> None:
+        p = self.params
+        frame_box = Box(0, 0, W, H)
+        for person in active:
+            box = person.box()
+            if box.area <= 0 or _overlap_fraction(box, frame_box) < p.leave_fraction:
+                del self.people[person.track_id]
+                continue
+            if self.auto and mask is not None and person.occluded_by is None and not person.hidden_parts:
+                c = box.clip(W, H)
+                region = mask[int(c.y):int(c.y2), int(c.x):int(c.x2)]
+                support = float((region > 0).mean()) if region.size else 0.0
+                person.unsupported = person.unsupported + 1 if support < p.support_min else 0
+                if person.unsupported >= p.lost_frames:
+                    del self.people[person.track_id]
+        for tid, q in list(self.people.items()):
+            if q.occluded_by is not None and q.occluded_by not in self.people:
+                q.occluded_by = None
+
+    def report_box(self, part: str, box: Box) -> Box:
+        """The box written for a part: its tracked inner rectangle widened to the part's extent
+        (``BodyParams.output_extent``), clipped to the frame."""
+        sw, sh, dx, dy = self.params.output_extent.get(part, (1.0, 1.0, 0.0, 0.0))
+        out = box.transformed(sw, sh, dx, dy)
+        size = getattr(self, "frame_size", None)
+        return out.clip(*size) if size else out
+
+    def _records(self, index: int, new_ids: set[int]) -> list[TrackRecord]:
+        out: list[TrackRecord] = []
+        for tid in sorted(self.people):
+            person = self.people[tid]
+            if tid in new_ids:
+                state = "init"
+            elif person.occluded_by is not None:
+                state = "occluded"
+            elif person.adjusted:
+                state = "adjusted"
+            else:
+                state = "tracked"
+            scores = [person.scores.get(n, 1.0) for n in person.filters]
+            boxes = {name: self.report_box(name, f.box) for name, f in person.filters.items()}
+            if not self.whole:
+                out.append(TrackRecord(index, tid, "person", minimum_bounding_rectangle(boxes.values()),
+                                       float(np.mean(scores)),
+                                       bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
+                                       state))
+            for name, f in person.filters.items():
+                hidden = person.occluded_by is not None or name in person.hidden_parts
+                part_state = "occluded" if hidden and state == "tracked" else state
+                out.append(TrackRecord(index, tid, name, boxes[name], person.scores.get(name, 1.0),
+                                       name in person.failed, 1.0 if hidden else 0.0, part_state))
+        return out

@@ -1,0 +1,314 @@
+"""One particle filter per head or hand, weighted against every skin blob (seed 000 sec. 4-5).
+
+Low layer of seed 000 (sec. 3): parallel filters with no interaction except the
+shared observations. A filter's particles are ``(N, 4) float64 [cx, cy, vx, vy]``
+(box centre and velocity, pixels); the box size is the target's fixed reference size
+(seed 003 sec. 3). Dynamics are second order, ``x_t - x_{t-1} = d (x_{t-1} - x_{t-2}) + w_t``
+(seed 003 sec. 3; ``d`` = ``velocity_decay``, 1 in the paper).
+
+The weight of particle i is the blob likelihood of seed 000 eq. (17) with every
+indicator set to one (all-neighbours association, sec. 5),
+
+    p(z | x_i) ~ sum_c p(x_i | Z_c) p(Z_c),   p(x_i | Z_c) = exp(-|x_i - Z_c|^2 / (2 sigma_xy^2)),
+
+times the hue-histogram confidence of seed 003 eq. (1). The candidate prior ``p(Z_c)``
+is a product of named terms (eq. 19); in one camera the silhouette term (eq. 27 in 2D)
+and the blob's mean skin probability (the observation-quality role of ``p_o``) apply.
+More cameras add their terms to :func:`candidate_terms` and nothing else changes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from partlab.tracking.core.hue_histogram import box_histograms, hue_confidence, mean_shift
+from partlab.tracking.params import LimbParams
+from partlab.tracking.core.resampling import systematic_resample
+from partlab.tracking.core.skin import Blobs
+
+
+@dataclass(frozen=True)
+class Candidates:
+    """Candidate points of one frame: ``centres (K, 2)``, ``boxes (K, 4)``, ``areas (K,)``,
+    their named prior terms ``terms[name] (K,)`` and the product ``priors (K,)`` (seed 000 eq. 19);
+    ``parents (K,)``: the blob (index into the frame's :class:`Blobs`) each candidate comes from
+    (None: candidate k is blob k)."""
+
+    centres: np.ndarray
+    boxes: np.ndarray
+    areas: np.ndarray
+    terms: dict[str, np.ndarray]
+    priors: np.ndarray
+    parents: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return int(self.priors.size)
+
+
+def silhouette_term(centres: np.ndarray, foreground: np.ndarray | None, sigma_s: float) -> np.ndarray:
+    """``exp(-Ds^2 / (2 sigma_s^2))`` with ``Ds`` the distance of each centre to the foreground
+    silhouette (seed 000 eq. 27, one camera); all ones without a foreground mask."""
+    centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+    if foreground is None or centres.size == 0:
+        return np.ones(len(centres))
+    fg = np.asarray(foreground) > 0
+    if not fg.any():
+        return np.zeros(len(centres))
+    dist = cv2.distanceTransform((~fg).astype(np.uint8), cv2.DIST_L2, 3)
+    hgt, wid = fg.shape
+    xs = np.clip(np.round(centres[:, 0]).astype(int), 0, wid - 1)
+    ys = np.clip(np.round(centres[:, 1]).astype(int), 0, hgt - 1)
+    d = dist[ys, xs]
+    return np.exp(-(d * d) / (2.0 * sigma_s**2))
+
+
+def skin_term(blobs: Blobs, skin_probability: np.ndarray | None) -> np.ndarray:
+    """Mean skin probability over each blob's pixels: how good the observation is (role of p_o)."""
+    if skin_probability is None or len(blobs) == 0:
+        return np.ones(len(blobs))
+    sums = np.bincount(blobs.labels.ravel(), weights=np.asarray(skin_probability, float).ravel(),
+                       minlength=int(blobs.ids.max()) + 1)
+    return np.clip(sums[blobs.ids] / np.maximum(blobs.areas, 1.0), 0.0, 1.0)
+
+
+def candidate_terms(blobs: Blobs, foreground: np.ndarray | None, skin_probability: np.ndarray | None,
+                    params: LimbParams) -> Candidates:
+    """Candidates from one camera's blobs, with the prior as a product of named terms."""
+    terms = {
+        "silhouette": silhouette_term(blobs.centres, foreground, params.sigma_s),
+        "skin": skin_term(blobs, skin_probability),
+    }
+    priors = np.ones(len(blobs))
+    for t in terms.values():
+        priors = priors * t
+    return Candidates(blobs.centres, blobs.boxes, blobs.areas, terms, priors)
+
+
+def blob_points(blobs: Blobs) -> list[np.ndarray]:
+    """``(n, 2) float [x, y]`` pixel coordinates of each blob, in the blobs' order."""
+    out = []
+    for (x, y, w, h), i in zip(blobs.boxes.astype(int), blobs.ids):
+        ys, xs = np.nonzero(blobs.labels[y:y + h, x:x + w] == i)
+        out.append(np.column_stack([xs + x, ys + y]).astype(float))
+    return out
+
+
+def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: float,
+              max_tips: int = 4) -> np.ndarray:
+    """Hand-sized ends of one blob: ``(T, 2)`` points, or the blob's centre when it is compact.
+
+    With short sleeves a hand and its forearm share one colour and form one blob (a desk
+    scene's arm is ~3-4 hand widths long); its centre lies mid-forearm, which pulls a hand
+    filter up the arm. The hand is an end of that blob. A blob whose farthest pixels are at
+    least ``span`` sides apart is split into ends: points of its outline that stick out (local
+    maxima of the distance to the blob's centre along the outline), the two farthest apart
+    first, then more (the tip of a V where two forearms meet at a clap) while one lies at
+    least ``far`` sides from every end found. The middle of a long straight arm's side is
+    no end: its distance to the centre is a minimum along the outline. Each end's point is
+    the centroid of the blob pixels within ``radius`` sides of it: a hand's centre when the
+    end is a hand.
+    """
+    pts = np.asarray(points, float).reshape(-1, 2)
+    centre = pts.mean(axis=0)
+    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
+    if np.hypot(*(pts - t1).T).max() < span * side:
+        return centre[None]
+    ends = _outline_maxima(pts, centre, max(int(side / 2), 2))
+    tips = [t1]
+    mind = np.hypot(*(ends - t1).T)
+    while len(tips) < max_tips and len(ends):
+        k = int(np.argmax(mind))
+        if mind[k] < (span if len(tips) == 1 else far) * side:
+            break
+        tips.append(ends[k])
+        mind = np.minimum(mind, np.hypot(*(ends - ends[k]).T))
+    if len(tips) == 1:  # no outline end far enough (a ragged blob): its farthest pixel
+        tips.append(pts[np.argmax(np.hypot(*(pts - t1).T))])
+    return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
+
+
+def _outline_maxima(pts: np.ndarray, centre: np.ndarray, half_window: int) -> np.ndarray:
+    """Points of a blob's outer outline farther from ``centre`` than every outline point
+    within ``half_window`` steps along it: ``(M, 2)``."""
+    x0, y0 = pts.min(axis=0).astype(int)
+    mask = np.zeros((int(pts[:, 1].max()) - y0 + 3, int(pts[:, 0].max()) - x0 + 3), np.uint8)
+    mask[pts[:, 1].astype(int) - y0 + 1, pts[:, 0].astype(int) - x0 + 1] = 1
+    contours, _ = cv2.findContours(mask, cv2.RETR_EXTERNAL, cv2.CHAIN_APPROX_NONE)
+    if not contours:
+        return np.zeros((0, 2))
+    c = max(contours, key=len).reshape(-1, 2).astype(float) + np.array([x0 - 1, y0 - 1])
+    r = np.hypot(*(c - centre[None, :]).T)
+    n = len(r)
+    w = min(half_window, (n - 1) // 2)
+    shifted = np.stack([np.roll(r, s) for s in range(-w, w + 1)])
+    return c[r >= shifted.max(axis=0)]
+
+
+def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, params: LimbParams) -> Candidates:
+    """Candidates of a hand of box side ``side``: each elongated blob replaced by its ends
+    (:func:`blob_tips`), which inherit the blob's prior terms."""
+    if len(cands) == 0:
+        return cands
+    centres, parents = [], []
+    for k, pts in enumerate(points):
+        tips = blob_tips(pts, side, params.tip_span, params.tip_far, params.tip_radius)
+        centres.append(tips)
+        parents += [k] * len(tips)
+    return _expand(cands, np.concatenate(centres), np.asarray(parents, int), side)
+
+
+def nearest_part_candidates(cands: Candidates, points: list[np.ndarray], near, side: float,
+                            params: LimbParams) -> Candidates:
+    """One candidate per blob: the centroid of its pixels within ``tip_radius`` sides of its
+    pixel nearest to ``near``. A combined pair of hands looks for its modes with these: where
+    two arms meet in a V the meeting point is no end of the blob's long axis, and as the hands
+    part each arm's part nearest the pair is its hand."""
+    if len(cands) == 0:
+        return cands
+    near = np.asarray(near, float)
+    centres = []
+    for pts in points:
+        d = np.hypot(*(pts - near[None, :]).T)
+        q = pts[int(np.argmin(d))]
+        centres.append(pts[np.hypot(*(pts - q).T) <= params.tip_radius * side].mean(axis=0))
+    return _expand(cands, np.asarray(centres).reshape(-1, 2), np.arange(len(points)), side)
+
+
+def nearest_per_parent(cands: Candidates, point) -> np.ndarray:
+    """``(K,) bool``: of the candidates sharing a parent blob, the one nearest ``point``."""
+    if cands.parents is None or len(cands) == 0:
+        return np.ones(len(cands), bool)
+    d = np.hypot(*(cands.centres - np.asarray(point, float)[None, :]).T)
+    keep = np.zeros(len(cands), bool)
+    for k in np.unique(cands.parents):
+        idx = np.flatnonzero(cands.parents == k)
+        keep[idx[np.argmin(d[idx])]] = True
+    return keep
+
+
+def _expand(cands: Candidates, centres: np.ndarray, parents: np.ndarray, side: float) -> Candidates:
+    boxes = np.column_stack([centres - side / 2, np.full((len(centres), 2), side)])
+    return Candidates(centres, boxes, cands.areas[parents], {k: v[parents] for k, v in cands.terms.items()},
+                      cands.priors[parents], parents)
+
+
+def blob_likelihood(points: np.ndarray, candidates: Candidates, sigma_xy: float) -> np.ndarray:
+    """``sum_c exp(-|x - Z_c|^2 / (2 sigma^2)) p(Z_c)`` for ``points (N, 2)`` -> ``(N,)`` (seed 000 eq. 17)."""
+    points = np.asarray(points, dtype=float).reshape(-1, 2)
+    if len(candidates) == 0:
+        return np.zeros(len(points))
+    d2 = ((points[:, None, :] - candidates.centres[None, :, :]) ** 2).sum(axis=2)
+    return (np.exp(-d2 / (2.0 * sigma_xy**2)) * candidates.priors[None, :]).sum(axis=1)
+
+
+class LimbFilter:
+    """SIR particle filter of one target (a head, a hand, or two combined targets)."""
+
+    def __init__(self, centre, size, ref_hist: np.ndarray | None, params: LimbParams, rng: np.random.Generator):
+        self.params = params
+        self.size = (float(size[0]), float(size[1]))
+        # no reference yet (the caller fills it in): flat until then
+        self.ref_hist = (np.full(params.hue_bins, 1.0 / params.hue_bins) if ref_hist is None
+                         else np.asarray(ref_hist, dtype=float))
+        self.particles = np.zeros((params.particles, 4))
+        self.reset(centre, rng)
+        self.confidence = 1.0
+        self.weights = np.full(params.particles, 1.0 / params.particles)
+
+    def reset(self, centre, rng: np.random.Generator, spread: float | None = None) -> None:
+        """Particles around ``centre`` with zero velocity (start, recovery, split)."""
+        s = self.params.noise_xy if spread is None else spread
+        n = self.params.particles
+        self.particles = np.zeros((n, 4))
+        self.particles[:, :2] = np.asarray(centre, dtype=float)[None, :] + rng.normal(0.0, s, (n, 2))
+        self.estimate = np.asarray(centre, dtype=float).copy()
+
+    def box(self, centre=None) -> tuple[float, float, float, float]:
+        cx, cy = self.estimate if centre is None else centre
+        w, h = self.size
+        return (float(cx - w / 2), float(cy - h / 2), w, h)
+
+    def predict(self, rng: np.random.Generator, scale: float = 1.0) -> None:
+        """Second-order dynamics (seed 003 sec. 3): position += velocity, both with white noise."""
+        p, n = self.params, len(self.particles)
+        self.particles[:, 2:] = p.velocity_decay * self.particles[:, 2:] + rng.normal(0.0, p.noise_v * scale, (n, 2))
+        self.particles[:, :2] += self.particles[:, 2:] + rng.normal(0.0, p.noise_xy * scale, (n, 2))
+
+    def particle_boxes(self) -> np.ndarray:
+        w, h = self.size
+        return np.column_stack([self.particles[:, 0] - w / 2, self.particles[:, 1] - h / 2,
+                                np.full(len(self.particles), w), np.full(len(self.particles), h)])
+
+    def weigh(self, candidates: Candidates, integral: np.ndarray) -> np.ndarray:
+        """Weights = blob likelihood (eq. 17) x hue confidence (seed 003 eq. 1) + a floor.
+
+        The floor is added, not multiplied by the hue term: a filter whose blob vanished
+        then diffuses around its last place instead of being drawn to another limb's skin.
+
+        ``confidence`` becomes the best particle's unnormalised score in [0, 1], the
+        likelihood level the state machine thresholds.
+        """
+        p = self.params
+        blob = np.minimum(blob_likelihood(self.particles[:, :2], candidates, p.sigma_xy), 1.0)
+        hue = hue_confidence(box_histograms(integral, self.particle_boxes()), self.ref_hist, p.lam)
+        score = blob * hue
+        self.confidence = float(score.max()) if score.size else 0.0
+        w = score + p.blob_floor
+        total = w.sum()
+        self.weights = w / total if total > 0 else np.full(len(w), 1.0 / len(w))
+        self.estimate = (self.weights[:, None] * self.particles[:, :2]).sum(axis=0)
+        return self.weights
+
+    def refine(self, backproj: np.ndarray | None) -> None:
+        """Mean shift from the PF mean on the back-projection, then shift the samples
+        by the same amount (seed 003 sec. 3: "redistribute the samples")."""
+        p = self.params
+        if backproj is None or p.mean_shift_iterations <= 0:
+            return
+        x, y, w, h = mean_shift(backproj, self.box(), p.mean_shift_iterations, p.mean_shift_eps)
+        self.shift_to((x + w / 2, y + h / 2))
+
+    def shift_to(self, centre) -> None:
+        """Move the estimate to ``centre`` and every sample by the same amount (a refinement)."""
+        new = np.asarray(centre, dtype=float)
+        self.particles[:, :2] += new - self.estimate
+        self.estimate = new.copy()
+
+    def resample(self, rng: np.random.Generator) -> None:
+        idx = systematic_resample(self.weights, len(self.particles), rng)
+        self.particles = self.particles[idx]
+        self.weights = np.full(len(self.particles), 1.0 / len(self.particles))
+
+    def update_reference(self, hist: np.ndarray | None) -> None:
+        """``h_ref = (1 - a) h_ref + a h`` with ``a`` = ``model_update``, when the estimate is confident."""
+        if hist is None or hist.sum() <= 0:
+            return
+        a = self.params.model_update
+        self.ref_hist = (1 - a) * self.ref_hist + a * hist
+
+
+def candidate_modes(points: np.ndarray, weights: np.ndarray, candidates: Candidates, sigma_xy: float,
+                    radius: float) -> np.ndarray:
+    """Modes of a (combined) filter's posterior: ``(M, 2)`` candidate centres, strongest first.
+
+    The posterior is the mixture of eq. (17); its components are the candidates, and the
+    mass of component c is ``sum_i w_i p(x_i | Z_c) p(Z_c)``. Candidates with mass at least a
+    tenth of the largest and within ``radius`` of the particle mean are the modes.
+    """
+    if len(candidates) == 0:
+        return np.zeros((0, 2))
+    points = np.asarray(points, float).reshape(-1, 2)
+    w = np.asarray(weights, float)
+    mean = (w[:, None] * points).sum(axis=0) / max(w.sum(), 1e-12)
+    d2 = ((points[:, None, :] - candidates.centres[None, :, :]) ** 2).sum(axis=2)
+    mass = (w[:, None] * np.exp(-d2 / (2.0 * sigma_xy**2))).sum(axis=0) * candidates.priors
+    near = np.hypot(*(candidates.centres - mean[None, :]).T) <= radius
+    mass = np.where(near, mass, 0.0)
+    if mass.max() <= 0:
+        return np.zeros((0, 2))
+    keep = np.flatnonzero(mass >= 0.1 * mass.max())
+    keep = keep[np.argsort(-mass[keep], kind="stable")]
+    return candidates.centres[keep]

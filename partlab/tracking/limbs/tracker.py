@@ -1,0 +1,664 @@
+"""The limb tracker: head, left hand and right hand of every person in one camera (seed 000, 003).
+
+Per frame (``LimbTracker.step``):
+
+1. observations: skin pixels (``partlab.tracking.core.skin``; with ``--init`` the skin model is refit
+   on the init boxes against the whole frame) within the foreground and the
+   neighbourhood of tracked targets, connected blobs, candidates with a prior that is a
+   product of named terms (``partlab.tracking.limbs.filter``);
+2. low layer: every active filter predicts, is weighted against the candidates no other
+   target sits on and its hue histogram over skin pixels (seed 000 eq. 17, seed 003
+   eq. 1-2), refined by mean shift on the skin hue back-projection and resampled;
+3. high layer: the per-tracker state machine (``partlab.tracking.limbs.state_machine``) combines,
+   splits, loses and recovers targets; this module acts on its transitions (one filter
+   for a combined pair, one filter per mode after a split, labels by the direction
+   cue), labels auto-started trackers (face detector for heads, side of the head for
+   hands) and re-acquires a head with the face detector (seed 003 sec. 3).
+
+A tracker's output row has ``track_id`` = the person, ``part`` in head/left_hand/right_hand,
+``state`` = its state-machine state and ``score`` = the filter's confidence.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pandas as pd
+
+from partlab.tracking.core.box import Box
+from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from partlab.tracking.limbs.filter import (Candidates, LimbFilter, blob_points, candidate_modes, candidate_terms,
+                                 nearest_part_candidates, nearest_per_parent, tip_candidates)
+from partlab.tracking.params import LimbParams
+from partlab.tracking.parts import LIMB_PARTS
+from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
+from partlab.tracking.limbs.state_machine import (JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction,
+                                    distance_threshold)
+from partlab.tracking.tracks import TrackRecord, normalise_tracks
+
+EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a",
+                                  "track_id_b", "part_b", "ended_by")
+
+FACE_CASCADE_FILE = "haarcascade_frontalface_default.xml"
+
+
+def load_face_detector() -> cv2.CascadeClassifier | None:
+    """OpenCV's bundled frontal-face cascade, or None if this OpenCV build lacks it
+    (then heads are started and re-acquired from skin blobs only)."""
+    data = getattr(cv2, "data", None)
+    if data is None:
+        return None
+    path = Path(data.haarcascades) / FACE_CASCADE_FILE
+    if not path.exists():
+        return None
+    det = cv2.CascadeClassifier(str(path))
+    return None if det.empty() else det
+
+
+def event_kind(part_a: str | None, track_a: int | None, part_b: str | None, track_b: int | None) -> str:
+    """Activity class of a join (seed 000 sec. 7.1): two hands of one person -> clap (or an
+    exchange between the hands), hands of two people -> handshake, a hand and a head -> hand_head."""
+    hands = {"left_hand", "right_hand"}
+    if part_a in hands and part_b in hands:
+        return "clap" if track_a == track_b else "handshake"
+    if {part_a, part_b} & hands and "head" in (part_a, part_b):
+        return "hand_head"
+    return "join"
+
+
+def write_events(events: pd.DataFrame, path: str | PathLike) -> None:
+    """Write the join/separation events as ``EVENTS.csv`` (columns :data:`EVENT_COLUMNS`)."""
+    missing = [c for c in EVENT_COLUMNS if c not in events.columns]
+    if missing:
+        raise ValueError(f"events table lacks column(s) {', '.join(missing)}")
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    events.loc[:, list(EVENT_COLUMNS)].sort_values(["start_frame", "track_id_a"], kind="stable").to_csv(
+        path, index=False, lineterminator="\n")
+
+
+@dataclass
+class _Target:
+    """What the tracker knows of one head or hand beyond its state."""
+
+    track_id: int | None = None
+    part: str | None = None
+    filter: LimbFilter | None = None
+    size: tuple[float, float] = (0.0, 0.0)
+    ref_hist: np.ndarray | None = None
+    last: np.ndarray | None = None  # last confident position (lost-state search centre)
+    low_frames: int = 0  # frames below reacquire_confidence (heads)
+    unlabelled_frames: int = 0
+    candidate: np.ndarray | None = None  # uninitialized: the candidate it would start from
+    candidate_box: np.ndarray | None = None
+    missed: int = 0  # uninitialized: frames without its candidate
+    shown: np.ndarray | None = None  # combined: the position written for this member
+    anchor: np.ndarray | None = None  # the person's head estimate when ``last`` was taken
+    prev: np.ndarray | None = None  # normal: the estimate one frame before (the hand's velocity)
+
+    @property
+    def labelled(self) -> bool:
+        return self.track_id is not None and self.part is not None
+
+
+class LimbTracker:
+    """Head and hands of several people; implements ``partlab.tracking.frame_tracker.FrameTracker``.
+
+    ``init``: a tracks table (INIT.csv) whose head/left_hand/right_hand rows start
+    tracks at their first listed frame with their ``track_id``; without it (or without
+    limb rows in it), trackers
+    start from persistent skin blobs and are labelled by the face detector and by
+    position relative to a head.
+    """
+
+    def __init__(self, params: LimbParams | None = None, rng: np.random.Generator | None = None,
+                 init: pd.DataFrame | None = None, skin: SkinModel | None = None,
+                 face_detector: bool = True):
+        self.params = params or LimbParams()
+        self.rng = rng if rng is not None else np.random.default_rng(0)
+        # ``skin``: a trained model (e.g. from a model bundle); default: the YCrCb rule
+        self.skin = skin or SkinModel.default()
+        self.machine = LimbStateMachine(self.params)
+        self.targets: dict[int, _Target] = {}
+        self.face = load_face_detector() if face_detector else None
+        self._next_tracker = 0
+        self._next_person = 0
+        self._last_frame = -1
+        self._init: dict[int, list[tuple[int, str, np.ndarray]]] = {}
+        rows = None if init is None else normalise_tracks(init)
+        if rows is not None:
+            self._next_person = int(rows["track_id"].max()) + 1 if len(rows) else 0
+            rows = rows[rows["part"].isin(LIMB_PARTS)]
+        # an init table with only body rows (``--tracker all --init`` from the body tracker's
+        # boxes) starts the limbs automatically, with person ids after the table's
+        self.auto_start = rows is None or rows.empty
+        if not self.auto_start:
+            first = rows.sort_values("frame", kind="stable").groupby(["track_id", "part"], sort=False).head(1)
+            for r in first.itertuples(index=False):
+                self._init.setdefault(int(r.frame), []).append(
+                    (int(r.track_id), str(r.part), np.array([r.x, r.y, r.w, r.h], float)))
+
+    # -- public ----------------------------------------------------------------------------
+    @property
+    def events(self) -> pd.DataFrame:
+        """Join/separation events so far (:data:`EVENT_COLUMNS`); a join still open ends at the last frame."""
+        rows = []
+        evs = list(self.machine.events)
+        for t in self.machine.trackers():
+            p = self.machine.partner(t)
+            if self.machine.state(t) == LimbState.COMBINED and p is not None and t < p:
+                evs.append(JoinEvent(self.machine.joined_at(t), self._last_frame, t, p, "open"))
+        for e in evs:
+            a, b = self.targets[e.tracker_a], self.targets[e.tracker_b]
+            rows.append({"start_frame": e.start_frame, "end_frame": e.end_frame,
+                         "kind": event_kind(a.part, a.track_id, b.part, b.track_id),
+                         "track_id_a": a.track_id, "part_a": a.part, "track_id_b": b.track_id,
+                         "part_b": b.part, "ended_by": e.ended_by})
+        return pd.DataFrame(rows, columns=list(EVENT_COLUMNS))
+
+    def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None = None) -> list[TrackRecord]:
+        p = self.params
+        frame = np.asarray(frame)
+        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
+            raise ValueError(f"expected a BGR (H, W, 3) uint8 frame, got shape {frame.shape} dtype {frame.dtype}")
+        if foreground is not None and np.asarray(foreground).shape != frame.shape[:2]:
+            raise ValueError(f"foreground mask shape {np.asarray(foreground).shape} does not match the frame "
+                             f"{frame.shape[:2]}")
+        self._last_frame = index
+
+        # 1. observations ------------------------------------------------------------------
+        starting = self._init.get(index, [])
+        if starting and p.skin_adapt:
+            # the given boxes show these people's skin against this scene: a Bayes skin model
+            # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
+            # accepts, because their colours fill far more of the frame than the boxes.
+            self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
+                                         bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin,
+                                         keep_mass=p.skin_keep_mass, keep_recall=p.skin_keep_recall,
+                                         threshold=p.skin_threshold, keep_min_side=p.skin_keep_min_side)
+        skin_prob = self.skin.probability(frame)
+        skin_mask = skin_prob >= p.skin_threshold
+        fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
+        if fg is not None:
+            skin_mask &= fg
+        if p.skin_open > 1:  # remove speckle left by noise
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin_open, p.skin_open))
+            skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
+        people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
+        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, self._min_area(starting))
+        cands = candidate_terms(blobs, fg, skin_prob, p)
+        hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
+        bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
+        skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)  # skin_mask is within the support
+        # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
+        # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
+        # The colour likelihood and the mean shift therefore run on the "skin-colour
+        # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
+        integral = integral_histogram(skin_bins, p.hue_bins)
+
+        for track_id, part, box in starting:
+            self._start(box, skin_bins, track_id, part)
+        self._fill_references(skin_bins)
+        for t, tgt in self.targets.items():  # started before their head was: anchor them now
+            if tgt.anchor is None and tgt.last is not None and tgt.part != "head":
+                tgt.anchor = self._head_of(t)
+
+        # 2. low layer ---------------------------------------------------------------------
+        active = [t for t in self.machine.trackers()
+                  if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
+        observations: dict[int, Observation] = {}
+        pixels: list = []  # each blob's pixels, read once when a hand needs its ends
+        sets: dict = {}  # hands' candidate sets (blob ends) and their owners, by box side
+        owner, within = self._owners(cands, active)
+        # a head's blob (face and neck) is no hand's: its lower end would look like one
+        heads = within & np.array([self.targets[o].part == "head" if o >= 0 else False for o in owner], bool)
+
+        def points() -> list[np.ndarray]:
+            if not pixels:
+                pixels.append(blob_points(blobs))
+            return pixels[0]
+
+        def not_heads(c: Candidates) -> Candidates:
+            return self._subset(c, ~heads[c.parents]) if c.parents is not None else c
+
+        def seen_by(t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
+            side = self._hand_side(t)
+            if side not in sets:
+                c = cands if side is None else not_heads(tip_candidates(cands, points(), side, p))
+                sets[side] = (c, self._owners(c, active))
+            return sets[side]
+
+        for t in active:
+            tgt = self.targets[t]
+            state = self.machine.state(t)
+            own_c, owners = seen_by(t)
+            before, prev, tgt.prev = tgt.filter.estimate.copy(), tgt.prev, None
+            if state == LimbState.LOST:
+                tgt.filter.reset(self._search_centre(t), self.rng, spread=p.lost_search)
+                obs_c = self._unclaimed(own_c, exclude=t)
+            elif state == LimbState.COMBINED:
+                # the pair's filter sees only candidates no other tracker explains (its own blobs)
+                tgt.filter.predict(self.rng, p.combined_noise_scale)
+                side = self._hand_side(t)
+                if side is not None:  # two hands: each blob's part nearest the pair
+                    own_c = not_heads(nearest_part_candidates(cands, points(), tgt.filter.estimate, side, p))
+                obs_c = self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
+            else:
+                tgt.filter.predict(self.rng)
+                obs_c = self._owned(own_c, t, owners)
+            on_end = False  # the hand is seen as the end of an arm-long blob
+            if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
+                # one end per blob, the one nearest the predicted hand: the other end of its arm
+                # is its elbow, and a posterior split between both ends would put it mid-arm
+                at = tgt.filter.estimate if state == LimbState.LOST else \
+                    before if prev is None else before + p.velocity_decay * (before - prev)
+                ends = np.bincount(own_c.parents, minlength=len(blobs))[obs_c.parents] >= 2
+                keep = nearest_per_parent(obs_c, at)
+                if state != LimbState.LOST:
+                    # an arm's end farther than tip_gate sides is another part of it (an elbow
+                    # when the hand end merged into another blob): not this hand
+                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.tip_gate * max(tgt.size)
+                    keep &= ~(ends & far)
+                obs_c, ends = self._subset(obs_c, keep), ends[keep]
+                if len(obs_c):
+                    on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))])
+            tgt.filter.weigh(obs_c, integral)
+            modes: tuple = ()
+            if state == LimbState.COMBINED:
+                radius = p.mode_search * distance_threshold(p.split_distance, p.split_size, self._side(t))
+                # a kernel as wide as the search: the particles sit on one mode, the other may be far
+                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
+                modes = tuple(map(tuple, m[:2]))
+            if state != LimbState.LOST and on_end:
+                # the refinement of an arm's end is the end itself (mean shift on the skin
+                # would slide the window up the arm)
+                d = np.hypot(*(obs_c.centres - tgt.filter.estimate[None, :]).T)
+                if d.min() <= max(tgt.size):
+                    tgt.filter.shift_to(obs_c.centres[int(np.argmin(d))])
+            elif state != LimbState.LOST:
+                bp = back_projection(skin_bins, tgt.filter.ref_hist)
+                tgt.filter.refine(bp)
+            tgt.filter.resample(self.rng)
+            if state == LimbState.NORMAL:
+                tgt.prev = before
+            if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:
+                tgt.last = tgt.filter.estimate.copy()
+                tgt.anchor = self._head_of(t)
+                if state == LimbState.NORMAL:
+                    tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
+            observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
+                                          labelled=tgt.labelled, modes=modes, size=self._side(t))
+            self._place_pair(t, modes)
+        # followers of a combined pair report the leader's estimate
+        for t in self.machine.trackers():
+            if self.machine.state(t) == LimbState.COMBINED and not self.machine.is_leader(t):
+                lead = observations.get(self.machine.partner(t))
+                if lead is not None:
+                    observations[t] = Observation(position=lead.position, likelihood=lead.likelihood,
+                                                  labelled=self.targets[t].labelled, size=self._side(t))
+        if self.auto_start:
+            self._propose(cands, observations)
+        self._label(index, frame, observations)
+        self._reacquire_heads(frame, skin_bins, observations)
+
+        # 3. high layer --------------------------------------------------------------------
+        for tr in self.machine.update(index, observations):
+            self._apply(tr, index, skin_bins)
+        self._fill_references(skin_bins)
+        return self._records(index)
+
+    def _side(self, t: int) -> float:
+        """Box side of a target (mean of width and height), the unit of the state machine's
+        distances; a combined leader uses the mean of both members."""
+        tgt = self.targets[t]
+        side = (tgt.size[0] + tgt.size[1]) / 2
+        partner = self.machine.partner(t)
+        if self.machine.state(t) == LimbState.COMBINED and partner is not None:
+            other = self.targets[partner]
+            side = (side + (other.size[0] + other.size[1]) / 2) / 2
+        return side
+
+    def _hand_side(self, t: int) -> float | None:
+        """Box side of a hand target (of both, for a combined pair of hands), rounded to a
+        pixel so hands of one size share their candidates; None for heads and unlabelled targets."""
+        hands = ("left_hand", "right_hand")
+        members = [t]
+        partner = self.machine.partner(t)
+        if self.machine.state(t) == LimbState.COMBINED and partner is not None:
+            members.append(partner)
+        if any(self.targets[m].part not in hands for m in members):
+            return None
+        side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
+        return side if self.params.tip_span > 0 and side >= self.params.tip_min_side else None
+
+    def _head_of(self, t: int) -> np.ndarray | None:
+        """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
+        tid = self.targets[t].track_id
+        for h, tgt in self.targets.items():
+            if (h != t and tgt.track_id == tid and tgt.part == "head" and tgt.filter is not None
+                    and self.machine.state(h) in (LimbState.NORMAL, LimbState.UNLABELLED)):
+                return tgt.filter.estimate.copy()
+        return None
+
+    def _search_centre(self, t: int) -> np.ndarray:
+        """Where a lost target is looked for: its last confident position (sec. 5.2), moved
+        with its person's head since then: a walker's hidden hand travels with the body."""
+        tgt = self.targets[t]
+        head = self._head_of(t)
+        if tgt.anchor is None or head is None:
+            return tgt.last
+        return tgt.last + (head - tgt.anchor)
+
+    def _place_pair(self, leader: int, modes: tuple) -> None:
+        """Output positions of a combined pair: while two modes show (not yet far enough apart
+        to split), each member takes the one on its side (direction cue of sec. 7.1); with one
+        mode both sit on the filter's estimate."""
+        tgt = self.targets[leader]
+        tgt.shown = None
+        if self.machine.state(leader) != LimbState.COMBINED:
+            return
+        other = self.targets[self.machine.partner(leader)]
+        if len(modes) >= 2:
+            pos_a, pos_b = assign_by_direction(self.machine.direction_before(leader), np.asarray(modes[:2]))
+            tgt.shown, other.shown = pos_a, pos_b
+        else:
+            tgt.shown = other.shown = tgt.filter.estimate.copy()
+
+    def _min_area(self, starting) -> float:
+        """Smallest blob kept: ``min_blob_area``, or less when the targets are small (a distant
+        walker's hand): a quarter of the smallest target's box area."""
+        sizes = [t.size[0] * t.size[1] for t in self.targets.values() if t.filter is not None]
+        sizes += [float(b[2] * b[3]) for _, _, b in starting]
+        if not sizes:
+            return self.params.min_blob_area
+        return min(self.params.min_blob_area, 0.25 * min(sizes))
+
+    def _support(self, fg: np.ndarray, index: int) -> np.ndarray:
+        """The foreground plus a neighbourhood of every tracked target.
+
+        An adaptive background model absorbs a person who sits still (the desk scene's head
+        after a few seconds, or from the first frame when they are there from the start);
+        a target already under track keeps its region observable, while new trackers still
+        need real foreground to start. The neighbourhood is the target's box scaled by
+        ``support_scale`` around its last estimate.
+        """
+        boxes = [b for _, _, b in self._init.get(index, [])]
+        for t, tgt in self.targets.items():
+            if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
+                continue
+            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else self._search_centre(t)
+            w, h = tgt.size[0] * self.params.support_scale, tgt.size[1] * self.params.support_scale
+            boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
+        if not boxes:
+            return fg
+        out = fg.copy()
+        hgt, wid = fg.shape
+        for x, y, w, h in boxes:
+            x1, y1 = max(int(x), 0), max(int(y), 0)
+            x2, y2 = min(int(np.ceil(x + w)), wid), min(int(np.ceil(y + h)), hgt)
+            if x2 > x1 and y2 > y1:
+                out[y1:y2, x1:x2] = True
+        return out
+
+    # -- starting trackers -----------------------------------------------------------------
+    def _new_tracker(self, target: _Target, state: LimbState) -> int:
+        t = self._next_tracker
+        self._next_tracker += 1
+        self.targets[t] = target
+        self.machine.add(t, state)
+        return t
+
+    def _make_filter(self, tgt: _Target, centre) -> LimbFilter:
+        return LimbFilter(centre, tgt.size, tgt.ref_hist, self.params, self.rng)
+
+    def _reference(self, box, skin_bins: np.ndarray) -> np.ndarray | None:
+        """Hue reference of a box from its skin pixels; None when under a tenth of the box is
+        skin (a hand hidden behind the body at its first frame)."""
+        x, y, w, h = (int(round(v)) for v in box)
+        hgt, wid = skin_bins.shape
+        patch = skin_bins[max(y, 0):min(y + h, hgt), max(x, 0):min(x + w, wid)]
+        if patch.size == 0 or (patch >= 0).sum() < 0.1 * max(w * h, 1):
+            return None
+        return reference_histogram(skin_bins, box, self.params.hue_bins)
+
+    def _fill_references(self, skin_bins: np.ndarray) -> None:
+        """Targets started without a usable reference take their person's face colour (seed 003
+        sec. 3: the hands' reference comes from the face), else the hue of all skin in view."""
+        for t, tgt in self.targets.items():
+            if tgt.filter is None or tgt.ref_hist is not None:
+                continue
+            head = next((h for h in self.targets.values() if h.track_id == tgt.track_id and h.part == "head"
+                         and h.ref_hist is not None), None)
+            if head is not None:
+                ref = head.ref_hist.copy()
+            else:
+                vals = skin_bins[skin_bins >= 0]
+                ref = (np.bincount(vals, minlength=self.params.hue_bins).astype(float) if vals.size
+                       else np.ones(self.params.hue_bins))
+                ref = ref / ref.sum()
+            tgt.ref_hist = ref
+            tgt.filter.ref_hist = ref.copy()
+
+    def _start(self, box, skin_bins: np.ndarray, track_id: int, part: str) -> None:
+        """Start a labelled tracker from an INIT.csv box (state normal)."""
+        box = np.asarray(box, float)
+        tgt = _Target(track_id=track_id, part=part, size=(max(box[2], 2.0), max(box[3], 2.0)),
+                      ref_hist=self._reference(box, skin_bins))
+        centre = box[:2] + box[2:] / 2
+        tgt.filter = self._make_filter(tgt, centre)
+        tgt.last = centre.copy()
+        self._new_tracker(tgt, LimbState.NORMAL)
+
+    def _owners(self, cands: Candidates, active: list[int]) -> tuple[np.ndarray, np.ndarray]:
+        """For each candidate, the nearest tracked target (by last frame's estimate) and whether
+        it lies within that target's reach (half its size plus sigma_xy): ``(K,) int, (K,) bool``."""
+        live = [t for t in active if self.machine.state(t) != LimbState.LOST]
+        if len(cands) == 0 or not live:
+            return np.full(len(cands), -1), np.zeros(len(cands), bool)
+        est = np.array([self.targets[t].filter.estimate for t in live])
+        reach = np.array([max(self.targets[t].size) / 2 + self.params.sigma_xy for t in live])
+        d = np.hypot(cands.centres[:, None, 0] - est[None, :, 0], cands.centres[:, None, 1] - est[None, :, 1])
+        j = d.argmin(axis=1)
+        return np.asarray(live)[j], d[np.arange(len(cands)), j] <= reach[j]
+
+    def _owned(self, cands: Candidates, t: int, owners: tuple[np.ndarray, np.ndarray]) -> Candidates:
+        """The candidates a normal filter is weighted against: all but those another target sits on
+        (exclusion). Without it, a filter whose blob vanishes jumps to a neighbour's blob within a
+        frame and looks confident there, so it would never be declared lost (seed 000 sec. 5.2)."""
+        nearest, within = owners
+        keep = ~within | (nearest == t)
+        return self._subset(cands, keep)
+
+    @staticmethod
+    def _subset(cands: Candidates, keep: np.ndarray) -> Candidates:
+        return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
+                          {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep],
+                          None if cands.parents is None else cands.parents[keep])
+
+    def _unclaimed(self, cands: Candidates, exclude: int | tuple) -> Candidates:
+        """Candidates not explained by another active tracker (a lost target must not
+        recover onto a limb someone else tracks)."""
+        if len(cands) == 0:
+            return cands
+        keep = np.ones(len(cands), bool)
+        exclude = set(exclude) if isinstance(exclude, tuple) else {exclude}
+        for t, tgt in self.targets.items():
+            if t in exclude or tgt.filter is None:
+                continue
+            if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
+                d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
+                keep &= d > max(tgt.size) / 2 + self.params.sigma_xy
+        return self._subset(cands, keep)
+
+    def _propose(self, cands: Candidates, observations: dict[int, Observation]) -> None:
+        """Uninitialized trackers follow candidates no existing tracker explains (sec. 5.2)."""
+        free = self._unclaimed(cands, exclude=-1)
+        pending = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNINITIALIZED]
+        used: set[int] = set()
+        for t in pending:
+            tgt = self.targets[t]
+            if len(free):
+                d = np.hypot(*(free.centres - tgt.candidate[None, :]).T)
+                d[list(used)] = np.inf
+                j = int(np.argmin(d))
+                if d[j] <= 2 * self.params.sigma_xy + self.params.noise_xy:
+                    used.add(j)
+                    tgt.candidate, tgt.candidate_box, tgt.missed = free.centres[j].copy(), free.boxes[j].copy(), 0
+                    observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
+                    continue
+            tgt.missed += 1
+            observations[t] = Observation()
+        for j in range(len(free)):
+            if j not in used:
+                tgt = _Target(candidate=free.centres[j].copy(), candidate_box=free.boxes[j].copy())
+                t = self._new_tracker(tgt, LimbState.UNINITIALIZED)
+                observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
+        for t in pending:  # forget candidates that vanished
+            if self.targets[t].missed > self.params.start_frames:
+                self.machine.remove(t)
+                self.targets.pop(t)
+
+    # -- labelling (unlabelled -> normal) -----------------------------------------------------
+    def _faces(self, frame: np.ndarray) -> np.ndarray:
+        if self.face is None:
+            return np.zeros((0, 4))
+        grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+        found = self.face.detectMultiScale(grey, scaleFactor=1.1, minNeighbors=4, minSize=(12, 12))
+        return np.asarray(found, float).reshape(-1, 4)
+
+    def _label(self, index: int, frame: np.ndarray, observations: dict[int, Observation]) -> None:
+        """Cues for unlabelled trackers that never had a type: a face -> new person's head;
+        beside a head -> that person's hand on that side; alone and topmost for a while -> head."""
+        p = self.params
+        todo = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNLABELLED
+                and not self.targets[t].labelled and self.targets[t].filter is not None]
+        if not todo:
+            return
+        faces = self._faces(frame)
+        for t in sorted(todo, key=lambda t: self.targets[t].filter.estimate[1]):  # topmost first
+            tgt = self.targets[t]
+            tgt.unlabelled_frames += 1
+            cx, cy = tgt.filter.estimate
+            on_face = any(fx <= cx <= fx + fw and fy <= cy <= fy + fh for fx, fy, fw, fh in faces)
+            head = self._nearest_head(tgt.filter.estimate)
+            # a face that is not the nearby head's own is another person's head
+            if on_face and (head is None or np.hypot(*(head[1].filter.estimate - tgt.filter.estimate))
+                            > max(head[1].size)):
+                self._assign(t, self._next_person, "head")
+                self._next_person += 1
+            elif head is not None:
+                hid, htgt = head
+                right_side = cx < htgt.filter.estimate[0]  # image left of the head
+                side = ("right_hand" if right_side else "left_hand") if p.facing_camera else \
+                    ("left_hand" if right_side else "right_hand")
+                taken = self._parts_of(htgt.track_id)
+                other = "left_hand" if side == "right_hand" else "right_hand"
+                if side not in taken:
+                    self._assign(t, htgt.track_id, side)
+                elif other not in taken:
+                    self._assign(t, htgt.track_id, other)
+            elif tgt.unlabelled_frames >= p.head_guess_frames:
+                self._assign(t, self._next_person, "head")
+                self._next_person += 1
+            if tgt.labelled and t in observations:
+                o = observations[t]
+                observations[t] = Observation(o.position, o.likelihood, o.prior, True, o.modes, o.size)
+
+    def _assign(self, t: int, track_id: int, part: str) -> None:
+        tgt = self.targets[t]
+        tgt.track_id, tgt.part = track_id, part
+
+    def _parts_of(self, track_id: int) -> set[str]:
+        return {tgt.part for tgt in self.targets.values() if tgt.track_id == track_id and tgt.part}
+
+    def _nearest_head(self, point) -> tuple[int, _Target] | None:
+        best, best_d = None, math.inf
+        for t, tgt in self.targets.items():
+            if tgt.part != "head" or tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
+                continue
+            d = float(np.hypot(*(np.asarray(point) - tgt.filter.estimate)))
+            if d <= self.params.person_radius * tgt.size[1] and d < best_d:
+                best, best_d = (t, tgt), d
+        return best
+
+    # -- head re-acquisition (seed 003 sec. 3) -------------------------------------------------
+    def _reacquire_heads(self, frame: np.ndarray, skin_bins: np.ndarray, observations) -> None:
+        p = self.params
+        if self.face is None:
+            return
+        faces = None
+        for t, tgt in self.targets.items():
+            if tgt.part != "head" or tgt.filter is None or t not in observations:
+                continue
+            if self.machine.state(t) == LimbState.COMBINED:
+                continue
+            tgt.low_frames = tgt.low_frames + 1 if tgt.filter.confidence < p.reacquire_confidence else 0
+            if tgt.low_frames < p.reacquire_frames:
+                continue
+            if faces is None:
+                faces = self._faces(frame)
+            if len(faces) == 0:
+                continue
+            centres = faces[:, :2] + faces[:, 2:] / 2
+            last = tgt.last if tgt.last is not None else tgt.filter.estimate
+            d = np.hypot(*(centres - last[None, :]).T)
+            j = int(np.argmin(d))
+            if d[j] > p.person_radius * tgt.size[1]:
+                continue
+            tgt.filter.reset(centres[j], self.rng)
+            ref = reference_histogram(skin_bins, faces[j], p.hue_bins)
+            if ref is not None:  # replace the colour reference with the face's (sec. 3)
+                tgt.filter.ref_hist = ref
+            tgt.last, tgt.low_frames = centres[j].copy(), 0
+            o = observations[t]
+            observations[t] = Observation(tuple(centres[j]), max(o.likelihood, p.recover_likelihood),
+                                          o.prior, o.labelled, o.modes, o.size)
+
+    # -- acting on transitions -----------------------------------------------------------------
+    def _apply(self, tr, index: int, skin_bins: np.ndarray) -> None:
+        tgt = self.targets[tr.tracker]
+        if tr.old == LimbState.UNINITIALIZED and tr.new == LimbState.UNLABELLED:
+            box = tgt.candidate_box
+            side = float(max(box[2], box[3], 4.0))
+            tgt.size = (side, side)
+            tgt.ref_hist = self._reference(box, skin_bins)
+            tgt.filter = self._make_filter(tgt, tgt.candidate)
+            tgt.last = tgt.candidate.copy()
+        elif tr.new == LimbState.COMBINED and not self.machine.is_leader(tr.tracker):
+            tgt.filter = None  # the leader's filter tracks both
+        elif tr.reason == "split":
+            if tgt.filter is None:
+                tgt.filter = self._make_filter(tgt, tr.position)
+            tgt.filter.reset(tr.position, self.rng)
+            tgt.last = np.asarray(tr.position, float)
+        elif tr.new == LimbState.LOST:
+            if tgt.filter is None:  # a follower of a lost pair
+                tgt.filter = self._make_filter(tgt, tgt.last)
+            if tgt.last is None:
+                tgt.last = tgt.filter.estimate.copy()
+
+    def _records(self, index: int) -> list[TrackRecord]:
+        out = []
+        for t, tgt in self.targets.items():
+            state = self.machine.state(t)
+            if state == LimbState.UNINITIALIZED or not tgt.labelled:
+                continue
+            if state == LimbState.COMBINED:
+                lead = tgt.filter or self.targets[self.machine.partner(t)].filter
+                centre = tgt.shown if tgt.shown is not None else lead.estimate
+                conf = lead.confidence
+            elif state == LimbState.LOST:
+                centre = self._search_centre(t) if tgt.last is not None else tgt.filter.estimate
+                conf = tgt.filter.confidence
+            else:
+                centre, conf = tgt.filter.estimate, tgt.filter.confidence
+            w, h = tgt.size
+            box = Box(float(centre[0] - w / 2), float(centre[1] - h / 2), float(w), float(h))
+            out.append(TrackRecord(index, int(tgt.track_id), str(tgt.part), box, score=float(conf),
+                                   failure=state == LimbState.LOST, state=state.value, source="limbs"))
+        return out

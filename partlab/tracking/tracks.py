@@ -1,0 +1,224 @@
+"""The tracks CSV: what ``partlab track`` writes and ``train``/``eval``/``export`` read.
+
+Header row, then ``frame,track_id,part,x,y,w,h`` first and in that order, then any of
+the optional columns ``score, failure, occluded, state, source``. ``frame`` is the
+0-based decode index, ``x, y`` the top-left corner, ``w, h`` the size in pixels.
+Readers ignore columns they do not know. In memory a tracks table is a pandas
+DataFrame with exactly these columns (optional ones filled with their defaults).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+
+import pandas as pd
+
+from partlab.tracking.core.box import Box
+from partlab.tracking.parts import PART_NAMES
+
+REQUIRED_COLUMNS: tuple[str, ...] = ("frame", "track_id", "part", "x", "y", "w", "h")
+OPTIONAL_COLUMNS: tuple[str, ...] = ("score", "failure", "occluded", "state", "source")
+COLUMNS: tuple[str, ...] = REQUIRED_COLUMNS + OPTIONAL_COLUMNS
+
+#: Value an optional column takes when a file does not have it.
+DEFAULTS: dict[str, object] = {
+    "score": float("nan"),
+    "failure": False,
+    "occluded": 0.0,
+    "state": "",
+    "source": "tracker",
+}
+
+
+class TracksCSVError(ValueError):
+    """A tracks CSV that cannot be read; the message names the file, line and column."""
+
+
+@dataclass(frozen=True, slots=True)
+class TrackRecord:
+    """One box of one part of one track at one frame (a row of the tracks CSV)."""
+
+    frame: int
+    track_id: int
+    part: str
+    box: Box
+    score: float = float("nan")
+    failure: bool = False
+    occluded: float = 0.0
+    state: str = ""
+    source: str = "tracker"
+
+    def as_row(self) -> dict[str, object]:
+        return {
+            "frame": self.frame,
+            "track_id": self.track_id,
+            "part": self.part,
+            "x": self.box.x,
+            "y": self.box.y,
+            "w": self.box.w,
+            "h": self.box.h,
+            "score": self.score,
+            "failure": self.failure,
+            "occluded": self.occluded,
+            "state": self.state,
+            "source": self.source,
+        }
+
+
+def empty_tracks() -> pd.DataFrame:
+    """A tracks table with no rows and the canonical columns and dtypes."""
+    return normalise_tracks(pd.DataFrame({c: [] for c in REQUIRED_COLUMNS}))
+
+
+def records_to_frame(records) -> pd.DataFrame:
+    """Tracks table from an iterable of :class:`TrackRecord`."""
+    rows = [r.as_row() for r in records]
+    if not rows:
+        return empty_tracks()
+    return normalise_tracks(pd.DataFrame(rows))
+
+
+def frame_to_records(df: pd.DataFrame) -> list[TrackRecord]:
+    """The rows of a tracks table as :class:`TrackRecord` objects."""
+    df = normalise_tracks(df)
+    return [
+        TrackRecord(
+            int(r.frame), int(r.track_id), str(r.part), Box(float(r.x), float(r.y), float(r.w), float(r.h)),
+            float(r.score), bool(r.failure), float(r.occluded), str(r.state), str(r.source),
+        )
+        for r in df.itertuples(index=False)
+    ]
+
+
+def _parse_bool(text: str) -> bool | None:
+    t = text.strip().lower()
+    if t in ("1", "true", "yes", "y", "t"):
+        return True
+    if t in ("0", "false", "no", "n", "f", ""):
+        return False
+    return None
+
+
+def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
+    """Read and validate a tracks CSV.
+
+    Every malformed cell is reported as ``FILE line L, column 'C': problem`` (lines
+    counted from 1, the header being line 1), so a user can open the file there.
+    """
+    if isinstance(source, (str, PathLike)):
+        path = Path(source)
+        label = name or str(path)
+        try:
+            text = path.read_text(encoding="utf-8-sig")
+        except FileNotFoundError:
+            raise TracksCSVError(f"{label}: no such file") from None
+        except UnicodeDecodeError:
+            raise TracksCSVError(f"{label}: not a text CSV file (not UTF-8)") from None
+    else:
+        label = name or "tracks CSV"
+        text = source.read()
+    reader = csv.reader(io.StringIO(text))
+    try:
+        header = next(reader)
+    except StopIteration:
+        raise TracksCSVError(f"{label}: the file is empty; expected a header row "
+                             f"starting with {','.join(REQUIRED_COLUMNS)}") from None
+    header = [h.strip() for h in header]
+    if tuple(header[: len(REQUIRED_COLUMNS)]) != REQUIRED_COLUMNS:
+        missing = [c for c in REQUIRED_COLUMNS if c not in header]
+        if missing:
+            raise TracksCSVError(f"{label} line 1: missing column(s) {', '.join(repr(m) for m in missing)}; "
+                                 f"the header must start with {','.join(REQUIRED_COLUMNS)}")
+        raise TracksCSVError(f"{label} line 1: the header must start with {','.join(REQUIRED_COLUMNS)} "
+                             f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
+    index = {c: i for i, c in enumerate(header) if c in COLUMNS}
+    cols: dict[str, list] = {c: [] for c in index}
+    for lineno, row in enumerate(reader, start=2):
+        if not row or all(not cell.strip() for cell in row):
+            continue
+        if len(row) < len(REQUIRED_COLUMNS):
+            raise TracksCSVError(f"{label} line {lineno}: {len(row)} cells, expected at least "
+                                 f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
+        for col, i in index.items():
+            cell = row[i].strip() if i < len(row) else ""
+            where = f"{label} line {lineno}, column '{col}'"
+            if col in ("frame", "track_id"):
+                try:
+                    value = int(cell)
+                except ValueError:
+                    try:
+                        f = float(cell)
+                    except ValueError:
+                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+                    if not f.is_integer():
+                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+                    value = int(f)
+                if value < 0:
+                    raise TracksCSVError(f"{where}: {value} is negative")
+            elif col == "part":
+                if cell not in PART_NAMES:
+                    raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
+                value = cell
+            elif col in ("x", "y", "w", "h", "score", "occluded"):
+                if cell == "" and col in ("score", "occluded"):
+                    value = DEFAULTS[col]
+                else:
+                    try:
+                        value = float(cell)
+                    except ValueError:
+                        raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
+                    if col in ("x", "y", "w", "h") and not math.isfinite(value):
+                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+                    if col in ("w", "h") and value < 0:
+                        raise TracksCSVError(f"{where}: negative size {value:g}")
+            elif col == "failure":
+                value = _parse_bool(cell)
+                if value is None:
+                    raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
+            else:  # state, source
+                value = cell if cell else DEFAULTS[col]
+            cols[col].append(value)
+    return normalise_tracks(pd.DataFrame(cols))
+
+
+def normalise_tracks(df: pd.DataFrame) -> pd.DataFrame:
+    """Canonical column order, dtypes and defaults; extra columns are dropped."""
+    missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
+    if missing:
+        raise TracksCSVError(f"tracks table lacks column(s) {', '.join(missing)}")
+    out = pd.DataFrame(index=df.index)
+    out["frame"] = df["frame"].astype("int64")
+    out["track_id"] = df["track_id"].astype("int64")
+    out["part"] = df["part"].astype(str)
+    for c in ("x", "y", "w", "h"):
+        out[c] = df[c].astype("float64")
+    for c in OPTIONAL_COLUMNS:
+        if c in df.columns:
+            out[c] = df[c]
+        else:
+            out[c] = DEFAULTS[c]
+    out["score"] = out["score"].astype("float64")
+    out["failure"] = out["failure"].fillna(False).astype(bool)
+    out["occluded"] = out["occluded"].fillna(0.0).astype("float64")
+    out["state"] = out["state"].fillna("").astype(str)
+    out["source"] = out["source"].fillna("tracker").astype(str)
+    return out.reset_index(drop=True)
+
+
+def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> None:
+    """Write a tracks table, sorted by frame, track and part, with every column."""
+    df = normalise_tracks(df)
+    order = {p: i for i, p in enumerate(PART_NAMES)}
+    df = df.assign(_p=df["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
+    df = df.drop(columns="_p")
+    df = df.assign(failure=df["failure"].astype(int))
+    if isinstance(dest, (str, PathLike)):
+        Path(dest).parent.mkdir(parents=True, exist_ok=True)
+        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
+    else:
+        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
