@@ -12,6 +12,8 @@ import argparse
 import importlib
 import sys
 
+from partlab.errors import UserError
+
 #: sub-command -> one-line help (the order is the order of ``partlab --help``).
 COMMANDS: dict[str, str] = {
     "track": "track people's parts in a video and write a tracks CSV",
@@ -24,7 +26,7 @@ COMMANDS: dict[str, str] = {
 }
 
 
-class CommandError(Exception):
+class CommandError(UserError):
     """A user-facing failure: printed as ``partlab CMD: message`` with exit code 2."""
 
 
@@ -55,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(_module(args.command).run(args) or 0)
-    except CommandError as exc:
+    except UserError as exc:
         print(f"partlab {args.command}: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

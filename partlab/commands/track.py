@@ -1,4 +1,4 @@
-"""``partlab track VIDEO -o TRACKS.csv``: run the trackers over a clip, write a tracks CSV."""
+"""``partlab track VIDEO|TAKE_DIR -o TRACKS.csv``: run a tracker over a clip or take, write a tracks CSV."""
 
 from __future__ import annotations
 
@@ -10,10 +10,13 @@ from partlab.cli import CommandError
 
 
 def add_arguments(p) -> None:
-    p.add_argument("video", metavar="VIDEO", help="input clip (any format OpenCV decodes)")
+    from partlab.tracking import registry
+
+    p.add_argument("video", metavar="VIDEO|TAKE_DIR",
+                   help="input clip (any format OpenCV decodes) or a take folder (docs/formats.md)")
     p.add_argument("-o", "--output", metavar="TRACKS.csv", required=True, help="tracks CSV to write")
-    p.add_argument("--tracker", choices=["body", "limbs", "all", "whole"], default="body",
-                   help="body: head/torso/hip-leg; limbs: head and hands; all: both; whole: one box per person")
+    p.add_argument("--tracker", choices=registry.names(), default="body",
+                   help="; ".join(f"{e.name}: {e.summary}" for e in registry.TRACKERS.values()))
     p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
     p.add_argument("--model", metavar="BUNDLE_DIR",
                    help="model bundle from partlab train, or 'default' for the one shipped with partlab "
@@ -21,7 +24,7 @@ def add_arguments(p) -> None:
                         "failure detection")
     p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
     p.add_argument("--events", metavar="EVENTS.csv",
-                   help="limbs/all: write the limbs' join and separation events (claps, handshakes, ...)")
+                   help="write the events the tracker recognises (limbs/all: joins and separations)")
     p.add_argument("--occluders", metavar="FILE",
                    help="CSV with columns x,y,w,h: fixed regions (pillars, doors) that can hide people")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
@@ -70,7 +73,7 @@ def load_model(path: str | Path):
 def run(args) -> int:
     from tqdm import tqdm
 
-    from partlab.app.pipeline import track_video
+    from partlab.app.pipeline import track_path
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv, write_tracks_csv
 
     init = None
@@ -83,7 +86,6 @@ def run(args) -> int:
             raise CommandError(f"{args.init}: no boxes to start from")
     occluders = read_occluders(args.occluders) if args.occluders else ()
     model = load_model(args.model) if args.model else None
-    events: list = []
     bar = None
 
     def progress(done: int, total: int) -> None:
@@ -93,11 +95,12 @@ def run(args) -> int:
         bar.update(done - bar.n)
 
     try:
-        tracks = track_video(args.video, tracker=args.tracker, init=init, model=model, occluders=occluders,
-                             seed=args.seed, progress=progress if args.progress else None, events_out=events)
+        result = track_path(args.video, args.tracker, init=init, model=model, occluders=occluders,
+                            seed=args.seed, progress=progress if args.progress else None)
     finally:
         if bar is not None:
             bar.close()
+    tracks = result.tracks
     try:
         write_tracks_csv(tracks, args.output)
     except OSError as exc:
@@ -105,10 +108,11 @@ def run(args) -> int:
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
     if args.events:
-        if args.tracker not in ("limbs", "all"):
-            raise CommandError("--events needs --tracker limbs or all (events are the limbs' joins)")
+        if result.events is None:
+            raise CommandError(f"--events: tracker {args.tracker!r} recognises no events "
+                               "(limbs and all write the limbs' joins)")
         from partlab.tracking.limbs.tracker import write_events
 
-        write_events(events[0], args.events)
-        print(f"wrote {len(events[0])} event(s) to {args.events}")
+        write_events(result.events, args.events)
+        print(f"wrote {len(result.events)} event(s) to {args.events}")
     return 0

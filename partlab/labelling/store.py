@@ -33,7 +33,7 @@ from partlab.labelling.config import data_dir, database_url
 from partlab.labelling.video import VideoError, probe, store_by_hash
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import check_part
-from partlab.tracking.tracks import COLUMNS, normalise_tracks
+from partlab.tracking.tracks import COLUMNS, TAKE_COLUMNS, normalise_tracks
 
 
 class StoreError(ValueError):
@@ -357,7 +357,7 @@ class Store:
                        for r in s.scalars(tq)]
             edits = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, float("nan"), r.failure, r.occluded, "",
                       "human", r.revision, r.deleted) for r in s.scalars(eq)]
-        cols = list(COLUMNS) + ["revision"]
+        cols = [c for c in COLUMNS if c not in TAKE_COLUMNS] + ["revision"]
         tdf = pd.DataFrame(tracker, columns=cols)
         edf = pd.DataFrame(edits, columns=cols + ["deleted"])
         if len(edf):

@@ -19,10 +19,12 @@ from typing import Iterator
 import cv2
 import numpy as np
 
+from partlab.errors import UserError
+
 VIDEO_EXTENSIONS: tuple[str, ...] = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm", ".mpg", ".mpeg")
 
 
-class VideoError(ValueError):
+class VideoError(UserError):
     """A file that cannot be used as a clip; the message says why."""
 
 

@@ -40,7 +40,7 @@ import numpy as np
 
 from partlab.models.features import BODY_PARTS, DEFAULT_DT, N_FEATURES, dt_frames, features_from_history
 from partlab.models.labels import SVM_NAMES, svm_targets
-from partlab.tracking.frame_tracker import FailureVerdict
+from partlab.tracking.protocol import FailureVerdict
 
 KERNELS: tuple[str, ...] = ("linear", "rbf")
 #: Share of correctly tracked parts that must pass, whatever the TNR target asks: every
@@ -244,7 +244,7 @@ def train_failure_svms(x: np.ndarray, labels: np.ndarray, seed: int = 0, tnr_tar
 
 
 class SVMFailureDetector:
-    """Seed 002 sec. 4.2 failure detection, implementing :class:`partlab.tracking.frame_tracker.FailureDetector`.
+    """Seed 002 sec. 4.2 failure detection, implementing :class:`partlab.tracking.protocol.FailureDetector`.
 
     A part is failed when its SVM's score (decision minus threshold) is negative. When
     any part failed, the ``multi`` SVM decides the failure type, as the paper asks

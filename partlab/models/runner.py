@@ -3,7 +3,8 @@
 Training (seed 002 sec. 4.2) runs the plain tracker (no failure detector) on each
 corrected clip from the truth's first boxes and labels what it produced; the
 benchmarks run it with and without a detector. One background model per run, as
-``partlab.app.pipeline.track_video`` does.
+the run loop (:func:`partlab.tracking.run.track`) does; the seed
+goes straight to the body tracker (training's results predate the registry's seed streams).
 """
 
 from __future__ import annotations
@@ -13,10 +14,12 @@ from typing import Callable, Iterator
 import numpy as np
 import pandas as pd
 
-from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.body.tracker import BodyTracker
+from partlab.tracking.core.background import BackgroundModel
+from partlab.tracking.frame import FrameSet
 from partlab.tracking.params import BodyParams
-from partlab.tracking.tracks import empty_tracks, records_to_frame
+from partlab.tracking.protocol import SingleView
+from partlab.tracking.run import run_frames
 
 
 def run_body_tracker(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], fps: float, init: pd.DataFrame,
@@ -26,11 +29,8 @@ def run_body_tracker(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], fps
     params = params or BodyParams()
     tracker = BodyTracker(params, np.random.default_rng(seed), init=init, occluders=occluders,
                           failure_detector=failure_detector, fps=fps)
-    background = BackgroundModel(params)
-    records = []
-    for index, frame in frames():
-        records.extend(tracker.step(index, frame, background.apply(frame)))
-    return records_to_frame(records) if records else empty_tracks()
+    sets = (FrameSet.single(index, frame) for index, frame in frames())
+    return run_frames(SingleView(tracker, params), sets, lambda stream: BackgroundModel(params))
 
 
 def body_tracker_runner(frames, fps: float, init: pd.DataFrame, seed: int, params: BodyParams | None = None,

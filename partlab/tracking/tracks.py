@@ -1,10 +1,13 @@
 """The tracks CSV: what ``partlab track`` writes and ``train``/``eval``/``export`` read.
 
 Header row, then ``frame,track_id,part,x,y,w,h`` first and in that order, then any of
-the optional columns ``score, failure, occluded, state, source``. ``frame`` is the
-0-based decode index, ``x, y`` the top-left corner, ``w, h`` the size in pixels.
-Readers ignore columns they do not know. In memory a tracks table is a pandas
-DataFrame with exactly these columns (optional ones filled with their defaults).
+the optional columns ``score, failure, occluded, state, source`` and, for takes,
+``camera, X, Y, Z``. ``frame`` is the 0-based decode index, ``x, y`` the top-left corner,
+``w, h`` the size in pixels; ``camera`` names the take's stream the box is in (empty for a
+one-stream take) and ``X, Y, Z`` are the part's 3D position in millimetres in the take's world
+frame (empty when unknown). Readers ignore columns they do not know. In memory a tracks table is
+a pandas DataFrame with exactly these columns (optional ones filled with their defaults); the
+writer leaves out ``camera`` and ``X, Y, Z`` when no row has them, so 2D files stay as they were.
 """
 
 from __future__ import annotations
@@ -22,7 +25,9 @@ from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 
 REQUIRED_COLUMNS: tuple[str, ...] = ("frame", "track_id", "part", "x", "y", "w", "h")
-OPTIONAL_COLUMNS: tuple[str, ...] = ("score", "failure", "occluded", "state", "source")
+OPTIONAL_COLUMNS: tuple[str, ...] = ("score", "failure", "occluded", "state", "source", "camera", "X", "Y", "Z")
+#: the optional columns of takes, written only when some row has them
+TAKE_COLUMNS: tuple[str, ...] = ("camera", "X", "Y", "Z")
 COLUMNS: tuple[str, ...] = REQUIRED_COLUMNS + OPTIONAL_COLUMNS
 
 #: Value an optional column takes when a file does not have it.
@@ -32,6 +37,10 @@ DEFAULTS: dict[str, object] = {
     "occluded": 0.0,
     "state": "",
     "source": "tracker",
+    "camera": "",
+    "X": float("nan"),
+    "Y": float("nan"),
+    "Z": float("nan"),
 }
 
 
@@ -52,6 +61,10 @@ class TrackRecord:
     occluded: float = 0.0
     state: str = ""
     source: str = "tracker"
+    camera: str = ""
+    X: float = float("nan")
+    Y: float = float("nan")
+    Z: float = float("nan")
 
     def as_row(self) -> dict[str, object]:
         return {
@@ -67,6 +80,10 @@ class TrackRecord:
             "occluded": self.occluded,
             "state": self.state,
             "source": self.source,
+            "camera": self.camera,
+            "X": self.X,
+            "Y": self.Y,
+            "Z": self.Z,
         }
 
 
@@ -90,6 +107,7 @@ def frame_to_records(df: pd.DataFrame) -> list[TrackRecord]:
         TrackRecord(
             int(r.frame), int(r.track_id), str(r.part), Box(float(r.x), float(r.y), float(r.w), float(r.h)),
             float(r.score), bool(r.failure), float(r.occluded), str(r.state), str(r.source),
+            str(r.camera), float(r.X), float(r.Y), float(r.Z),
         )
         for r in df.itertuples(index=False)
     ]
@@ -164,15 +182,15 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                 if cell not in PART_NAMES:
                     raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
                 value = cell
-            elif col in ("x", "y", "w", "h", "score", "occluded"):
-                if cell == "" and col in ("score", "occluded"):
+            elif col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
+                if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
                     value = DEFAULTS[col]
                 else:
                     try:
                         value = float(cell)
                     except ValueError:
                         raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
-                    if col in ("x", "y", "w", "h") and not math.isfinite(value):
+                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and not math.isfinite(value):
                         raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
                     if col in ("w", "h") and value < 0:
                         raise TracksCSVError(f"{where}: negative size {value:g}")
@@ -180,7 +198,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                 value = _parse_bool(cell)
                 if value is None:
                     raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
-            else:  # state, source
+            else:  # state, source, camera
                 value = cell if cell else DEFAULTS[col]
             cols[col].append(value)
     return normalise_tracks(pd.DataFrame(cols))
@@ -207,7 +225,15 @@ def normalise_tracks(df: pd.DataFrame) -> pd.DataFrame:
     out["occluded"] = out["occluded"].fillna(0.0).astype("float64")
     out["state"] = out["state"].fillna("").astype(str)
     out["source"] = out["source"].fillna("tracker").astype(str)
+    out["camera"] = out["camera"].fillna("").astype(str)
+    for c in ("X", "Y", "Z"):
+        out[c] = pd.to_numeric(out[c], errors="coerce").astype("float64")
     return out.reset_index(drop=True)
+
+
+def has_take_columns(df: pd.DataFrame) -> bool:
+    """Whether some row names a camera or a 3D position."""
+    return bool(len(df)) and bool((df["camera"] != "").any() or df[["X", "Y", "Z"]].notna().any(axis=None))
 
 
 def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> None:
@@ -217,6 +243,8 @@ def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> 
     df = df.assign(_p=df["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
     df = df.drop(columns="_p")
     df = df.assign(failure=df["failure"].astype(int))
+    if not has_take_columns(df):
+        df = df.drop(columns=list(TAKE_COLUMNS))
     if isinstance(dest, (str, PathLike)):
         Path(dest).parent.mkdir(parents=True, exist_ok=True)
         df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")

@@ -8,7 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from partlab.cli import CommandError, main
+from partlab.cli import main
+from partlab.errors import UserError
 from partlab.app.pipeline import track_video
 from partlab.labelling.video import write_video
 from tests.tracking.walkers import background, correct, draw_walker
@@ -64,7 +65,7 @@ def test_pipeline_same_seed_same_output_and_start_stop(clip):
 
 
 @pytest.mark.parametrize("argv_extra, message", [
-    (["--events", "ev.csv"], "--events needs --tracker limbs or all"),
+    (["--events", "ev.csv"], "recognises no events"),
     (["--model", "nowhere"], "model bundle"),
     (["--occluders", "missing.csv"], "no such occluders file"),
 ])
@@ -88,7 +89,7 @@ def test_bad_inputs_are_reported(clip, tmp_path, capsys):
     occ.write_text("x,y,w\n1,2,3\n")
     assert main(["track", str(path), "-o", str(tmp_path / "x.csv"), "--occluders", str(occ)]) == 2
     assert "missing column(s) h" in capsys.readouterr().err
-    with pytest.raises(CommandError, match="outside the clip"):
+    with pytest.raises(UserError, match="outside the clip"):
         track_video(path, start=500)
 
 

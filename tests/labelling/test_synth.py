@@ -7,7 +7,7 @@ import pytest
 from partlab.cli import main
 from partlab.labelling.synth import SCENARIOS, make_scene, render_scenario
 from partlab.labelling.synth.figure import colour_table, FACE, HAIR, SHOES, TROUSERS, TROUSERS_FAR
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 from partlab.tracking.tracks import read_tracks_csv
 
 
@@ -80,7 +80,7 @@ def test_part_boxes_nest_in_the_person_and_stack_head_torso_hipleg(clean_single)
 
 def test_lone_walker_is_never_occluded(clean_single):
     assert clean_single.truth["occluded"].max() == 0.0
-    assert set(clean_single.truth["part"]) == set(PART_NAMES)
+    assert set(clean_single.truth["part"]) == set(BOX_PARTS)
 
 
 def test_hidden_walker_at_the_middle_of_the_crossing():
@@ -134,7 +134,7 @@ def test_every_scenario_renders_valid_truth(name, tmp_path):
     assert sorted(truth.track_id.unique()) == list(range(1, n_tracks + 1))
     assert (truth.source == "truth").all() and truth.occluded.between(0, 1).all()
     assert sorted(truth.frame.unique()) == list(range(12))
-    expected_parts = set(PART_NAMES) - ({"hipleg"} if name == "desk" else set())
+    expected_parts = set(BOX_PARTS) - ({"hipleg"} if name == "desk" else set())
     for tid, rows in truth.groupby("track_id"):
         assert set(rows.part) == expected_parts
         assert set(init[init.track_id == tid].part) == expected_parts

@@ -10,7 +10,7 @@ from tests.tracking.walkers import correct
 from partlab.tracking.body.adjustment import head_from_torso, hipleg_from_torso, torso_from_head_and_hipleg
 from partlab.tracking.body.tracker import BodyTracker
 from partlab.tracking.core.box import Box
-from partlab.tracking.frame_tracker import FailureVerdict
+from partlab.tracking.protocol import FailureVerdict
 from partlab.tracking.params import BodyParams
 
 

@@ -4,7 +4,7 @@ import pandas as pd
 import pytest
 
 from partlab.tracking.core.box import Box
-from partlab.tracking.tracks import (COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
+from partlab.tracking.tracks import (COLUMNS, TAKE_COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
                              records_to_frame, write_tracks_csv)
 
 HEADER = "frame,track_id,part,x,y,w,h"
@@ -21,9 +21,25 @@ def test_round_trip(tmp_path):
     path = tmp_path / "tracks.csv"
     write_tracks_csv(records_to_frame(recs), path)
     first = path.read_text().splitlines()[0]
-    assert first == ",".join(COLUMNS)
+    assert first == ",".join(c for c in COLUMNS if c not in TAKE_COLUMNS)  # 2D files stay as they were
     back = frame_to_records(read_tracks_csv(path))
-    assert back[0].frame == 0 and back[1] == recs[0]
+    assert back[0].frame == 0
+    assert pd.Series(back[1].as_row()).equals(pd.Series(recs[0].as_row()))  # NaN X,Y,Z equal NaN
+
+
+def test_camera_and_3d_columns_round_trip(tmp_path):
+    recs = [TrackRecord(5, 1, "left_hand", Box(10, 20, 8, 9), camera="cam1", X=-120.5, Y=300.25, Z=1510.0),
+            TrackRecord(5, 1, "left_shoulder", Box(40, 20, 4, 4), camera="cam1", X=-200, Y=250, Z=1400),
+            TrackRecord(5, 1, "head", Box(1, 2, 3, 4), camera="cam2")]
+    path = tmp_path / "tracks3d.csv"
+    write_tracks_csv(records_to_frame(recs), path)
+    assert path.read_text().splitlines()[0].endswith(",camera,X,Y,Z")
+    back = read_tracks_csv(path)
+    hand = back[back.part == "left_hand"].iloc[0]
+    assert (hand.camera, hand.X, hand.Y, hand.Z) == ("cam1", -120.5, 300.25, 1510.0)
+    assert back[back.part == "head"].iloc[0][["X", "Y", "Z"]].isna().all()
+    with pytest.raises(TracksCSVError, match="column 'Z'"):
+        _read(HEADER + ",camera,X,Y,Z\n0,1,head,1,2,3,4,cam0,1,2,inf\n")
 
 
 def test_optional_columns_and_unknown_columns():

@@ -32,7 +32,8 @@ from partlab.tracking.parts import PART_NAMES
 NAME = "cvat"
 FILE_NAME = "annotations.xml"
 COLOURS = {"person": "#33ddff", "head": "#fa3253", "torso": "#34d1b7", "hipleg": "#ff6037",
-           "left_hand": "#ddff33", "right_hand": "#b83df5"}
+           "left_hand": "#ddff33", "right_hand": "#b83df5", "left_shoulder": "#3d3df5",
+           "right_shoulder": "#f59331", "left_elbow": "#2a7dd1", "right_elbow": "#d12a7d"}
 #: per-frame attributes: name -> (CVAT input type, default value, values line)
 ATTRIBUTES: dict[str, tuple[str, str, str]] = {
     "failure": ("checkbox", "false", "false\ntrue"),

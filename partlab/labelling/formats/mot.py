@@ -7,7 +7,7 @@ which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider 
 it), and ``visibility = 1 - occluded``.
 MOT ids must be unique per object, and each of our people has several parts, so the id
 of (track_id, part) is ``10 * track_id + part_index + 1`` (part_index in
-:data:`partlab.tracking.parts.PART_NAMES`); the importer inverts this for our own exports
+:data:`partlab.tracking.parts.BOX_PARTS`); the importer inverts this for our own exports
 (recognised by ``partlab.json``). Foreign files keep their ids as track ids; rows with
 ``conf == 0`` in a ``gt.txt`` are ignored boxes in MOTChallenge and are skipped, and
 10-column MOT15 files (no class) are read as ``pedestrian``. Datumaro copies MOT
@@ -28,11 +28,11 @@ from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_
                                     thinned_tracks)
 from partlab.labelling.formats.frames import all_frames, write_frames
 from partlab.labelling.video import VideoInfo
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 
 NAME = "mot"
-ID_STRIDE = 10  # > len(PART_NAMES): ids of one person's parts share all digits but the last
-ID_RULE = f"MOT id = {ID_STRIDE} * track_id + part_index + 1, part_index in {list(PART_NAMES)}"
+ID_STRIDE = 10  # > len(BOX_PARTS): ids of one person's parts share all digits but the last
+ID_RULE = f"MOT id = {ID_STRIDE} * track_id + part_index + 1, part_index in {list(BOX_PARTS)}"
 
 
 def mot_id(track_id: np.ndarray, part_index: np.ndarray) -> np.ndarray:
@@ -47,14 +47,15 @@ def _num(v: float) -> str:
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
     df, keep = thinned_tracks(df, info, video_path, every, out_dir)
+    df = df[df["part"].isin(BOX_PARTS)]  # MOT holds boxes; 3D joints (shoulders, elbows) are not boxes
     (out_dir / "gt").mkdir(exist_ok=True)
-    part_index = df["part"].map({p: i for i, p in enumerate(PART_NAMES)}).to_numpy()
+    part_index = df["part"].map({p: i for i, p in enumerate(BOX_PARTS)}).to_numpy()
     ids = mot_id(df["track_id"].to_numpy(), part_index)
     vis = np.clip(1.0 - df["occluded"].to_numpy(dtype=float), 0.0, 1.0)
     with open(out_dir / "gt" / "gt.txt", "w", encoding="utf-8") as f:
         for r, i, c, v in zip(df.itertuples(index=False), ids, part_index, vis):
             f.write(f"{r.frame + 1},{i},{_num(r.x + 1)},{_num(r.y + 1)},{_num(r.w)},{_num(r.h)},1,{c + 1},{_num(v)}\n")
-    (out_dir / "gt" / "labels.txt").write_text("".join(f"{p}\n" for p in PART_NAMES), encoding="utf-8")
+    (out_dir / "gt" / "labels.txt").write_text("".join(f"{p}\n" for p in BOX_PARTS), encoding="utf-8")
     seq = configparser.ConfigParser()
     seq.optionxform = str  # MOT keys are camelCase
     seq["Sequence"] = {

@@ -1,7 +1,7 @@
 """YOLO (Ultralytics layout) for detector training: ``data.yaml``, ``images/train/``, ``labels/train/``.
 
 One text file per exported frame, a line ``class cx cy w h`` per box with the centre
-and size divided by the frame size; class ``k`` is ``PART_NAMES[k]``. Boxes are clipped
+and size divided by the frame size; class ``k`` is ``BOX_PARTS[k]``. Boxes are clipped
 to the frame first (YOLO coordinates must lie in [0, 1]) and boxes with nothing inside
 the frame are left out. Track ids and flags are not representable: export CVAT or
 Parquet to keep them.
@@ -18,7 +18,7 @@ import yaml
 from partlab.labelling.formats.base import ExportManifest, thinned_tracks
 from partlab.labelling.formats.frames import frame_name, write_frames
 from partlab.labelling.video import VideoInfo
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 
 NAME = "yolo"
 SUBSET = "train"
@@ -36,10 +36,11 @@ def clipped_xyxy(df: pd.DataFrame, width: int, height: int) -> np.ndarray:
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
            frames: bool = True) -> Path:
     df, keep = thinned_tracks(df, info, video_path, every, out_dir)
+    df = df[df["part"].isin(BOX_PARTS)]  # YOLO holds boxes; 3D joints are not boxes
     labels_dir = out_dir / "labels" / SUBSET
     labels_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "images" / SUBSET).mkdir(parents=True, exist_ok=True)
-    cls = df["part"].map({p: i for i, p in enumerate(PART_NAMES)}).to_numpy()
+    cls = df["part"].map({p: i for i, p in enumerate(BOX_PARTS)}).to_numpy()
     xyxy = clipped_xyxy(df, info.width, info.height)
     cx = (xyxy[:, 0] + xyxy[:, 2]) / 2 / info.width
     cy = (xyxy[:, 1] + xyxy[:, 3]) / 2 / info.height
@@ -52,7 +53,7 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     for f, ls in lines.items():
         (labels_dir / f"{frame_name(f)}.txt").write_text("".join(ls), encoding="utf-8")
     data = {"path": ".", "train": f"images/{SUBSET}", "val": f"images/{SUBSET}",
-            "nc": len(PART_NAMES), "names": {i: p for i, p in enumerate(PART_NAMES)}}
+            "nc": len(BOX_PARTS), "names": {i: p for i, p in enumerate(BOX_PARTS)}}
     (out_dir / "data.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
     if frames:
         write_frames(video_path, info, keep, out_dir / "images" / SUBSET, name=frame_name)

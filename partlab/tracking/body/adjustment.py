@@ -29,7 +29,7 @@ import numpy as np
 
 from partlab.tracking.core.box import Box
 from partlab.tracking.body.decomposition import decompose, inner_rectangle, minimum_bounding_rectangle
-from partlab.tracking.frame_tracker import FailureVerdict
+from partlab.tracking.protocol import FailureVerdict
 from partlab.tracking.body.part_filter import box_to_state, state_to_box
 
 if TYPE_CHECKING:

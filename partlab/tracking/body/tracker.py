@@ -35,7 +35,7 @@ import pandas as pd
 from partlab.tracking.core.box import Box, iou_xywh
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
-from partlab.tracking.frame_tracker import FailureDetector, FailureVerdict
+from partlab.tracking.protocol import FailureDetector, FailureVerdict
 from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
 from partlab.tracking.params import BodyParams
 from partlab.tracking.body.part_filter import PartFilter
@@ -145,7 +145,7 @@ class BodyTracker:
 
     ``init``: a tracks table (person and/or part rows) to start tracks from instead of
     detecting people; ``occluders``: fixed regions (``Box``) that hide people;
-    ``failure_detector``: a :class:`partlab.tracking.frame_tracker.FailureDetector` called each
+    ``failure_detector``: a :class:`partlab.tracking.protocol.FailureDetector` called each
     frame for every person not in occlusion; ``whole``: one box per person.
     """
 

@@ -5,3 +5,17 @@ particle filters over skin blobs, sec. 4-5; the five-state machine, sec. 5.2) an
 (hue histograms refined by mean shift, sec. 3). Read :mod:`.filter` (one filter per target),
 :mod:`.state_machine` (sec. 5.2) and :mod:`.tracker` (the per-frame loop).
 """
+
+
+def build(params, rngs, context):
+    """The registry's factory (:mod:`partlab.tracking.registry`)."""
+    from partlab.errors import UserError
+    from partlab.tracking.limbs.tracker import LimbTracker
+    from partlab.tracking.protocol import SingleView
+
+    p = params["limbs"]
+    try:
+        tracker = LimbTracker(p, rngs["limbs"], init=context.init)
+    except ValueError as exc:
+        raise UserError(f"bad init table: {exc}") from None
+    return SingleView(tracker, p)

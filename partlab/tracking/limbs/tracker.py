@@ -107,7 +107,7 @@ class _Target:
 
 
 class LimbTracker:
-    """Head and hands of several people; implements ``partlab.tracking.frame_tracker.FrameTracker``.
+    """Head and hands of several people; implements ``partlab.tracking.protocol.FrameTracker``.
 
     ``init``: a tracks table (INIT.csv) whose head/left_hand/right_hand rows start
     tracks at their first listed frame with their ``track_id``; without it (or without

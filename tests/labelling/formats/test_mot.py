@@ -8,7 +8,7 @@ import pytest
 from partlab.labelling.evaluation import iou_distance
 from partlab.labelling.formats import FormatError, export_dataset, import_dataset
 from partlab.labelling.formats.mot import mot_id
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "occluded"]
 
@@ -25,7 +25,7 @@ def test_layout_states_the_clip(exported, clip):
     seq.read(exported / "seqinfo.ini")
     assert dict(seq["Sequence"]) == {"name": "clip", "imdir": "img1", "framerate": "10", "seqlength": "20",
                                      "imwidth": "160", "imheight": "120", "imext": ".jpg"}
-    assert (exported / "gt" / "labels.txt").read_text().split() == list(PART_NAMES)
+    assert (exported / "gt" / "labels.txt").read_text().split() == list(BOX_PARTS)
     images = sorted(p.name for p in (exported / "img1").iterdir())
     assert images[0] == "000001.jpg" and images[-1] == "000020.jpg" and len(images) == 20
 
@@ -34,11 +34,11 @@ def test_motmetrics_reads_the_boxes_flags_and_classes(exported, truth):
     gt = mm.io.loadtxt(str(exported / "gt" / "gt.txt"), fmt="mot15-2D")
     assert len(gt) == len(truth)
     # motmetrics undoes MOT's 1-based pixels and frames: our decoder frame 7, track 0, torso
-    row = gt.loc[(8, int(mot_id(0, PART_NAMES.index("torso"))))]
+    row = gt.loc[(8, int(mot_id(0, BOX_PARTS.index("torso"))))]
     t = truth[(truth.frame == 7) & (truth.track_id == 0) & (truth.part == "torso")].iloc[0]
     assert (row.X, row.Y, row.Width, row.Height) == pytest.approx((t.x, t.y, t.w, t.h))
     assert row.Visibility == pytest.approx(0.75)  # occluded 0.25
-    assert row.ClassId == PART_NAMES.index("torso") + 1
+    assert row.ClassId == BOX_PARTS.index("torso") + 1
     assert gt.index.is_unique  # one MOT id per (person, part)
 
 

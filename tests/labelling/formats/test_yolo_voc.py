@@ -4,7 +4,7 @@ import yaml
 from datumaro.components.dataset import Dataset
 
 from partlab.labelling.formats import FormatError, export_dataset, import_dataset
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 
 
 def _clipped(t, w=160, h=120):
@@ -16,7 +16,7 @@ def test_yolo_read_by_datumaro(tmp_path, truth, clip):
     path, info = clip
     out = export_dataset(truth, "yolo", tmp_path / "y", info, video_path=path)
     data = yaml.safe_load((out / "data.yaml").read_text())
-    assert data["names"] == dict(enumerate(PART_NAMES)) and data["nc"] == 6
+    assert data["names"] == dict(enumerate(BOX_PARTS)) and data["nc"] == 6
     ds = Dataset.import_from(str(out), "yolo")
     names = [c.name for c in ds.categories()[list(ds.categories())[0]]]
     assert len(ds) == 20 and sum(len(i.annotations) for i in ds) == len(truth)
