@@ -6,7 +6,7 @@ import argparse
 import csv
 from pathlib import Path
 
-from partlab.cli import CommandError
+from partlab.cli import CommandError, describe_os_error
 
 
 def add_arguments(p) -> None:
@@ -104,7 +104,7 @@ def run(args) -> int:
     try:
         write_tracks_csv(tracks, args.output)
     except OSError as exc:
-        raise CommandError(f"{args.output}: cannot write: {exc}") from None
+        raise CommandError(f"{args.output}: cannot write: {describe_os_error(exc)}") from None
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
     if args.events:

@@ -246,7 +246,9 @@ def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> 
     if not has_take_columns(df):
         df = df.drop(columns=list(TAKE_COLUMNS))
     if isinstance(dest, (str, PathLike)):
-        Path(dest).parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
+        from partlab.files import replacing
+
+        with replacing(dest) as tmp:  # a full disk leaves an earlier file as it was
+            df.to_csv(tmp, index=False, float_format="%.2f", lineterminator="\n")
     else:
         df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
