@@ -30,6 +30,17 @@ class CommandError(UserError):
     """A user-facing failure: printed as ``partlab CMD: message`` with exit code 2."""
 
 
+def seed(text: str) -> int:
+    """argparse type of ``--seed``: a whole number from 0 to 2**32 - 1 (what numpy seeds take)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"{value} is outside 0..{2**32 - 1}")
+    return value
+
+
 def _module(name: str):
     return importlib.import_module(f"partlab.commands.{name}")
 

@@ -6,7 +6,7 @@ import argparse
 import csv
 from pathlib import Path
 
-from partlab.cli import CommandError, describe_os_error
+from partlab.cli import CommandError, describe_os_error, seed
 
 
 def add_arguments(p) -> None:
@@ -22,7 +22,7 @@ def add_arguments(p) -> None:
                    help="model bundle from partlab train, or 'default' for the one shipped with partlab "
                         "(failure detection and adjustment on); without it: the built-in parameters, no "
                         "failure detection")
-    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
+    p.add_argument("--seed", type=seed, default=0, help="random seed; the same seed gives the same output")
     p.add_argument("--events", metavar="EVENTS.csv",
                    help="write the events the tracker recognises (limbs/all: joins and separations)")
     p.add_argument("--occluders", metavar="FILE",
