@@ -98,8 +98,8 @@ def run(args) -> int:
 
         print("\nreported box extent per part (fitted vs default: scale of the tracked inner rectangle, "
               "shift in its size):")
-        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output_extent)
-        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output_extent)
+        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output.extent)
+        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output.extent)
         print(table.pivot(index="part", columns="term", values="fitted").round(3).to_string())
     if "selection" in bundle.summary:
         from partlab.models.selection import selection_table
