@@ -18,6 +18,7 @@ import pandas as pd
 
 from partlab.labelling.archive import ArchiveError, is_archive, safe_extract
 from partlab.labelling.formats import coco, cvat, mot, parquet, voc, yolo
+from partlab.labelling.formats.alignment import align_frames
 from partlab.labelling.formats.base import ExportManifest, FormatError, check_frame_count
 from partlab.labelling.video import VideoInfo, probe
 
@@ -81,7 +82,8 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
                     frames=frames and fmt != "parquet")
 
 
-def _import_dir(path: Path, f: Format, mapping, video) -> pd.DataFrame:
+def _import_dir(path: Path, f: Format, mapping, video, frame_offset: int) -> pd.DataFrame:
+    info = None
     if video is not None:
         info = video if isinstance(video, VideoInfo) else probe(video)
         stated = f.frame_count(path) if f.frame_count else None
@@ -91,15 +93,28 @@ def _import_dir(path: Path, f: Format, mapping, video) -> pd.DataFrame:
             manifest.check_video(info)
         elif stated is not None:
             check_frame_count(stated, info, f"the {f.name} annotations")
-    return f.import_(path, mapping)
+    df = f.import_(path, mapping)
+    if frame_offset:
+        attrs = df.attrs
+        df = df.assign(frame=df["frame"] + int(frame_offset))
+        df.attrs = dict(attrs, images={k + int(frame_offset): v for k, v in attrs.get("images", {}).items()})
+    if info is not None:
+        df = align_frames(df, info, clip_path=None if isinstance(video, VideoInfo) else video, source=str(path))
+    df.attrs.pop("images", None)  # paths into a temporary extraction are of no use to the caller
+    return df
 
 
-def import_dataset(path, fmt: str, mapping=None, video=None) -> pd.DataFrame:
+def import_dataset(path, fmt: str, mapping=None, video=None, frame_offset: int = 0) -> pd.DataFrame:
     """Read a ``fmt`` dataset (our export directory, the format's own file, or a zip/tar of
     either) as a tracks table. ``mapping`` maps foreign label names or class ids to part
-    names (dict, JSON text or ``"face=head,1=person"``). With ``video`` (path or
-    :class:`VideoInfo`) the clip's frame count must match the one the files state.
-    ``df.attrs['skipped']`` counts boxes whose labels map to no part.
+    names (dict, JSON text or ``"face=head,1=person"``). ``frame_offset`` is added to the frames
+    read (``-1`` for files numbered from 1 that our readers cannot tell are).
+
+    With ``video`` (path or :class:`VideoInfo`) the clip's frame count must match the one the
+    files state, and the frames are lined up with the clip by :func:`~.alignment.align_frames`:
+    by the images' content when the dataset holds its frames (a shift of up to two frames is
+    corrected and recorded in ``df.attrs['frame_shift']``), and boxes on frames the clip does not
+    have are refused. ``df.attrs['skipped']`` counts boxes whose labels map to no part.
     """
     f = _format(fmt)
     if f.import_ is None:
@@ -117,8 +132,8 @@ def import_dataset(path, fmt: str, mapping=None, video=None) -> pd.DataFrame:
             entries = [e for e in root.iterdir() if not e.name.startswith(("__MACOSX", "."))]
             if len(entries) == 1 and entries[0].is_dir():
                 root = entries[0]
-            return _import_dir(root, f, mapping, video)
-    return _import_dir(p, f, mapping, video)
+            return _import_dir(root, f, mapping, video, frame_offset)
+    return _import_dir(p, f, mapping, video, frame_offset)
 
 
 def _clip_dir_name(clip) -> str:

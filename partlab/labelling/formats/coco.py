@@ -117,12 +117,24 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     cats = {c.get("id"): str(c.get("name", c.get("id"))) for c in doc["categories"] if isinstance(c, dict)}
     images = sorted((im for im in doc["images"] if isinstance(im, dict)), key=lambda im: im.get("id", 0))
     frame_of: dict = {}
+    origin = set()
     for position, im in enumerate(images):
         if isinstance(im.get("frame_id"), int):
             frame_of[im.get("id")] = im["frame_id"]
+            origin.add("frame_id")
         else:
             m = re.search(r"(\d+)$", Path(str(im.get("file_name", ""))).stem)
             frame_of[im.get("id")] = int(m.group(1)) if m else position
+            origin.add("file names" if m else "image order")
+    image_of = {}
+    subset = js.stem.split("_", 1)[1] if js.stem.startswith("instances_") else "default"
+    roots = [js.parent, js.parent / "images", js.parent / FIFTYONE_DATA, js.parent.parent / "images",
+             js.parent.parent / "images" / subset, js.parent.parent / FIFTYONE_DATA]
+    for im in images:
+        name = str(im.get("file_name", ""))
+        found = next((r / name for r in roots if name and (r / name).is_file()), None)
+        if found is not None:
+            image_of[frame_of[im.get("id")]] = found
     rows: list[dict] = []
     skipped: dict[str, int] = {}
     for a in doc["annotations"]:
@@ -154,4 +166,7 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
             "failure": bool(attrs.get("failure", False)), "occluded": float(occlusion),
             "state": str(attrs.get("state", "")), "source": str(attrs.get("source", NAME)),
         })
-    return finish_import(rows, skipped, str(js))
+    df = finish_import(rows, skipped, str(js))
+    df.attrs["images"] = image_of
+    df.attrs["frame_origin"] = "frame_id" if origin == {"frame_id"} else " and ".join(sorted(origin))
+    return df

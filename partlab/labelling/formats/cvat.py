@@ -215,6 +215,11 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
                 "source": attrs.get("source") or ("cvat" if keyframe else "interpolated"),
             })
     df = finish_import(rows, skipped, str(xml))
+    images = xml.parent / "images"
+    if images.is_dir():  # a CVAT task's frames: images/frame_000042.png (or .jpg)
+        df.attrs["images"] = {int(p.stem[6:]): p for p in images.iterdir()
+                              if p.stem.startswith("frame_") and p.stem[6:].isdigit()}
+    df.attrs["frame_origin"] = "CVAT frame numbers"
     dup = df.duplicated(["frame", "track_id", "part"])
     if dup.any():
         raise FormatError(f"{xml}: {int(dup.sum())} boxes repeat a (frame, group, label); two CVAT tracks of "

@@ -137,6 +137,7 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     img_dir = root / read_seqinfo(root).get("imDir", "img1") if root.is_dir() else None
     if img_dir is not None and img_dir.is_dir():
         df.attrs["images"] = _images_by_frame(img_dir)
+    df.attrs["frame_origin"] = "MOT frame numbers (1-based)"
     return df
 
 
