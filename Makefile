@@ -8,7 +8,7 @@ HOST ?= 127.0.0.1
 PORT ?= 8501
 export PARTLAB_DATA ?= $(CURDIR)/partlab-data
 
-.PHONY: run test venv clean
+.PHONY: run test venv peers clean
 
 $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
@@ -28,12 +28,22 @@ $(VENV)/.installed-test: pyproject.toml $(VENV)/.installed
 
 venv: $(VENV)/.installed
 
+# Peers whose pins conflict with ours, each in its own venv, called by the tests as subprocesses
+# (tests/labelling/formats/test_peers_venv.py): label-studio-converter and FiftyOne.
+PEERS ?= .venv-peers
+$(PEERS)/%/.installed:
+	$(PYTHON) -m venv $(PEERS)/$*
+	$(PEERS)/$*/bin/python -m pip install --quiet $(if $(filter labelstudio,$*),label-studio-converter,fiftyone)
+	touch $@
+
+peers: $(PEERS)/labelstudio/.installed $(PEERS)/fiftyone/.installed
+
 run: $(VENV)/.installed
 	$(PY) -m partlab.app.demo
 	$(PY) -m partlab app --host $(HOST) --port $(PORT)
 
-test: $(VENV)/.installed-test
+test: $(VENV)/.installed-test peers
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) $(PEERS) build *.egg-info

@@ -5,7 +5,7 @@ Ultralytics (``data.yaml`` with ``train: train/images``; it finds each label by 
 ``images`` with ``labels`` in the image path), Datumaro (detected as ``roboflow_yolo`` with the
 names of ``data.yaml``; a flat ``labels/`` would match two of its YOLO readers at once) and
 label-studio-converter's ``yolo`` import pointed at ``train/`` (``classes.txt``, ``images/``,
-``labels/``).
+``labels/``) and FiftyOne's ``YOLOv5Dataset`` (``dataset.yaml``, a hard link to ``data.yaml``).
 
 One text file per exported frame, a line ``class cx cy w h`` per box with the centre
 and size divided by the frame size; class ``k`` is ``BOX_PARTS[k]``. Boxes are clipped
@@ -23,7 +23,7 @@ import pandas as pd
 import yaml
 
 from partlab.labelling.formats.base import ExportManifest, thinned_tracks
-from partlab.labelling.formats.frames import frame_name, write_frames
+from partlab.labelling.formats.frames import frame_name, link_or_copy, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import BOX_PARTS
 
@@ -63,6 +63,7 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     data = {"path": ".", "train": f"{SUBSET}/images", "val": f"{SUBSET}/images",
             "nc": len(BOX_PARTS), "names": {i: p for i, p in enumerate(BOX_PARTS)}}
     (out_dir / "data.yaml").write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    link_or_copy(out_dir / "data.yaml", out_dir / "dataset.yaml")  # FiftyOne's YOLOv5Dataset default name
     (out_dir / SUBSET / CLASSES_FILE).write_text("".join(f"{p}\n" for p in BOX_PARTS), encoding="utf-8")
     if frames:
         write_frames(video_path, info, keep, out_dir / SUBSET / "images", name=frame_name)
