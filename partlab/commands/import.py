@@ -6,7 +6,7 @@ import sys
 
 from partlab.cli import CommandError
 
-FORMATS = ["mot", "cvat", "coco", "parquet"]
+FORMATS = ["mot", "cvat", "coco", "parquet", "labelstudio"]
 
 
 def add_arguments(p) -> None:

@@ -19,7 +19,7 @@ from typing import Callable
 import pandas as pd
 
 from partlab.labelling.archive import ArchiveError, is_archive, safe_extract
-from partlab.labelling.formats import coco, cvat, mot, parquet, voc, yolo
+from partlab.labelling.formats import coco, cvat, labelstudio, mot, parquet, voc, yolo
 from partlab.labelling.formats.alignment import align_frames
 from partlab.labelling.formats.base import MANIFEST_NAME, ExportManifest, FormatError, check_frame_count
 from partlab.labelling.video import VideoInfo, probe
@@ -49,7 +49,11 @@ FORMATS: dict[str, Format] = {
     "yolo": Format("yolo", "YOLO (Ultralytics): data.yaml, images/, labels/", yolo.export),
     "voc": Format("voc", "Pascal VOC: Annotations/, JPEGImages/, ImageSets/", voc.export),
     "parquet": Format("parquet", "Parquet and CSV of every box and flag", parquet.export, parquet.import_),
+    "labelstudio": Format("labelstudio", "Label Studio video tracks: tasks.json (videorectangle), labeling_config.xml",
+                          labelstudio.export, labelstudio.import_, labelstudio.annotated_frame_count),
 }
+#: formats whose files carry no frames (the clip itself goes to the other tool)
+NO_FRAMES = ("parquet", "labelstudio")
 IMPORT_FORMATS: tuple[str, ...] = tuple(n for n, f in FORMATS.items() if f.import_ is not None)
 
 
@@ -72,13 +76,13 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise FormatError(f"{out}: exists and is not a directory; -o names the output directory")
-    if frames and video_path is None and fmt != "parquet":
+    if frames and video_path is None and fmt not in NO_FRAMES:
         raise FormatError(f"writing frames for {fmt} needs the video (or pass frames=False / --no-frames)")
     if out.is_dir() and any(out.iterdir()):
         _remove_previous_export(out)
     kept = {c.name for c in out.iterdir()} if out.is_dir() else set()
     result = f.export(tracks_df, out, video_info, video_path=video_path, every=every,
-                      frames=frames and fmt != "parquet")
+                      frames=frames and fmt not in NO_FRAMES)
     manifest = ExportManifest.read(out)
     if manifest is not None:  # record what this export wrote, so the next one removes only that
         written = sorted(c.name for c in out.iterdir() if c.name not in kept) + [MANIFEST_NAME]
@@ -116,7 +120,10 @@ def _import_dir(path: Path, f: Format, mapping, video, frame_offset: int) -> pd.
             manifest.check_video(info)
         elif stated is not None:
             check_frame_count(stated, info, f"the {f.name} annotations")
-    df = f.import_(path, mapping)
+    if f.name == "labelstudio":  # percentages of the frame: the clip gives the size when the file does not
+        df = f.import_(path, mapping, size=(info.width, info.height) if info is not None else None)
+    else:
+        df = f.import_(path, mapping)
     if frame_offset:
         attrs = df.attrs
         df = df.assign(frame=df["frame"] + int(frame_offset))
