@@ -123,7 +123,8 @@ def _task(path: Path) -> tuple[Path, dict]:
     return js, tasks[0]
 
 
-def _results(task: dict) -> list:
+def results_of(task: dict) -> list:
+    """The regions of a task's most recent annotation, or of its most recent prediction when it has none."""
     for key in ("annotations", "predictions"):
         entries = [a for a in task.get(key) or [] if isinstance(a, dict) and not a.get("was_cancelled")]
         if entries:
@@ -134,7 +135,7 @@ def _results(task: dict) -> list:
 
 def annotated_frame_count(path: Path) -> int | None:
     _, task = _task(path)
-    counts = {r.get("value", {}).get("framesCount") for r in _results(task) if isinstance(r, dict)}
+    counts = {r.get("value", {}).get("framesCount") for r in results_of(task) if isinstance(r, dict)}
     counts = {c for c in counts if isinstance(c, int)}
     return counts.pop() if len(counts) == 1 else None
 
@@ -161,11 +162,18 @@ def import_(path: Path, mapping=None, size: tuple[int, int] | None = None) -> pd
     """Boxes of the task's latest annotation; ``size`` (width, height: the clip's, given with --video)
     turns percentages into pixels when the regions do not state ``original_width/height``."""
     js, task = _task(path)
+    if size is None:
+        meta = (task.get("meta") or {}).get("partlab") or {}
+        size = (meta["width"], meta["height"]) if "width" in meta and "height" in meta else None
+    return tracks_from_results(results_of(task), size, str(js), mapping)
+
+
+def tracks_from_results(regions_: list, size: tuple[int, int] | None, source: str, mapping=None) -> pd.DataFrame:
+    """A tracks table of Label Studio result regions (one box per frame each ``videorectangle`` shows)."""
     names = parse_mapping(mapping)
-    size = {"width": size[0], "height": size[1]} if size else ((task.get("meta") or {}).get("partlab") or {})
     rows: list[dict] = []
     skipped: dict[str, int] = {}
-    regions_ = [r for r in _results(task) if isinstance(r, dict)]
+    regions_ = [r for r in regions_ if isinstance(r, dict)]
     video = [r for r in regions_ if str(r.get("type", "")).lower() == "videorectangle"]
     for r in regions_:
         if r not in video:
@@ -186,23 +194,24 @@ def import_(path: Path, mapping=None, size: tuple[int, int] | None = None) -> pd
             track_id = int(m.group(1))
         else:
             track_id, next_id = next_id, next_id + 1
-        W = float(r.get("original_width") or size.get("width") or 0)
-        H = float(r.get("original_height") or size.get("height") or 0)
+        W = float(r.get("original_width") or (size[0] if size else 0))
+        H = float(r.get("original_height") or (size[1] if size else 0))
         if not (W > 0 and H > 0):
-            raise FormatError(f"{js}: region {r.get('id')} gives no frame size (original_width/height) to turn "
+            raise FormatError(f"{source}: region {r.get('id')} gives no frame size (original_width/height) to turn "
                               "its percentages into pixels; pass the clip with --video")
         try:
             boxes = expand(seq, value.get("framesCount"))
         except (KeyError, TypeError) as exc:
-            raise FormatError(f"{js}: region {r.get('id')} has a keyframe without {exc}; expected "
+            raise FormatError(f"{source}: region {r.get('id')} has a keyframe without {exc}; expected "
                               "frame, x, y, width, height") from None
         for frame, x, y, w, h, key in boxes:
             if frame < 1:
-                raise FormatError(f"{js}: region {r.get('id')} has frame {frame}; Label Studio frames count from 1")
+                raise FormatError(f"{source}: region {r.get('id')} has frame {frame}; Label Studio frames count "
+                                  "from 1")
             rows.append({"frame": frame - 1, "track_id": track_id, "part": part,
                          "x": x * W / 100.0, "y": y * H / 100.0, "w": w * W / 100.0, "h": h * H / 100.0,
                          "score": float(r["score"]) if isinstance(r.get("score"), (int, float)) else float("nan"),
                          "source": NAME if key else "interpolated"})
-    df = finish_import(rows, skipped, str(js))
+    df = finish_import(rows, skipped, source)
     df.attrs["frame_origin"] = "Label Studio frame numbers (1-based)"
     return df
