@@ -12,7 +12,8 @@ here with the standard library so that no conflicting pins come in:
   :mod:`partlab.labelling.formats.labelstudio`;
 - ``POST /webhook`` (and ``/train``) with Label Studio's webhook body: ``ANNOTATION_CREATED`` and
   ``ANNOTATION_UPDATED`` keep the task's annotation (``MODEL_DIR/annotations/<task>.json``) and retrain;
-  ``START_TRAINING`` retrains on every annotation kept.
+  ``START_TRAINING`` retrains on every annotation kept. Retraining runs in a thread (the answer is
+  ``{"status": "training"}`` at once); ``/health`` reports the new ``model_version`` when it is done.
 
 A task's video is ``data.video``: a local path, a Label Studio upload (``/data/upload/...``, found under
 ``--data-root``, Label Studio's data directory, or downloaded from ``--ls-url`` with ``--api-key``) or
@@ -61,7 +62,9 @@ class PartlabBackend:
     seed: int = 0
     train_with_tracker: bool = False  # validation runs of the tracker make fit minutes long; opt in
     version: int = 0
+    last_fit: dict = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+    _fits: list = field(default_factory=list, repr=False)
 
     def __post_init__(self):
         self.model_dir = Path(self.model_dir)
@@ -153,10 +156,28 @@ class PartlabBackend:
             task = dict(task, annotations=[annotation])
             (self.model_dir / "annotations" / f"{int(task.get('id') or 0)}.json").write_text(
                 json.dumps(task), encoding="utf-8")
-            return self.fit()
+            return self.fit_in_background()
         if action == "START_TRAINING":
-            return self.fit()
+            return self.fit_in_background()
         return {"status": "ignored", "reason": f"action {action!r}", "model_version": self.model_version}
+
+    def fit_in_background(self) -> dict:
+        """Start :meth:`fit` in a thread and answer at once (Label Studio does not wait minutes for a
+        webhook); fits run one after another, and ``predict`` uses the newest finished bundle."""
+        def run():
+            try:
+                self.last_fit = self.fit()
+            except Exception as exc:  # noqa: BLE001 - reported on /health, the server keeps serving
+                self.last_fit = {"status": "failed", "error": f"{type(exc).__name__}: {exc}"}
+        thread = threading.Thread(target=run, name="partlab-fit", daemon=True)
+        self._fits.append(thread)
+        thread.start()
+        return {"status": "training", "model_version": self.model_version}
+
+    def wait(self, timeout: float | None = None) -> None:
+        """Wait for the fits started so far (for tests and a clean shutdown)."""
+        for thread in list(self._fits):
+            thread.join(timeout)
 
     def fit(self) -> dict:
         """Retrain from every kept annotation, starting from the current bundle."""
@@ -204,7 +225,8 @@ def make_server(backend: PartlabBackend, host: str = "127.0.0.1", port: int = 90
 
         def do_GET(self):
             if self.path.split("?")[0] in ("/", "/health"):
-                self._send(200, {"status": "UP", "model_class": "partlab", "model_version": backend.model_version})
+                self._send(200, {"status": "UP", "model_class": "partlab", "model_version": backend.model_version,
+                                 **({"last_fit": backend.last_fit} if backend.last_fit else {})})
             else:
                 self._send(404, {"error": f"no route {self.path}"})
 

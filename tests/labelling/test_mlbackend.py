@@ -79,7 +79,11 @@ def test_predict_fit_predict(server, walk):
                                                           info)}
     code, fit = _post(url + "/webhook", {"action": "ANNOTATION_CREATED", "task": {"id": 3, "data": task["data"]},
                                          "annotation": corrected, "project": {"id": 1}})
-    assert code == 201 and fit["status"] == "ok" and fit["model_version"] == "partlab-1" and fit["annotations"] == 1
+    assert code == 201 and fit == {"status": "training", "model_version": "partlab-0"}
+    backend.wait(600)
+    with urllib.request.urlopen(url + "/health", timeout=10) as resp:
+        health = json.loads(resp.read())
+    assert health["model_version"] == "partlab-1" and health["last_fit"]["annotations"] == 1
     assert (backend.model_dir / "bundle-1" / "bundle.json").is_file()
     code, got = _post(url + "/predict", {"tasks": [task]})
     assert got["model_version"] == "partlab-1" and got["results"][0]["model_version"] == "partlab-1"
