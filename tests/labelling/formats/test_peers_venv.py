@@ -47,6 +47,16 @@ def test_label_studio_converter_reads_our_yolo(exports, truth, tmp_path):
     assert len(heads) == 36 and all(r["original_width"] == 160 for r in heads)
 
 
+def test_label_studio_converter_reads_our_coco_as_image_tasks(exports, truth, tmp_path):
+    exe = _python("labelstudio").parent / "label-studio-converter"
+    out = tmp_path / "coco-tasks.json"
+    subprocess.run([str(exe), "import", "coco", "-i", str(exports["coco"] / "annotations" / "instances_default.json"),
+                    "-o", str(out)], check=True, capture_output=True, timeout=300)
+    tasks = json.loads(out.read_text())
+    assert len(tasks) == 20 and all("image" in t["data"] for t in tasks)  # one image task per exported frame
+    assert sum(len(t["annotations"][0]["result"]) for t in tasks) == len(truth)
+
+
 FIFTYONE = """
 import json, sys
 import fiftyone.utils.coco as fouc, fiftyone.utils.voc as fouv, fiftyone.utils.yolo as fouy
