@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import hashlib
 import shutil
+from collections.abc import Iterator
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Iterator
 
 import cv2
 import numpy as np
@@ -120,7 +120,7 @@ class VideoClip:
             self._cap.release()
             self._cap = None
 
-    def __enter__(self) -> "VideoClip":
+    def __enter__(self) -> VideoClip:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -19,8 +19,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.formats.frames import frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES

@@ -16,15 +16,21 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pandas as pd
 from defusedxml import ElementTree as SafeET
 from defusedxml.common import DefusedXmlException
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.formats.frames import all_frames, frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
@@ -74,7 +80,7 @@ def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
     size = ET.SubElement(task, "original_size")
     ET.SubElement(size, "width").text = str(info.width)
     ET.SubElement(size, "height").text = str(info.height)
-    ET.SubElement(meta, "dumped").text = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    ET.SubElement(meta, "dumped").text = datetime.now(UTC).isoformat(timespec="seconds")
     ET.SubElement(meta, "source").text = f"partlab, fps={_num(info.fps)}"
 
 

@@ -28,8 +28,18 @@ from tqdm import tqdm
 from partlab.labelling.synth.appearance import Appearance
 from partlab.labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from partlab.labelling.synth.camera import Camera
-from partlab.labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
-                                    colour_table, draw_figure)
+from partlab.labelling.synth.figure import (
+    FACE,
+    FIGURE_PARTS,
+    FOREARM,
+    HAND_LEFT,
+    HAND_RIGHT,
+    NECK,
+    PART_LABELS,
+    FigurePose,
+    colour_table,
+    draw_figure,
+)
 from partlab.labelling.synth.scenarios import BUILDERS, Script
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
