@@ -21,6 +21,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from partlab.limits import MAX_ID, max_coord, max_csv_rows
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 
@@ -122,6 +123,17 @@ def _parse_bool(text: str) -> bool | None:
     return None
 
 
+def _rows(reader, label: str):
+    """The CSV module's rows, its own errors (NUL bytes, stray quotes) said with the line."""
+    while True:
+        try:
+            yield next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            raise TracksCSVError(f"{label} line {reader.line_num}: not a CSV row ({exc})") from None
+
+
 def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
     """Read and validate a tracks CSV.
 
@@ -129,7 +141,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     counted from 1, the header being line 1), so a user can open the file there.
     """
     label, text = _read_text(source, name)
-    reader = csv.reader(io.StringIO(text))
+    reader = _rows(csv.reader(io.StringIO(text, newline="")), label)
     try:
         header = next(reader)
     except StopIteration:
@@ -139,15 +151,19 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     _check_header(header, label)
     index = {c: i for i, c in enumerate(header) if c in COLUMNS}
     cols: dict[str, list] = {c: [] for c in index}
+    coord_limit, row_limit = max_coord(), max_csv_rows()
     for lineno, row in enumerate(reader, start=2):
         if not row or all(not cell.strip() for cell in row):
             continue
+        if lineno - 1 > row_limit:
+            raise TracksCSVError(f"{label}: more than the limit of {row_limit} rows "
+                                 "(set PARTLAB_MAX_CSV_ROWS to change it)")
         if len(row) < len(REQUIRED_COLUMNS):
             raise TracksCSVError(f"{label} line {lineno}: {len(row)} cells, expected at least "
                                  f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
         for col, i in index.items():
             cell = row[i].strip() if i < len(row) else ""
-            cols[col].append(_parse_cell(col, cell, f"{label} line {lineno}, column '{col}'"))
+            cols[col].append(_parse_cell(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
     return normalise_tracks(pd.DataFrame(cols))
 
 
@@ -177,7 +193,7 @@ def _check_header(header: list[str], label: str) -> None:
 
 
 def _parse_int(cell: str, where: str) -> int:
-    """A non-negative integer (``3`` or ``3.0``)."""
+    """A non-negative id or frame (``3`` or ``3.0``) within :data:`MAX_ID`."""
     try:
         value = int(cell)
     except ValueError:
@@ -190,24 +206,34 @@ def _parse_int(cell: str, where: str) -> int:
         value = int(f)
     if value < 0:
         raise TracksCSVError(f"{where}: {value} is negative")
+    if value > MAX_ID:
+        raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
     return value
 
 
-def _parse_number(col: str, cell: str, where: str) -> float:
+def _parse_number(col: str, cell: str, where: str, coord_limit: float) -> float:
     if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
         return DEFAULTS[col]
     try:
         value = float(cell)
     except ValueError:
         raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
-    if col in ("x", "y", "w", "h", "X", "Y", "Z") and not math.isfinite(value):
+    if col in ("x", "y", "w", "h", "X", "Y", "Z"):
+        if not math.isfinite(value):
+            raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+        if abs(value) > coord_limit:
+            raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
+                                 "(set PARTLAB_MAX_COORD to change it)")
+    if col == "score" and math.isinf(value):
         raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+    if col == "occluded" and not 0.0 <= value <= 1.0:
+        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
     if col in ("w", "h") and value < 0:
         raise TracksCSVError(f"{where}: negative size {value:g}")
     return value
 
 
-def _parse_cell(col: str, cell: str, where: str):
+def _parse_cell(col: str, cell: str, where: str, coord_limit: float):
     """One cell of column ``col``, checked; ``where`` names it in the error."""
     if col in ("frame", "track_id"):
         return _parse_int(cell, where)
@@ -216,7 +242,7 @@ def _parse_cell(col: str, cell: str, where: str):
             raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
         return cell
     if col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
-        return _parse_number(col, cell, where)
+        return _parse_number(col, cell, where, coord_limit)
     if col == "failure":
         value = _parse_bool(cell)
         if value is None:
@@ -267,7 +293,9 @@ def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> 
     if not has_take_columns(df):
         df = df.drop(columns=list(TAKE_COLUMNS))
     if isinstance(dest, (str, PathLike)):
-        Path(dest).parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
+        from partlab.files import replacing
+
+        with replacing(dest) as tmp:  # a full disk leaves an earlier file as it was
+            df.to_csv(tmp, index=False, float_format="%.2f", lineterminator="\n")
     else:
         df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")

@@ -25,6 +25,8 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from partlab.labelling.synth.activities import BUILDERS as ACTIVITY_BUILDERS
+from partlab.labelling.synth.activities import HANDS
 from partlab.labelling.synth.appearance import Appearance
 from partlab.labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from partlab.labelling.synth.camera import Camera
@@ -45,7 +47,10 @@ from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 from partlab.tracking.tracks import normalise_tracks
 
-SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
+SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk",
+                              "pick_place", "exchange", "handshake", "clap")
+#: the columns of a scene's event truth (``events.csv``)
+EVENT_TRUTH_COLUMNS = ("kind", "start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b", "colour")
 FPS = 25.0
 OCCLUDER_ID = 255
 SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
@@ -72,6 +77,7 @@ class Scene:
     appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
     background: np.ndarray | None = None  # (H, W, 3) uint8: the empty room (no shadows, flicker or noise)
     owners: np.ndarray | None = None  # (T, H, W) uint8 who is seen where: 0 room, k track k, 255 occluder
+    events: pd.DataFrame | None = None  # activity truth (EVENT_TRUTH_COLUMNS), scenes with activities only
 
 
 def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
@@ -119,6 +125,31 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
     frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
 
 
+def _truth_rows(i: int, drawn: list, owner: np.ndarray) -> list[tuple]:
+    """Truth rows of frame ``i``: every drawn person's box and each part's box (its visible
+    pixels, or all of it when hidden), with the occluded fraction from the owner map."""
+    rows = []
+    for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
+        own = owner[cy1:cy2, cx1:cx2]
+        lab = fig.labels[crop]
+        parts = {"person": lab > 0}
+        for p in FIGURE_PARTS:
+            if p in fig.masks:
+                whole = fig.masks[p][crop]
+                shown = whole & np.isin(lab, PART_LABELS[p])
+                parts[p] = shown if shown.any() else whole
+        for part, mask in parts.items():
+            total = int(mask.sum())
+            if total == 0:
+                continue
+            cols = np.flatnonzero(mask.any(axis=0))
+            rws = np.flatnonzero(mask.any(axis=1))
+            visible = int(np.count_nonzero(own[mask] == a + 1))
+            rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
+                         rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+    return rows
+
+
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
                *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
@@ -130,7 +161,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.for_frame(width, height)
-    script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
+    script: Script = {**BUILDERS, **ACTIVITY_BUILDERS}[name](rng, camera, n_frames, FPS)
     background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
@@ -175,28 +206,12 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             frame[cy1:cy2, cx1:cx2][on] = colours
             owner[cy1:cy2, cx1:cx2][on] = a + 1
             drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
+        _draw_objects(frame, script.objects, drawn, i)
         for o, tex in zip(script.occluders, occ_tex):
             x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
             owner[y:y + h, x:x + w] = OCCLUDER_ID
-        for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
-            own = owner[cy1:cy2, cx1:cx2]
-            lab = fig.labels[crop]
-            parts = {"person": lab > 0}
-            for p in FIGURE_PARTS:
-                if p in fig.masks:
-                    whole = fig.masks[p][crop]
-                    shown = whole & np.isin(lab, PART_LABELS[p])
-                    parts[p] = shown if shown.any() else whole
-            for part, mask in parts.items():
-                total = int(mask.sum())
-                if total == 0:
-                    continue
-                cols = np.flatnonzero(mask.any(axis=0))
-                rws = np.flatnonzero(mask.any(axis=1))
-                visible = int(np.count_nonzero(own[mask] == a + 1))
-                rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
-                             rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+        rows.extend(_truth_rows(i, drawn, owner))
         frames[i] = frame if effects is None else effects.apply(frame, i)
         if owner_maps is not None:
             owner_maps[i] = owner
@@ -207,8 +222,41 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
     init = truth[truth["frame"] == first].reset_index(drop=True)
+    events = None
+    if script.events:
+        events = pd.DataFrame([(e.kind, e.start_frame, e.end_frame, e.track_id_a, e.part_a, e.track_id_b, e.part_b,
+                                "" if e.colour is None else "#{:02x}{:02x}{:02x}".format(*reversed(e.colour)))
+                               for e in script.events], columns=list(EVENT_TRUTH_COLUMNS))
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
-                 tuple(a.appearance for a in script.actors), background, owner_maps)
+                 tuple(a.appearance for a in script.actors), background, owner_maps, events)
+
+
+def _draw_objects(frame: np.ndarray, objects, drawn, i: int) -> None:
+    """Carried objects at frame ``i``: in front of the holding hand (a little below its centre, so
+    the hand still shows), or where they rest."""
+    import cv2
+
+    figs = {a: (fig, box) for a, fig, _, box in drawn}
+    for obj in objects:
+        h = int(obj.holder[i])
+        if h < 0:
+            if not np.all(np.isfinite(obj.rest[i])):
+                continue
+            centre, r = obj.rest[i], None
+        else:
+            got = figs.get(h // 2)
+            mask = None if got is None else got[0].masks.get(HANDS[h % 2])
+            if mask is None or not mask.any():
+                continue
+            ys, xs = np.nonzero(mask)
+            x0, y0 = got[0].origin
+            hand_r = max(2.0, 0.5 * (xs.max() - xs.min() + 1))
+            centre = np.array([x0 + xs.mean(), y0 + ys.mean() + 1.1 * hand_r])
+            r = obj.radius * hand_r
+        if r is None:
+            r = obj.rest_radius_px
+        cv2.ellipse(frame, (int(round(centre[0])), int(round(centre[1]))), (int(round(r)), int(round(0.8 * r))),
+                    0, 0, 360, tuple(int(c) for c in obj.colour), -1, lineType=cv2.LINE_AA)
 
 
 def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,
@@ -236,4 +284,6 @@ def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: 
                         "hair": list(p.hair), "height_m": round(p.height_m, 3)}
                        for k, p in enumerate(scene.appearances)]}
     (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
+    if scene.events is not None:
+        scene.events.to_csv(out / "events.csv", index=False, lineterminator="\n")
     return out
