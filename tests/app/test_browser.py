@@ -17,6 +17,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from playwright import sync_api as playwright  # the test extra installs it: a broken import fails
 
 from partlab.commands.app import streamlit_command
 
@@ -25,7 +26,6 @@ ROOT = Path(__file__).resolve().parents[2]
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--disable-sync", "--no-first-run"]
 
-playwright = pytest.importorskip("playwright.sync_api", reason="the playwright package is not installed")
 if not os.path.exists(CHROMIUM):
     pytest.skip("chromium is not installed (apt-get install chromium; .ci/run does it)", allow_module_level=True)
 
