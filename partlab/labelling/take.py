@@ -20,16 +20,17 @@ stream's.
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
-from typing import Iterator, Mapping
 
 import cv2
 import numpy as np
 
 from partlab.errors import UserError
-from partlab.labelling.calibration import FILE_NAME as CALIBRATION_FILE, read_calibration
+from partlab.labelling.calibration import FILE_NAME as CALIBRATION_FILE
+from partlab.labelling.calibration import read_calibration
 from partlab.labelling.video import VIDEO_EXTENSIONS, VideoClip, is_image_sequence
 from partlab.tracking.camera import Camera
 from partlab.tracking.frame import DEFAULT_STREAM, Frame, FrameSet
@@ -149,7 +150,7 @@ class Take:
             if s.color is not None:
                 s.color.close()
 
-    def __enter__(self) -> "Take":
+    def __enter__(self) -> Take:
         return self
 
     def __exit__(self, *exc) -> None:
