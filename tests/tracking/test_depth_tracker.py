@@ -97,5 +97,5 @@ def test_parameters_round_trip_and_ablation_variants():
     assert not p.depth.importance_sampling and not p.depth.depth_foreground and p.refinement.mean_shift
     assert not DepthParams.ablation("color_is").refinement.mean_shift
     assert DepthParams.from_dict(p.to_dict()) == p
-    with pytest.raises(ValueError, match="unknown depth.dynamics parameter"):
+    with pytest.raises(ValueError, match=r"depth.dynamics: unknown parameter\(s\) particls"):
         DepthParams.from_dict({"dynamics": {"particls": 3}})
