@@ -28,7 +28,8 @@ import pandas as pd
 
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
-from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from partlab.tracking.core.hue_histogram import (back_projection, box_histograms, hue_bin_image, hue_confidence,
+                                                 integral_histogram, reference_histogram)
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthParams
 from partlab.tracking.depth.posture import head_width, recover
@@ -279,6 +280,8 @@ class DepthTracker:
             box = self._init_boxes.get("head") or self._detect_face(color)
             if box is None or not self._start_face(box, bins):
                 return []
+            self.face.conf = self.face.conf + hue_confidence(
+                box_histograms(integral, self.face.boxes(self.face.estimate)), self.face.ref, ap.lam)[0]
             for name in HANDS:
                 hb = self._init_boxes.get(name)
                 h = self.hands[name]
