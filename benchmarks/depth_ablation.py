@@ -2,8 +2,8 @@
 stereo against rendered depth, and speed at 320x240.
 
 Scenes: :func:`partlab.labelling.synth.depth_scene.make_depth_scene`, ``desk_depth`` on even seeds
-and ``standing_depth`` on odd ones, 150 frames at 320x240 (seeds are scenes not used to choose the
-parameters, which were chosen on seeds 100-103). Variants (Table 2's rows):
+and ``standing_depth`` on odd ones, 150 frames at 320x240 (the parameters were set by hand while
+looking at seeds 0-3, so those four are not unseen). Variants (Table 2's rows):
 
 - ``color_ms``: colour PF + mean shift, no depth at all;
 - ``color_is``: colour PF + depth importance sampling (no mean shift);

