@@ -35,7 +35,8 @@ def run(args) -> int:
     from partlab.labelling.synth.depth_scene import DEPTH_SCENARIOS, render_depth_scenario
 
     if args.scenario not in SCENARIOS + DEPTH_SCENARIOS:
-        raise CommandError(f"unknown scenario {args.scenario!r}; choose one of {', '.join(SCENARIOS + DEPTH_SCENARIOS)}")
+        raise CommandError(f"unknown scenario {args.scenario!r}; "
+                           f"choose one of {', '.join(SCENARIOS + DEPTH_SCENARIOS)}")
     depth = args.scenario in DEPTH_SCENARIOS
     width, height = _size(args.size or ("320x240" if depth else "720x480"))
     if width < 64 or height < 48 or width % 2 or height % 2:

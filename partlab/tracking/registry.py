@@ -104,7 +104,8 @@ def params_class(key: str) -> type:
 register_parameters(ParameterEntry("body", "partlab.tracking.body.params:BodyParams", rng_slot=0))
 register_parameters(ParameterEntry("limbs", "partlab.tracking.limbs.params:LimbParams", rng_slot=1))
 register_parameters(ParameterEntry("activities", "partlab.tracking.activities.params:ActivityParams", rng_slot=9))
-register_parameters(ParameterEntry("depth", "partlab.tracking.depth.params:DepthParams", rng_slot=16))  # 16: the issue number, clear of the other trackers' slots
+# slots clear of each other: 16 the depth tracker's issue number
+register_parameters(ParameterEntry("depth", "partlab.tracking.depth.params:DepthParams", rng_slot=16))
 
 register(TrackerEntry(
     "body", "head, torso and hip-leg of every person, plus the person box (Zhao & Lee)",
