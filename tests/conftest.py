@@ -19,10 +19,18 @@ import tempfile
 import pytest
 
 
+#: ``PARTLAB_TEST_BACKEND=postgresql`` runs every test's store on a fresh PostgreSQL database (CI)
+TEST_BACKEND = os.environ.get("PARTLAB_TEST_BACKEND", "sqlite")
+
+
 @pytest.fixture(autouse=True)
-def _isolated_data_dir(tmp_path, monkeypatch):
+def _isolated_data_dir(request, tmp_path, monkeypatch):
     monkeypatch.setenv("PARTLAB_DATA", str(tmp_path / "partlab-data"))
     monkeypatch.delenv("PARTLAB_DATABASE_URL", raising=False)
+    if TEST_BACKEND == "postgresql":
+        monkeypatch.setenv("PARTLAB_DATABASE_URL", _fresh_database(request.getfixturevalue("postgres_server")))
+    elif TEST_BACKEND != "sqlite":
+        pytest.fail(f"PARTLAB_TEST_BACKEND must be sqlite or postgresql, got {TEST_BACKEND!r}")
     yield
 
 
@@ -79,11 +87,16 @@ _counter = itertools.count()
 def backend(request, monkeypatch):
     """Point ``PARTLAB_DATABASE_URL`` at a fresh database of each kind."""
     if request.param == "postgresql":
-        base = request.getfixturevalue("postgres_server")
-        import psycopg
-
-        name = f"t{os.getpid()}_{next(_counter)}"
-        with psycopg.connect(base.replace("postgresql+psycopg", "postgresql") + "/postgres", autocommit=True) as c:
-            c.execute(f"CREATE DATABASE {name}")
-        monkeypatch.setenv("PARTLAB_DATABASE_URL", f"{base}/{name}")
+        monkeypatch.setenv("PARTLAB_DATABASE_URL", _fresh_database(request.getfixturevalue("postgres_server")))
+    else:
+        monkeypatch.delenv("PARTLAB_DATABASE_URL", raising=False)
     return request.param
+
+
+def _fresh_database(base: str) -> str:
+    import psycopg
+
+    name = f"t{os.getpid()}_{next(_counter)}"
+    with psycopg.connect(base.replace("postgresql+psycopg", "postgresql") + "/postgres", autocommit=True) as c:
+        c.execute(f"CREATE DATABASE {name}")
+    return f"{base}/{name}"
