@@ -99,6 +99,15 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     if retrack:
         stop = next_human_frame(store, clip.id, start)
     occluders = tuple(store.occluders(clip.id))
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
+        else f"track {clip.name} ({tracker})"
+    if jobs.engine_enabled():  # on a Dask worker: survives a server restart, can be cancelled
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("track", what, tasks.track_clip, dict(clip_id=clip.id, project_id=clip.project_id),
+                                  url=store.url, clip_id=clip.id, tracker=tracker,
+                                  bundle_path=str(bundle_path) if bundle_path else None, seed=seed, start=start,
+                                  stop=stop, init=None if init is None else init.to_dict("records"))
 
     def work(progress):
         model = _load_model(bundle_path)
@@ -108,8 +117,6 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
                                         start_frame=start, stop_frame=stop)
         return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
 
-    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
-        else f"track {clip.name} ({tracker})"
     return jobs.submit("track", what, work, clip_id=clip.id, project_id=clip.project_id)
 
 
