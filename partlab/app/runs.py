@@ -180,6 +180,13 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     runner_mod = optional("partlab.models.runner")  # the tracker's own failures are the paper's training samples
     runner = getattr(runner_mod, "body_tracker_runner", None)
     names = [store.clip(cid).name for cid in clip_ids]
+    if jobs.engine_enabled() and runner is not None:  # on a Dask worker, like tracking
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("train", f"train bundle {name}", tasks.train_bundle, dict(project_id=project_id),
+                                  url=store.url, project_id=project_id, clip_ids=list(clip_ids), name=name,
+                                  out=str(out), seed=seed, make_default=make_default,
+                                  start_path=str(start_path) if start_path else None)
     start = _load_model(start_path)
 
     def work(progress):

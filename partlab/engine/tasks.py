@@ -26,3 +26,34 @@ def track_clip(progress, *, url: str, clip_id: int, tracker: str, bundle_path: s
     run_id = store.save_tracker_run(clip_id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
                                     start_frame=start, stop_frame=stop)
     return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
+
+
+def train_bundle(progress, *, url: str, project_id: int, clip_ids: list[int], name: str, out: str, seed: int = 0,
+                 make_default: bool = False, start_path: str | None = None, with_tracker: bool = True) -> dict:
+    """Train a bundle from a project's corrected clips, save it to ``out`` and register it
+    (``with_tracker``: also learn from the body tracker's own failures, as the app does)."""
+    from partlab.app.runs import frames_factory, training_truth
+    from partlab.labelling.store import Store
+    from partlab.models import bundle as bundle_mod
+    from partlab.models import training
+    from partlab.models.runner import body_tracker_runner
+
+    store = Store(url)
+    clips = [(frames_factory(store.clip(cid).path), store.clip(cid).fps, training_truth(store, cid)) for cid in clip_ids]
+    names = [store.clip(cid).name for cid in clip_ids]
+    start = bundle_mod.load_bundle(start_path) if start_path else None
+    runner = body_tracker_runner if with_tracker else None
+    total = training.training_steps(len(clips), with_tracker=runner is not None)
+    steps = iter(range(1, 10**6))
+
+    def step(_message: str) -> None:  # train_bundle reports named steps; the bar counts them
+        progress(next(steps), total)
+
+    progress(0, total)
+    bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner,
+                                   names=names, start=start)
+    bundle_mod.save_bundle(bundle, out)
+    record = store.add_bundle(project_id, name, out, summary=bundle.summary)
+    if make_default:
+        store.set_default_bundle(project_id, record.id)
+    return dict(bundle_id=record.id, path=str(out))
