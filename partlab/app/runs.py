@@ -153,15 +153,8 @@ def training_truth(store: Store, clip_id: int) -> pd.DataFrame:
     return tracks[tracks.frame.isin(human)].drop(columns=["revision"]).reset_index(drop=True)
 
 
-def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
-                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
-    """Train a bundle from corrected clips in the background, save it and register it.
-    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
-    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
-    training = optional("partlab.models.training")
-    bundle_mod = optional("partlab.models.bundle")
-    if training is None or bundle_mod is None:
-        raise RuntimeError("training is not available yet (partlab.models.training / partlab.models.bundle have not landed)")
+def _training_inputs(store: Store, project_id: int, clip_ids: list[int], name: str) -> tuple[list, Path]:
+    """The clips to train from ``(frames, fps, truth)`` and the bundle's new folder, or ValueError."""
     if not clip_ids:
         raise ValueError("pick at least one corrected clip")
     folder = safe_name(name)
@@ -177,6 +170,19 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
+    return clips, out
+
+
+def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
+                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
+    """Train a bundle from corrected clips in the background, save it and register it.
+    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
+    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    training = optional("partlab.models.training")
+    bundle_mod = optional("partlab.models.bundle")
+    if training is None or bundle_mod is None:
+        raise RuntimeError("training is not available yet (partlab.models.training / partlab.models.bundle have not landed)")
+    clips, out = _training_inputs(store, project_id, clip_ids, name)
     runner_mod = optional("partlab.models.runner")  # the tracker's own failures are the paper's training samples
     runner = getattr(runner_mod, "body_tracker_runner", None)
     names = [store.clip(cid).name for cid in clip_ids]

@@ -11,7 +11,7 @@ from partlab.cli import CommandError, seed
 
 
 def add_arguments(p) -> None:
-    from partlab.engine.batch import DEFAULT_CHUNK, DEFAULT_OVERLAP
+    from partlab.engine import DEFAULT_CHUNK, DEFAULT_OVERLAP
     from partlab.tracking import registry
 
     p.add_argument("source", metavar="DIR|MANIFEST.csv", nargs="?",

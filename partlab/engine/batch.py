@@ -32,14 +32,9 @@ from typing import Callable, Iterable
 
 import pandas as pd
 
+from partlab.engine import DEFAULT_CHUNK, DEFAULT_OVERLAP
 from partlab.errors import UserError
 
-#: a chunked clip's chunks are this many frames by default (2 min at 25 fps): long enough that the
-#: overlap's warm-up costs under 3 %, short enough that a 1-hour clip spreads over 30 tasks
-DEFAULT_CHUNK = 3000
-#: frames each chunk starts early: the background model learns from its first frames and the body
-#: tracker's detection needs a person seen moving for some frames (2 s at 25 fps)
-DEFAULT_OVERLAP = 50
 #: chunk tracks whose boxes overlap an earlier chunk's track by less than this mean IoU over the
 #: overlap are new people, not continuations (the evaluation's "right box" needs 0.5 on one box;
 #: a mean over frames where either may have drifted is held to less)
