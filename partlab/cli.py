@@ -17,6 +17,7 @@ from partlab.errors import UserError
 #: sub-command -> one-line help (the order is the order of ``partlab --help``).
 COMMANDS: dict[str, str] = {
     "track": "track people's parts in a video and write a tracks CSV",
+    "batch": "track every clip of a folder, manifest or project on Dask (resumable)",
     "train": "train failure detectors and variance parameters from corrected clips",
     "eval": "compare tracks with truth: per-part tracking rates and MOT metrics",
     "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet, labelstudio)",

@@ -3,7 +3,8 @@
 This is glue only: the algorithms are ``partlab.app.pipeline.track_video`` (trackers),
 ``partlab.models.training.train_bundle`` (SVMs and variances) and the store. They are imported
 when a job starts (the pages stay quick to load); an import that breaks fails the job or the page,
-it is never hidden.
+it is never hidden. Jobs run on the engine (:mod:`partlab.engine`, a local Dask cluster outside the
+server) unless the app was started with ``--jobs threads``.
 """
 
 from __future__ import annotations
@@ -72,7 +73,6 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     synthetic scene's init.csv).
     """
     from partlab.app import pipeline
-
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
     stop = None
@@ -84,6 +84,15 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     if retrack:
         stop = next_human_frame(store, clip.id, start)
     occluders = tuple(store.occluders(clip.id))
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
+        else f"track {clip.name} ({tracker})"
+    if jobs.engine_enabled():  # on a Dask worker: survives a server restart, can be cancelled
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("track", what, tasks.track_clip, dict(clip_id=clip.id, project_id=clip.project_id),
+                                  url=store.url, clip_id=clip.id, tracker=tracker,
+                                  bundle_path=str(bundle_path) if bundle_path else None, seed=seed, start=start,
+                                  stop=stop, init=None if init is None else init.to_dict("records"))
 
     def work(progress):
         model = _load_model(bundle_path)
@@ -93,8 +102,6 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
                                         start_frame=start, stop_frame=stop)
         return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
 
-    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
-        else f"track {clip.name} ({tracker})"
     return jobs.submit("track", what, work, clip_id=clip.id, project_id=clip.project_id)
 
 
@@ -131,15 +138,8 @@ def training_truth(store: Store, clip_id: int) -> pd.DataFrame:
     return tracks[tracks.frame.isin(human)].drop(columns=["revision"]).reset_index(drop=True)
 
 
-def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
-                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
-    """Train a bundle from corrected clips in the background, save it and register it.
-    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
-    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
-    from partlab.models import bundle as bundle_mod
-    from partlab.models import training
-    from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
-
+def _training_inputs(store: Store, project_id: int, clip_ids: list[int], name: str) -> tuple[list, Path]:
+    """The clips to train from ``(frames, fps, truth)`` and the bundle's new folder, or ValueError."""
     if not clip_ids:
         raise ValueError("pick at least one corrected clip")
     folder = safe_name(name)
@@ -155,7 +155,27 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
+    return clips, out
+
+
+def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
+                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
+    """Train a bundle from corrected clips in the background, save it and register it.
+    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
+    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    from partlab.models import bundle as bundle_mod
+    from partlab.models import training
+    from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
+
+    clips, out = _training_inputs(store, project_id, clip_ids, name)
     names = [store.clip(cid).name for cid in clip_ids]
+    if jobs.engine_enabled():  # on a Dask worker, like tracking
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("train", f"train bundle {name}", tasks.train_bundle, dict(project_id=project_id),
+                                  url=store.url, project_id=project_id, clip_ids=list(clip_ids), name=name,
+                                  out=str(out), seed=seed, make_default=make_default,
+                                  start_path=str(start_path) if start_path else None)
     start = _load_model(start_path)
 
     def work(progress):

@@ -66,9 +66,13 @@ with st.sidebar:
         if running or recent or stopped:
             st.caption("Background jobs")
         for j in running:
-            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
+            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}"
+                        + (" (cancelling)" if j.cancel_requested else ""))
+            if not j.cancel_requested:
+                st.button("Cancel", key=f"cancel_{j.id}", on_click=jobs.cancel, args=(j.id,), type="tertiary")
         for j in recent:
-            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
+            word = j.status if j.status in ("done", "cancelled") else "FAILED"
+            st.caption(f"{word}: {j.label}" +
                        (f" ({j.error})" if j.error else ""))
         for e in stopped:
             st.caption(f"INTERRUPTED: {e['label']} (the app stopped at {e['done']}/{e['total'] or '?'}; "

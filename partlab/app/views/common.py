@@ -62,6 +62,8 @@ def job_panel(kind: str, limit: int = 5, **meta) -> None:
                 ended = True
             if job.status == "done":
                 st.success(f"{job.label}: done" + (f" ({describe(job.result)})" if describe(job.result) else "."))
+            elif job.status == "cancelled":
+                st.info(f"{job.label}: cancelled (what it had stored stays).")
             else:
                 st.error(f"{job.label}: failed: {job.error}")
         if ended:
