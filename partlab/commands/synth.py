@@ -10,10 +10,12 @@ from partlab.cli import CommandError
 def add_arguments(p) -> None:
     p.add_argument("outdir", metavar="OUTDIR", help="directory to write clip.mp4, truth.csv, init.csv, scene.json")
     p.add_argument("--scenario", default="single",
-                   help="single, pair_cross, pillar, distractors, crowd, bend or desk (default: single)")
+                   help="single, pair_cross, pillar, distractors, crowd, bend or desk (default: single); "
+                        "topview_s1, topview_s2, topview_s3: a depth-and-colour take seen from the ceiling "
+                        "(one person in dark / bright clothes, two people whose arms cross; docs/trackers/topview.md)")
     p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same scene")
     p.add_argument("--frames", type=int, default=150, help="number of frames (default: 150, 6 s at 25 fps)")
-    p.add_argument("--size", default="720x480", help="frame size WIDTHxHEIGHT (default: 720x480)")
+    p.add_argument("--size", default=None, help="frame size WIDTHxHEIGHT (default: 720x480; 320x240 for topview_*)")
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -25,10 +27,13 @@ def _size(text: str) -> tuple[int, int]:
 
 def run(args) -> int:
     from partlab.labelling.synth import SCENARIOS, render_scenario
+    from partlab.labelling.synth.topview import TOPVIEW_SCENARIOS, render_topview
 
-    if args.scenario not in SCENARIOS:
-        raise CommandError(f"unknown scenario {args.scenario!r}; choose one of {', '.join(SCENARIOS)}")
-    width, height = _size(args.size)
+    if args.scenario not in SCENARIOS + TOPVIEW_SCENARIOS:
+        raise CommandError(f"unknown scenario {args.scenario!r}; choose one of "
+                           f"{', '.join(SCENARIOS + TOPVIEW_SCENARIOS)}")
+    topview = args.scenario in TOPVIEW_SCENARIOS
+    width, height = _size(args.size or ("320x240" if topview else "720x480"))
     if width < 64 or height < 48 or width % 2 or height % 2:
         raise CommandError(f"--size {width}x{height}: width and height must be even and at least 64x48")
     if args.frames < 1:
@@ -36,8 +41,9 @@ def run(args) -> int:
     if args.seed < 0:
         raise CommandError(f"--seed must be a non-negative integer, got {args.seed}")
     try:
-        out = render_scenario(args.scenario, args.outdir, seed=args.seed, n_frames=args.frames,
-                              width=width, height=height, progress=True)
+        render = render_topview if topview else render_scenario
+        out = render(args.scenario, args.outdir, seed=args.seed, n_frames=args.frames,
+                     width=width, height=height, progress=True)
     except (ValueError, OSError) as exc:  # e.g. OUTDIR is a file, or the disk is full
         raise CommandError(f"cannot write the scene to {args.outdir}: {exc}") from exc
     print(f"partlab synth: wrote {args.scenario} (seed {args.seed}, {args.frames} frames, {width}x{height}) to {out}")

@@ -117,3 +117,10 @@ register(TrackerEntry(
 register(TrackerEntry(
     "whole", "one box per person (Zhao & Lee's whole-body baseline, Fig. 4(d))",
     "partlab.tracking.body:build_whole", ("body",), ("person",)))
+
+register_parameters(ParameterEntry("topview", "partlab.tracking.topview.params:TopViewParams", rng_slot=17))  # 17: the issue number, clear of the other trackers' slots
+register(TrackerEntry(
+    "topview", "3D head, shoulders, elbows and hands of several people seen from above by a depth camera "
+    "(Migniot & Ababsa)", "partlab.tracking.topview:build", ("topview",),
+    ("head", "right_shoulder", "left_shoulder", "right_elbow", "left_elbow", "right_hand", "left_hand"),
+    needs=frozenset({"depth", "calibration"}), foreground=False))
