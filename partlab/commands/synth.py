@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 
-from partlab.cli import CommandError
+from partlab.cli import CommandError, seed
 
 
 def add_arguments(p) -> None:
@@ -13,7 +13,7 @@ def add_arguments(p) -> None:
                    help="single, pair_cross, pillar, distractors, crowd, bend or desk (default: single); "
                         "topview_s1, topview_s2, topview_s3: a depth-and-colour take seen from the ceiling "
                         "(one person in dark / bright clothes, two people whose arms cross; docs/trackers/topview.md)")
-    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same scene")
+    p.add_argument("--seed", type=seed, default=0, help="random seed; the same seed gives the same scene")
     p.add_argument("--frames", type=int, default=150, help="number of frames (default: 150, 6 s at 25 fps)")
     p.add_argument("--size", default=None, help="frame size WIDTHxHEIGHT (default: 720x480; 320x240 for topview_*)")
 
