@@ -188,5 +188,5 @@ def test_init_without_3d_joints_is_refused():
 def test_params_round_trip():
     p = TopViewParams(resampling=ResamplingParams(mode="global", n_particles=50))
     assert TopViewParams.from_dict(p.to_dict()) == p
-    with pytest.raises(ValueError, match="mode"):
+    with pytest.raises(ValueError, match="topview.resampling.mode"):
         TopViewParams(resampling=ResamplingParams(mode="both"))

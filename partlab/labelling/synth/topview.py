@@ -40,7 +40,7 @@ import pandas as pd
 from partlab.labelling.synth.background import smooth_noise
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
-from partlab.tracking.topview.model import (CYLINDER, JOINT_LIMITS, JOINTS, KINDS, N_DOF, PART_OF, PRIMITIVES,
+from partlab.tracking.topview.model import (JOINT_LIMITS, JOINTS, KINDS, N_DOF, PART_OF, PRIMITIVES,
                                             RECTANGLE, SPHERE, DOF, Body, joints, primitives)
 from partlab.tracking.tracks import TrackRecord, records_to_frame
 

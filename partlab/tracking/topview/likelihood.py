@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from partlab.tracking.core.kernels import _jit
-from partlab.tracking.topview.model import CYLINDER, KINDS, N_PARTS, PART_OF, RECTANGLE, SPHERE
+from partlab.tracking.topview.model import KINDS, N_PARTS, PART_OF, RECTANGLE, SPHERE
 
 
 @_jit(inline="always", fastmath=True)

@@ -30,6 +30,7 @@ an origin and an orthonormal frame, with ``kind`` per primitive (:data:`KINDS`):
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -226,6 +227,20 @@ def neutral_state(x: float, y: float, body: Body, yaw: float = 0.0) -> np.ndarra
 
 
 def fit_state(targets: dict[str, np.ndarray], body: Body, start: np.ndarray | None = None) -> np.ndarray:
+    """See :func:`_fit_state`; the same joints and body give the same state, fitted once."""
+    key = (tuple((k, tuple(np.round(np.asarray(v, np.float64), 3))) for k, v in sorted(targets.items())), body,
+           None if start is None else tuple(np.round(np.asarray(start, np.float64), 6)))
+    return np.array(_fit_cached(key))
+
+
+@lru_cache(maxsize=64)
+def _fit_cached(key) -> tuple[float, ...]:
+    targets = {k: np.array(v) for k, v in key[0]}
+    start = None if key[2] is None else np.array(key[2])
+    return tuple(_fit_state(targets, key[1], start))
+
+
+def _fit_state(targets: dict[str, np.ndarray], body: Body, start: np.ndarray | None = None) -> np.ndarray:
     """The state whose :func:`joints` best match ``targets`` (joint name -> ``(3,)`` mm; any subset
     of :data:`JOINTS`), by least squares (``scipy.optimize.least_squares``) from ``start`` (default:
     standing under the mean of the targets, facing the way the shoulders say)."""

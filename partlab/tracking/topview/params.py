@@ -6,7 +6,11 @@ here says where it comes from. Distances are millimetres, angles radians, per fr
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass
+from typing import ClassVar
+
+from partlab.tracking.core.params import (FRACTION, POSITIVE, POSITIVE_COUNT, Parameters, flag, group_field,
+                                          mapping, number, pair)
 
 
 @dataclass(frozen=True)
@@ -15,14 +19,14 @@ class RoiParams:
     torso, arm or head. Hands hang at about 0.45 of a person's height (720 mm for 1.6 m), a low
     basket or shelf board stays below 650 mm; the sensor measures 0.8..3.5 m (sec. 3)."""
 
-    min_height_mm: float = 650.0
-    max_height_mm: float = 2400.0
-    min_depth_mm: float = 800.0
-    max_depth_mm: float = 3500.0
+    min_height_mm: float = number(650.0)
+    max_height_mm: float = number(2400.0)
+    min_depth_mm: float = number(800.0)
+    max_depth_mm: float = number(3500.0)
     #: points per person given to the likelihood each frame, drawn at random from its ROI pixels
     #: (a person covers 3-6 thousand pixels at 320x240; 500 keep eq. 1's mean within ~2 mm of
     #: all of them and the frame within budget)
-    max_points: int = 500
+    max_points: int = number(500, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)
@@ -30,12 +34,12 @@ class DynamicsParams:
     """Random-walk propagation (sec. 2.2): per-frame standard deviations of each group of degrees
     of freedom. Arms move fastest (a reaching hand about 50 mm a frame), the pelvis slowest."""
 
-    position_mm: float = 12.0
-    yaw: float = 0.04
-    bend: float = 0.03
-    neck: float = 0.06
-    shoulder: tuple[float, float, float] = (0.10, 0.08, 0.10)  # flexion, abduction, twist
-    elbow: tuple[float, float] = (0.12, 0.10)                 # flexion, twist
+    position_mm: float = number(12.0)
+    yaw: float = number(0.04)
+    bend: float = number(0.03)
+    neck: float = number(0.06)
+    shoulder: tuple[float, float, float] = pair((0.10, 0.08, 0.10), n=3)  # flexion, abduction, twist
+    elbow: tuple[float, float] = pair((0.12, 0.10))               # flexion, twist
 
 
 @dataclass(frozen=True)
@@ -46,21 +50,21 @@ class LikelihoodParams:
     the differences between good and poor particles (a depth point on a misplaced forearm is
     30-80 mm off), so weights spread over about one e-fold per centimetre."""
 
-    distance_scale_mm: float = 5.0
+    distance_scale_mm: float = number(5.0, POSITIVE)
     #: pseudo-points of the whole model's mean distance added to each part's mean (eq. 3): a
     #: part with 20 points of its own is judged half by them, one with 200 almost only by them
-    prior_points: float = 20.0
-    use_colour: bool = True
+    prior_points: float = number(20.0)
+    use_colour: bool = flag(True)
     #: weight of the summed Bhattacharyya distances; a distance of 0.1 (a clearly different
     #: histogram) then costs as much as 5 mm of eq. 1
-    colour_weight: float = 0.5
+    colour_weight: float = number(0.5)
     #: partlab's free-space check (:func:`partlab.tracking.topview.likelihood.free_space`): the
     #: weight of a part's mean violation in the cost (0: the paper's eq. 1-2 alone) and its cap
     #: (a misplaced arm over the floor costs ``cap`` at most, as much as a point 100 mm off)
-    free_space_weight: float = 0.5
-    free_space_cap_mm: float = 100.0
+    free_space_weight: float = number(0.5)
+    free_space_cap_mm: float = number(100.0)
     #: colour histogram: levels per BGR channel (4 -> 64 bins: enough for clothes vs skin vs hair)
-    colour_levels: int = 4
+    colour_levels: int = number(4, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)
@@ -69,7 +73,13 @@ class ResamplingParams:
     shuffles them (eq. 3-4); ``global`` resamples whole particles by one weight (the "3D model")."""
 
     mode: str = "part"
-    n_particles: int = 200
+    n_particles: int = number(200, POSITIVE_COUNT)
+
+    def check(self, path: str) -> None:
+        if self.mode not in ("part", "global"):
+            raise ValueError(f"{path}.mode: must be 'part' or 'global', got {self.mode!r}")
+        if self.n_particles < 2:
+            raise ValueError(f"{path}.n_particles: must be at least 2, got {self.n_particles}")
 
 
 @dataclass(frozen=True)
@@ -77,7 +87,7 @@ class ExclusionParams:
     """Eq. (5): each ROI point goes to the person whose predicted model is nearest; points
     farther than this from every model belong to nobody (a newcomer, an object)."""
 
-    max_assign_mm: float = 250.0
+    max_assign_mm: float = number(250.0)
 
 
 @dataclass(frozen=True)
@@ -88,65 +98,39 @@ class StartParams:
     a person (one person at 2.9 m covers 3-6 % of a Kinect picture); its highest point is the top
     of the head. A person with fewer than ``min_points`` points for ``lost_after`` frames is dropped."""
 
-    min_person_fraction: float = 0.012
-    head_band_mm: float = 120.0
+    min_person_fraction: float = number(0.012, FRACTION)
+    head_band_mm: float = number(120.0)
     #: a blob's highest point starts a person only this high (1.2 m: a child's head, above any
     #: arm a grown-up holds at the side); the person is what lies this close to it, seen from
     #: above (a torso's half diagonal plus a bent arm)
-    min_head_height_mm: float = 1200.0
-    person_radius_mm: float = 450.0
+    min_head_height_mm: float = number(1200.0)
+    person_radius_mm: float = number(450.0)
     #: height from the top of a head down to the lowest point around it: at least the head and
     #: neck (about 270 mm) plus the shoulders' slope; a forearm held level spans less
-    min_person_span_mm: float = 350.0
-    min_points: int = 80
-    lost_after: int = 10
+    min_person_span_mm: float = number(350.0)
+    min_points: int = number(80, POSITIVE_COUNT)
+    lost_after: int = number(10, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)
 class OutputParams:
     """The joints' image boxes: a square this many mm across at the joint's depth."""
 
-    joint_box_mm: dict[str, float] = field(default_factory=lambda: {
+    joint_box_mm: dict[str, float] = mapping(lambda: {
         "head": 190.0, "right_shoulder": 120.0, "left_shoulder": 120.0, "right_elbow": 110.0,
-        "left_elbow": 110.0, "right_hand": 160.0, "left_hand": 160.0})
-
-
-_GROUPS = {"roi": RoiParams, "dynamics": DynamicsParams, "likelihood": LikelihoodParams,
-           "resampling": ResamplingParams, "exclusion": ExclusionParams, "start": StartParams,
-           "output": OutputParams}
+        "left_elbow": 110.0, "right_hand": 160.0, "left_hand": 160.0}, rule=POSITIVE)
 
 
 @dataclass(frozen=True)
-class TopViewParams:
+class TopViewParams(Parameters):
     """All of the top-view tracker's parameters (registry key ``topview``)."""
 
-    roi: RoiParams = field(default_factory=RoiParams)
-    dynamics: DynamicsParams = field(default_factory=DynamicsParams)
-    likelihood: LikelihoodParams = field(default_factory=LikelihoodParams)
-    resampling: ResamplingParams = field(default_factory=ResamplingParams)
-    exclusion: ExclusionParams = field(default_factory=ExclusionParams)
-    start: StartParams = field(default_factory=StartParams)
-    output: OutputParams = field(default_factory=OutputParams)
+    KEY: ClassVar[str] = "topview"
 
-    def __post_init__(self):
-        if self.resampling.mode not in ("part", "global"):
-            raise ValueError(f"resampling mode must be 'part' or 'global', got {self.resampling.mode!r}")
-        if self.resampling.n_particles < 2:
-            raise ValueError(f"n_particles must be at least 2, got {self.resampling.n_particles}")
-
-    def to_dict(self) -> dict:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: dict) -> "TopViewParams":
-        unknown = set(data) - set(_GROUPS)
-        if unknown:
-            raise ValueError(f"unknown topview parameter group(s): {', '.join(sorted(unknown))}")
-        out = {}
-        for name, sub in data.items():
-            group = _GROUPS[name]
-            bad = set(sub) - {f.name for f in fields(group)}
-            if bad:
-                raise ValueError(f"unknown topview {name} parameter(s): {', '.join(sorted(bad))}")
-            out[name] = group(**{k: tuple(v) if isinstance(v, list) else v for k, v in sub.items()})
-        return cls(**out)
+    roi: RoiParams = group_field(RoiParams)
+    dynamics: DynamicsParams = group_field(DynamicsParams)
+    likelihood: LikelihoodParams = group_field(LikelihoodParams)
+    resampling: ResamplingParams = group_field(ResamplingParams)
+    exclusion: ExclusionParams = group_field(ExclusionParams)
+    start: StartParams = group_field(StartParams)
+    output: OutputParams = group_field(OutputParams)

@@ -14,7 +14,7 @@ the hands' centres) and a box around the joint's image.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Mapping
 
 import cv2
