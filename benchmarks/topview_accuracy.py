@@ -210,13 +210,13 @@ def main(argv=None) -> int:
             print(f"s3 seed {seed} done", file=sys.stderr, flush=True)
             if args.json:
                 args.json.write_text(json.dumps(results, indent=1))
-    print(f"{args.seeds} seeds x {args.frames} frames at 320x240, started from the frame-0 truth; mean +- sd over seeds")
-    print(f"{'take / resampling / cue':28s} {'N':>4s} {'eps mm':>14s} {'cpu ms':>14s} {'wall ms':>14s} "
+    print(f"seeds 0.. x {args.frames} frames at 320x240, started from the frame-0 truth; mean +- sd over seeds")
+    print(f"{'take / resampling / cue':28s} {'N':>4s} {'seeds':>5s} {'eps mm':>14s} {'cpu ms':>14s} {'wall ms':>14s} "
           f"{'arm<80':>16s} {'frames<80':>16s} {'assign':>16s}")
     for key, rows in results.items():
         for n in sorted({r["n"] for r in rows}):
             sel = [r for r in rows if r["n"] == n]
-            print(f"{key:28s} {n:4d} {summary(sel, 'eps'):>14s} {summary(sel, 'cpu_ms'):>14s} "
+            print(f"{key:28s} {n:4d} {len(sel):5d} {summary(sel, 'eps'):>14s} {summary(sel, 'cpu_ms'):>14s} "
                   f"{summary(sel, 'wall_ms'):>14s} {summary(sel, 'arm80'):>16s} {summary(sel, 'frames80'):>16s} "
                   f"{summary(sel, 'assign') if key.startswith('S3') else '':>16s}")
     print("\nsurvival (distinct particles kept / N, mean over frames and seeds) at N =", args.default_particles)
@@ -226,21 +226,23 @@ def main(argv=None) -> int:
         if sel:
             s = np.mean([r["survival"] for r in sel], 0)
             print(f"{key:28s} " + " ".join(f"{v:10.3f}" for v in s))
-    # equal time: part-based at each count against global at the count of nearest CPU time
+    # equal time: each part-based count against the global count whose CPU time is nearest
     for scen in ("S1", "S2"):
         pk, gk = f"{scen} part colour", f"{scen} global colour"
-        if pk in results and gk in results:
-            wins = []
-            pe = {n: np.mean([r["eps"] for r in results[pk] if r["n"] == n]) for n in counts}
-            ge = {n: np.mean([r["eps"] for r in results[gk] if r["n"] == n]) for n in counts}
-            pt = {n: np.mean([r["cpu_ms"] for r in results[pk] if r["n"] == n]) for n in counts}
-            gt = {n: np.mean([r["cpu_ms"] for r in results[gk] if r["n"] == n]) for n in counts}
-            for n in counts:
-                per_seed = [a["eps"] < b["eps"] for a, b in zip([r for r in results[pk] if r["n"] == n],
-                                                                 [r for r in results[gk] if r["n"] == n])]
-                wins.append(f"N={n}: part {pe[n]:.1f} mm in {pt[n]:.0f} ms vs global {ge[n]:.1f} mm in {gt[n]:.0f} ms, "
-                            f"part lower on {sum(per_seed)}/{len(per_seed)} seeds")
-            print(f"\n{scen} equal particle counts: " + "; ".join(wins))
+        if pk not in results or gk not in results:
+            continue
+        ns = sorted({r["n"] for r in results[pk]})
+        by = {(k, n): [r for r in results[k] if r["n"] == n] for k in (pk, gk) for n in ns}
+        t = {key: np.mean([r["cpu_ms"] for r in rows]) for key, rows in by.items()}
+        lines = []
+        for n in ns:
+            m = min(ns, key=lambda m: abs(t[(gk, m)] - t[(pk, n)]))
+            pe = [r["eps"] for r in by[(pk, n)]]
+            ge = [r["eps"] for r in by[(gk, m)]]
+            lower = sum(a < b for a, b in zip(pe, ge))
+            lines.append(f"part N={n} {np.mean(pe):.1f} mm in {t[(pk, n)]:.0f} ms vs global N={m} {np.mean(ge):.1f} mm "
+                         f"in {t[(gk, m)]:.0f} ms: part lower on {lower}/{len(pe)} seeds")
+        print(f"\n{scen} at about equal CPU time:\n  " + "\n  ".join(lines))
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
     if args.plot:
