@@ -126,3 +126,11 @@ register(TrackerEntry(
     "partlab.tracking.depth:build", ("depth",),
     ("head", "left_hand", "right_hand", "torso", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow"),
     needs=frozenset({"color", "depth"}), foreground=False))
+
+# 17: the top-view tracker's issue number
+register_parameters(ParameterEntry("topview", "partlab.tracking.topview.params:TopViewParams", rng_slot=17))
+register(TrackerEntry(
+    "topview", "3D head, shoulders, elbows and hands of several people seen from above by a depth camera "
+    "(Migniot & Ababsa)", "partlab.tracking.topview:build", ("topview",),
+    ("head", "right_shoulder", "left_shoulder", "right_elbow", "left_elbow", "right_hand", "left_hand"),
+    needs=frozenset({"depth", "calibration"}), foreground=False))
