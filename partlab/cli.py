@@ -22,6 +22,7 @@ COMMANDS: dict[str, str] = {
     "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet)",
     "import": "import a dataset (mot, cvat, coco) as a tracks CSV",
     "synth": "render a synthetic scene with exact ground truth",
+    "calibrate": "calibrate cameras from chessboard clips (or import OpenCV/PETS XML) into calibration.json",
     "app": "start the Streamlit labelling app (headless)",
 }
 

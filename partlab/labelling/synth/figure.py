@@ -148,8 +148,12 @@ def _box_corners(u_top, hw_top, hd_top, u_bot, hw_bot, hd_bot) -> np.ndarray:
 
 
 def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False,
-                  long_hair: bool = False) -> list[_Solid]:
-    """The solids of the figure in image coordinates, sorted far to near."""
+                  long_hair: bool = False, anchors: dict | None = None) -> list[_Solid]:
+    """The solids of the figure in image coordinates, sorted far to near.
+
+    ``anchors``, when given, receives the floor offsets and height ``(dx, dz, u)`` (metres, the
+    view's floor frame) of the head's centre and of each hand's centre, keyed by part name: the
+    3D truth of the multi-camera scenes (:mod:`partlab.labelling.synth.multiview`)."""
     H = height_m
     F = np.array([np.cos(pose.facing), np.sin(pose.facing)])  # forward on the floor (X, Z)
     L = np.array([-F[1], F[0]])  # the person's left
@@ -229,6 +233,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         ay = view.s * H * np.hypot(ru, view.k * 0.3 * np.hypot(rl * Lh[1], rf * Fh[1]))
         return centre, (ax, ay), dz
 
+    if anchors is not None:
+        anchors["head"] = np.concatenate([np.ravel(v) for v in to_world(head_c)])
     hc, hax, hdz = head_ellipse(-0.012, 0.010, HEAD_RL * 1.06, HEAD_RF * 1.07, HEAD_RU * 0.9)
     head_depth = depth(head_c)
     solids.append(_Solid("ellipse", (hc, hax), HAIR, "head", head_depth + 0.001))
@@ -267,6 +273,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
             elbow = sh + UPPER_ARM * H * up
             wrist = elbow + FOREARM_LEN * H * fore
             hand = wrist + HAND_R * H * 0.9 * fore
+        if anchors is not None:
+            anchors[hand_part] = np.concatenate([np.ravel(v) for v in to_world(hand)])
         pts = project(np.stack([sh, elbow, wrist]))
         d = depth(np.stack([elbow, wrist]))
         arm_depths.append(d)
@@ -345,9 +353,11 @@ def _extent(solid: _Solid) -> np.ndarray:
     return np.concatenate([pts.min(0) - rm, pts.max(0) + rm])
 
 
-def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView) -> Figure:
-    """Draw one person: the label image and the part masks over its bounding region."""
-    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair)
+def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView, anchors: dict | None = None) -> Figure:
+    """Draw one person: the label image and the part masks over its bounding region
+    (``anchors``: see :func:`figure_solids`)."""
+    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair,
+                           anchors)
     ext = np.array([_extent(s) for s in solids])
     x1, y1 = np.floor(ext[:, :2].min(0)).astype(int) - 2
     x2, y2 = np.ceil(ext[:, 2:].max(0)).astype(int) + 2
