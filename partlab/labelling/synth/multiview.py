@@ -34,7 +34,7 @@ import pandas as pd
 from partlab.labelling.synth.appearance import Appearance, sample_appearances
 from partlab.labelling.synth.background import CameraEffects, smooth_noise
 from partlab.labelling.synth.figure import FIGURE_PARTS, HAND_R, PART_LABELS, FigurePose, colour_table, draw_figure
-from partlab.labelling.synth.motion import bump, clip_time
+from partlab.labelling.synth.motion import bump
 from partlab.labelling.synth.scene import SKIN_LABELS
 from partlab.tracking.camera import Camera
 from partlab.tracking.parts import PART_NAMES
@@ -164,6 +164,13 @@ class Script3D:
     objects: list = field(default_factory=list)  # (holder track per frame (T,), hand index, radius mm, BGR)
 
 
+def _story_time(n: int) -> np.ndarray:
+    """Each scenario's story takes 150 frames at 25 fps (a clap around frames 60-80, ...): frame
+    ``i`` is at story time ``i / 149``, so a shorter take is the story's beginning and moves at the
+    same speeds (a longer one goes on at rest)."""
+    return np.arange(n) / 149.0
+
+
 def _wander(rng, n, amp, lo=0.15, hi=0.45) -> np.ndarray:
     """A smooth random signal of amplitude about ``amp`` (two sines of random frequency and phase)."""
     t = np.arange(n) / FPS
@@ -194,7 +201,7 @@ def _people(rng, n: int) -> list[Appearance]:
 def _standing(rng, n) -> Script3D:
     (app,) = _people(rng, 1)
     H = app.height_m
-    t = clip_time(n)
+    t = _story_time(n)
     heading = np.full(n, rng.uniform(-np.pi, np.pi)) + _wander(rng, n, 0.35, 0.05, 0.15)
     pos = np.stack([_wander(rng, n, 60.0, 0.05, 0.2), _wander(rng, n, 60.0, 0.05, 0.2)], 1)
     hands = np.empty((n, 2, 3))
@@ -220,7 +227,7 @@ TABLE_COLOURS = ((150, 150, 148), (215, 215, 210), (120, 80, 50), (70, 110, 70))
 def _seated(rng, n) -> Script3D:
     (app,) = _people(rng, 1)
     H = app.height_m
-    t = clip_time(n)
+    t = _story_time(n)
     frames = np.arange(n)
     heading0 = rng.uniform(-np.pi, np.pi)
     heading = np.full(n, heading0)
@@ -255,7 +262,7 @@ def _seated(rng, n) -> Script3D:
 
 def _handshake(rng, n) -> Script3D:
     apps = _people(rng, 2)
-    t = clip_time(n)
+    t = _story_time(n)
     axis = rng.uniform(-np.pi, np.pi)  # the line between the two people
     gap = rng.uniform(1050, 1250)  # mm between their feet
     u = np.array([np.cos(axis), np.sin(axis)])
