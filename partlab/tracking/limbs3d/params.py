@@ -93,3 +93,10 @@ class Limbs3DParams:
     # automatic start (no --init): a head is the highest of a person's candidates, hands within
     # this horizontal radius of it; persons are assumed to face the cameras' centroid
     person_radius: float = 900.0
+
+    @property
+    def states(self) -> "Limbs3DParams":
+        """Where :class:`~partlab.tracking.limbs.state_machine.LimbStateMachine` reads its thresholds
+        (``params.states.lost_frames``, the grouped style of ``LimbParams``); here they are fields of
+        this object (the state-machine block above)."""
+        return self
