@@ -82,6 +82,8 @@ def _run_take(args, truth, tracks) -> int:
     with pd.option_context("display.width", 120, "display.float_format", "{:.3f}".format):
         if err is not None:
             print(f"3D error per part (mm, {path3d.name})\n{err}\n")
+        parts = set(tracks["part"])
         for cam, r in views.items():
-            print(f"view {cam}: tracking rate (rate_at = at frame offset {r.at})\n{r.summary}\n")
+            summary = r.summary[r.summary.index.isin(parts)]  # the parts this tracker writes
+            print(f"view {cam}: tracking rate (rate_at = at frame offset {r.at})\n{summary}\n")
     return 0

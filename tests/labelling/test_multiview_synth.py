@@ -51,3 +51,22 @@ def test_render_take_writes_a_take_the_trackers_can_open(tmp_path):
     assert set(truth["camera"]) == {"cam0", "cam1"} and truth["X"].notna().any()
     init = read_tracks_csv(out / "init.csv")
     assert set(init["frame"]) == {0} and set(init["track_id"]) == {1, 2}
+
+
+def test_limbs3d_runs_through_the_run_loop_and_refuses_one_view(tmp_path):
+    import pytest
+
+    from partlab.errors import UserError
+    from partlab.tracking.run import track
+
+    out = render_take("standing", tmp_path / "take", 2, seed=5, n_frames=3, width=320, height=240, chessboard=False)
+    take = open_take(out)
+    result = track(take, "limbs3d", init=read_tracks_csv(out / "init.csv"), seed=1)
+    rows = result.tracks
+    assert set(rows["camera"]) == {"cam0", "cam1"} and set(rows["frame"]) == {0, 1, 2}
+    assert set(rows["part"]) == {"head", "left_hand", "right_hand"} and rows["X"].notna().all()
+    again = track(open_take(out), "limbs3d", init=read_tracks_csv(out / "init.csv"), seed=1).tracks
+    assert rows.equals(again)  # the same seed, the same output
+    (out / "cam1.mp4").unlink()
+    with pytest.raises(UserError, match="at least 2 streams"):
+        track(open_take(out), "limbs3d", init=read_tracks_csv(out / "init.csv"))
