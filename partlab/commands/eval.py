@@ -1,4 +1,5 @@
-"""``partlab eval TRUTH.csv TRACKS.csv [--at 105] [--json] [--plot OUT.html] [--truth3d TRUTH3D.csv]``.
+"""``partlab eval TRUTH.csv TRACKS.csv [--at 105] [--json] [--plot OUT.html] [--truth3d TRUTH3D.csv]``, and
+``partlab eval TRUTH_EVENTS.csv EVENTS.csv --events``: per-kind precision and recall of activities.
 
 For a take of several views (truth and tracks with a ``camera`` column) the 2D rates are reported
 per view; with ``--truth3d`` (or a ``truth3d.csv`` beside TRUTH.csv) also the mean 3D error in mm
@@ -24,6 +25,11 @@ def add_arguments(p) -> None:
     p.add_argument("--truth3d", metavar="TRUTH3D.csv", default=None,
                    help="3D truth (frame,track_id,part,X,Y,Z mm): report the mean 3D error per part "
                         "(default: truth3d.csv beside TRUTH.csv when the tracks carry X,Y,Z)")
+    p.add_argument("--events", action="store_true",
+                   help="the two files are events (truth, then found: partlab track --events): per-kind "
+                        "precision and recall at temporal IoU >= --event-iou")
+    p.add_argument("--event-iou", type=float, default=0.5, metavar="IOU",
+                   help="temporal IoU an event needs to match the truth (default 0.5)")
 
 
 def _format(report) -> str:
@@ -40,7 +46,23 @@ def _format(report) -> str:
                 f"{mot}\n")
 
 
+def _run_events(args) -> int:
+    from partlab.labelling.events import evaluate_events, read_events
+
+    if not 0 < args.event_iou <= 1:
+        raise CommandError(f"--event-iou must be in (0, 1], got {args.event_iou}")
+    table = evaluate_events(read_events(args.truth), read_events(args.tracks), iou=args.event_iou)
+    if args.json:
+        print(table.reset_index().to_json(orient="records"))
+    else:
+        print(f"events matched at temporal IoU >= {args.event_iou:g} (same kind, one to one)\n"
+              f"{table.round(3).to_string()}")
+    return 0
+
+
 def run(args) -> int:
+    if args.events:
+        return _run_events(args)
     from partlab.labelling.evaluation import EvaluationError, evaluate, rate_curve_figure
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
 
