@@ -93,7 +93,8 @@ def find_corners(clip: Path, board: tuple[int, int]) -> tuple[dict[int, np.ndarr
         size = (video.width, video.height)
         for i, frame in video.frames(0, video.frame_count):
             gray = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
-            ok, corners = cv2.findChessboardCorners(gray, board, cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE)
+            flags = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
+            ok, corners = cv2.findChessboardCorners(gray, board, flags)
             if not ok:
                 continue
             corners = cv2.cornerSubPix(gray, corners, (5, 5), (-1, -1),

@@ -383,7 +383,7 @@ def error_3d(tracks: pd.DataFrame, truth3d: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("part")
 
 
-def evaluate_views(truth: pd.DataFrame, tracks: pd.DataFrame, at: int = DEFAULT_AT) -> dict[str, "EvaluationReport"]:
+def evaluate_views(truth: pd.DataFrame, tracks: pd.DataFrame, at: int = DEFAULT_AT) -> dict[str, EvaluationReport]:
     """Per view (``camera`` column), the 2D tracking-rate report of :func:`evaluate`."""
     out = {}
     for cam in sorted(set(truth["camera"]) - {""}):

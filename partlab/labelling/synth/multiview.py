@@ -115,7 +115,7 @@ class PinholeView:
     k: float
 
     @classmethod
-    def make(cls, camera: Camera, origin_mm, height_m: float) -> "PinholeView":
+    def make(cls, camera: Camera, origin_mm, height_m: float) -> PinholeView:
         o = np.asarray(origin_mm, float)
         ax = camera.R[0].copy()
         ax[2] = 0.0
@@ -290,7 +290,7 @@ def _handshake(rng, n) -> Script3D:
     meet = np.zeros((n, 3))
     meet[:, :2] = 0.22 * side
     meet[:, 2] = 0.6 * hmean
-    for k, (app, pos, hd, hands) in enumerate(actors_h):
+    for k, (_app, pos, hd, hands) in enumerate(actors_h):
         pos_m = pos / 1000.0
         target = _to_body(mid, pos_m, hd)
         hands[:, 1] = _blend(hands[:, 1], target, shake)  # the right hand (index 1) shakes
@@ -415,6 +415,46 @@ def _check(name: str, n_cameras: int, seed: int, n_frames: int, width: int, heig
         raise ValueError("seed must be >= 0, frames >= 1 and the size at least 64x48")
 
 
+def _part_rows(drawn, owner: np.ndarray, i: int, camera: str) -> list[tuple]:
+    """Truth rows of one view at frame ``i``: each drawn part's tight box and occluded fraction."""
+    rows = []
+    for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
+        own = owner[cy1:cy2, cx1:cx2]
+        lab = fig.labels[crop]
+        parts = {"person": lab > 0}
+        for p in FIGURE_PARTS:
+            if p in fig.masks:
+                whole = fig.masks[p][crop]
+                shown = whole & np.isin(lab, PART_LABELS[p])
+                parts[p] = shown if shown.any() else whole
+        for part, mask in parts.items():
+            total = int(mask.sum())
+            if total == 0:
+                continue
+            cs = np.flatnonzero(mask.any(axis=0))
+            rs = np.flatnonzero(mask.any(axis=1))
+            visible = int(np.count_nonzero(own[mask] == a + 1))
+            rows.append((i, a + 1, part, cx1 + cs[0], cy1 + rs[0], cs[-1] - cs[0] + 1, rs[-1] - rs[0] + 1,
+                         round(1.0 - visible / total, 4), camera))
+    return rows
+
+
+def _draw_carried(frame, owner, cam: Camera, view: PinholeView, anchors: dict, objects, track: int, i: int) -> None:
+    """Carried objects in front of the hand holding them (owner :data:`OBJECT_ID`)."""
+    height, width = owner.shape
+    for holder, hand, radius, colour in objects:
+        if holder[i] != track:
+            continue
+        part = LIMB_PARTS[1 + int(hand[i])]
+        X = view.world(*anchors[part])[0] + np.array([0.0, 0.0, 30.0])
+        uv, z = project(cam, X[None])
+        r = cam.K[0, 0] * radius / float(z[0])
+        mask = np.zeros((height, width), np.uint8)
+        cv2.circle(mask, tuple(int(round(v * 16)) for v in uv[0]), int(round(r * 16)), 1, -1, cv2.LINE_8, 4)
+        frame[mask > 0] = colour
+        owner[mask > 0] = OBJECT_ID
+
+
 def make_multiview_scene(name: str, n_cameras: int = 3, seed: int = 0, n_frames: int = 150, width: int = 640,
                          height: int = 480, *, clean: bool = False) -> MultiScene:
     """Render scenario ``name`` (:data:`SCENARIOS_3D`) from ``n_cameras`` cameras, deterministically."""
@@ -482,41 +522,13 @@ def make_multiview_scene(name: str, n_cameras: int = 3, seed: int = 0, n_frames:
                 frame[cy1:cy2, cx1:cx2][on] = np.clip(cols, 0, 255).astype(np.uint8)
                 owner[cy1:cy2, cx1:cx2][on] = a + 1
                 drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
-                for holder, hand, radius, colour in script.objects:  # a carried object in front of the hand
-                    if holder[i] != a + 1:
-                        continue
-                    part = LIMB_PARTS[1 + int(hand[i])]
-                    X = view.world(*anchors[part])[0] + np.array([0.0, 0.0, 30.0])
-                    uv, z = project(cam, X[None])
-                    r = cam.K[0, 0] * radius / float(z[0])
-                    mask = np.zeros((height, width), np.uint8)
-                    cv2.circle(mask, tuple(int(round(v * 16)) for v in uv[0]), int(round(r * 16)), 1, -1,
-                               cv2.LINE_8, 4)
-                    frame[mask > 0] = colour
-                    owner[mask > 0] = OBJECT_ID
+                _draw_carried(frame, owner, cam, view, anchors, script.objects, a + 1, i)
             for _, poly in front_faces:
                 m = np.zeros((height, width), np.uint8)
                 _fill(m, poly, 1)
                 frame[m > 0] = (wood * 0.7).astype(np.uint8)
                 owner[m > 0] = TABLE_ID
-            for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
-                own = owner[cy1:cy2, cx1:cx2]
-                lab = fig.labels[crop]
-                parts = {"person": lab > 0}
-                for p in FIGURE_PARTS:
-                    if p in fig.masks:
-                        whole = fig.masks[p][crop]
-                        shown = whole & np.isin(lab, PART_LABELS[p])
-                        parts[p] = shown if shown.any() else whole
-                for part, mask in parts.items():
-                    total = int(mask.sum())
-                    if total == 0:
-                        continue
-                    cs = np.flatnonzero(mask.any(axis=0))
-                    rs = np.flatnonzero(mask.any(axis=1))
-                    visible = int(np.count_nonzero(own[mask] == a + 1))
-                    rows.append((i, a + 1, part, cx1 + cs[0], cy1 + rs[0], cs[-1] - cs[0] + 1, rs[-1] - rs[0] + 1,
-                                 round(1.0 - visible / total, 4), cam.name))
+            rows += _part_rows(drawn, owner, i, cam.name)
             frame = np.clip(frame.astype(np.float32) * casts[ci], 0, 255).astype(np.uint8)
             out[i] = frame if effects is None else effects.apply(frame, i)
         frames[cam.name] = out
@@ -552,7 +564,8 @@ BOARD = (9, 6)  # inner corners (columns, rows): 10 x 7 squares, not symmetric u
 SQUARE_MM = 100.0
 
 
-def board_poses(rng: np.random.Generator, n_frames: int, facing: float | list[float]) -> list[tuple[np.ndarray, np.ndarray]]:
+def board_poses(rng: np.random.Generator, n_frames: int,
+                facing: float | list[float]) -> list[tuple[np.ndarray, np.ndarray]]:
     """Board poses ``(R, origin)`` (board -> world: ``X = R @ [x, y, 0] + origin``, mm).
 
     Frame 0 lies on the floor, first inner corner at the origin, rows along +X, columns along +Y:
@@ -640,7 +653,8 @@ def render_chessboard(cameras: list[Camera], outdir: str | PathLike, seed: int =
 def render_take(name: str, outdir: str | PathLike, n_cameras: int = 3, seed: int = 0, n_frames: int = 150,
                 width: int = 640, height: int = 480, *, chessboard: bool = True) -> Path:
     """Render a multi-camera take: ``<cam>.mp4`` per camera, ``calibration.json``, ``truth.csv`` (per
-    view, ``camera`` column), ``truth3d.csv``, ``init.csv``, ``scene.json``, ``<cam>_background.png`` (the empty scene, as the
+    view, ``camera`` column), ``truth3d.csv``, ``init.csv``, ``scene.json``, ``<cam>_background.png``
+    (the empty scene, as the
     paper's background model is trained on, sec. 6.1) and ``chessboard/``."""
     from partlab.labelling.calibration import write_calibration
     from partlab.labelling.video import write_video
@@ -658,7 +672,8 @@ def render_take(name: str, outdir: str | PathLike, n_cameras: int = 3, seed: int
     scene.truth3d.to_csv(out / "truth3d.csv", index=False, lineterminator="\n")
     meta = {"name": name, "seed": seed, "fps": scene.fps, "cameras": [c.name for c in scene.cameras],
             "width": width, "height": height, "n_frames": n_frames, "units": "mm",
-            "people": [{"track_id": k + 1, "skin": list(p.skin), "shirt": list(p.shirt), "height_m": round(p.height_m, 3)}
+            "people": [{"track_id": k + 1, "skin": list(p.skin), "shirt": list(p.shirt),
+                        "height_m": round(p.height_m, 3)}
                        for k, p in enumerate(scene.appearances)]}
     (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
     if chessboard:

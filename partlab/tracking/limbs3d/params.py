@@ -95,7 +95,7 @@ class Limbs3DParams:
     person_radius: float = 900.0
 
     @property
-    def states(self) -> "Limbs3DParams":
+    def states(self) -> Limbs3DParams:
         """Where :class:`~partlab.tracking.limbs.state_machine.LimbStateMachine` reads its thresholds
         (``params.states.lost_frames``, the grouped style of ``LimbParams``); here they are fields of
         this object (the state-machine block above)."""

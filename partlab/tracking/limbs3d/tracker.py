@@ -24,8 +24,8 @@ the others its hands by side.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Mapping
 
 import cv2
 import numpy as np
