@@ -23,6 +23,7 @@ COMMANDS: dict[str, str] = {
     "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet, labelstudio)",
     "import": "import a dataset (mot, cvat, coco, parquet, labelstudio) as a tracks CSV",
     "synth": "render a synthetic scene with exact ground truth",
+    "calibrate": "calibrate cameras from chessboard clips (or import OpenCV/PETS XML) into calibration.json",
     "app": "start the Streamlit labelling app (headless)",
     "serve-ml": "serve partlab as a Label Studio ML backend (predict part boxes, retrain from annotations)",
 }

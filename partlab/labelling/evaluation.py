@@ -342,3 +342,52 @@ def rate_curve_figure(report: EvaluationReport):
                       xaxis_title="frames after initialisation", yaxis_title="tracking rate",
                       yaxis_range=[0, 1.05], template="plotly_white")
     return fig
+
+
+# -- takes of several calibrated views ------------------------------------------------------------
+
+TRUTH3D_COLUMNS = ("frame", "track_id", "part", "X", "Y", "Z")
+
+
+def read_truth3d(path) -> pd.DataFrame:
+    """A ``truth3d.csv`` (``frame, track_id, part, X, Y, Z`` in mm); :class:`EvaluationError` names
+    the file and what is missing."""
+    try:
+        df = pd.read_csv(path)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise EvaluationError(f"{path}: cannot read a 3D truth table ({exc})") from None
+    missing = [c for c in TRUTH3D_COLUMNS if c not in df.columns]
+    if missing:
+        raise EvaluationError(f"{path}: a 3D truth table needs columns {', '.join(TRUTH3D_COLUMNS)}; "
+                              f"missing {', '.join(missing)}")
+    return df[list(TRUTH3D_COLUMNS)]
+
+
+def error_3d(tracks: pd.DataFrame, truth3d: pd.DataFrame) -> pd.DataFrame:
+    """Mean 3D error in mm per part (the multi-camera paper's protocol, sec. 8): tracked ``X, Y, Z``
+    against the truth at every frame both have, matched by ``track_id`` and part. Columns
+    ``frames, mean_mm, median_mm, p90_mm, within_100mm`` (fraction of frames under 10 cm); a
+    missed frame (truth but no estimate) counts in ``missed``."""
+    est = tracks.dropna(subset=["X", "Y", "Z"]).drop_duplicates(["frame", "track_id", "part"])
+    m = truth3d.merge(est[["frame", "track_id", "part", "X", "Y", "Z"]], on=["frame", "track_id", "part"],
+                      how="left", suffixes=("_t", ""))
+    m["err"] = np.linalg.norm(m[["X", "Y", "Z"]].to_numpy(float) - m[["X_t", "Y_t", "Z_t"]].to_numpy(float), axis=1)
+    rows = []
+    for part, g in m.groupby("part", sort=False):
+        e = g["err"].dropna()
+        rows.append({"part": part, "frames": int(len(e)), "missed": int(g["err"].isna().sum()),
+                     "mean_mm": float(e.mean()) if len(e) else float("nan"),
+                     "median_mm": float(e.median()) if len(e) else float("nan"),
+                     "p90_mm": float(e.quantile(0.9)) if len(e) else float("nan"),
+                     "within_100mm": float((e < 100).mean()) if len(e) else float("nan")})
+    return pd.DataFrame(rows).set_index("part")
+
+
+def evaluate_views(truth: pd.DataFrame, tracks: pd.DataFrame, at: int = DEFAULT_AT) -> dict[str, EvaluationReport]:
+    """Per view (``camera`` column), the 2D tracking-rate report of :func:`evaluate`."""
+    out = {}
+    for cam in sorted(set(truth["camera"]) - {""}):
+        t, k = truth[truth["camera"] == cam], tracks[tracks["camera"] == cam]
+        if len(k):
+            out[cam] = evaluate(t.reset_index(drop=True), k.reset_index(drop=True), at=at, matching="id")
+    return out
