@@ -8,16 +8,19 @@ import streamlit as st
 
 st.set_page_config(page_title="partlab", layout="wide")
 
-from partlab.app import jobs, state  # noqa: E402
-from partlab.app.demo import ensure_demo  # noqa: E402
-from partlab.app.views.common import bound_widget  # noqa: E402
+from partlab.app import jobs, prefs, state  # noqa: E402
+from partlab.app.demo import ensure_demo, track_demo  # noqa: E402
+from partlab.app.views.common import bound_widget, plain  # noqa: E402
 from partlab.labelling.config import data_dir  # noqa: E402
 
 
 @st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
 def _demo_ready(data: str) -> bool:
-    """Once per server process and data directory."""
-    return ensure_demo()
+    """Once per server process and data directory; the demo clips are tracked in the background."""
+    ready = ensure_demo()
+    if ready:
+        track_demo()
+    return ready
 
 
 _demo_ready(str(data_dir()))
@@ -49,6 +52,7 @@ with st.sidebar:
         st.page_link(page)
     st.divider()
     st.markdown("### partlab")
+    prefs.remember(store)  # this browser's project and name, across sessions
     projects = store.projects()
     if projects:
         state.project_id(store)
@@ -65,12 +69,12 @@ with st.sidebar:
         if running or recent or stopped:
             st.caption("Background jobs")
         for j in running:
-            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
+            st.progress(j.fraction, text=f"{plain(j.label)}: {j.done}/{j.total or '?'}")
         for j in recent:
-            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
+            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {plain(j.label)}" +
                        (f" ({j.error})" if j.error else ""))
         for e in stopped:
-            st.caption(f"INTERRUPTED: {e['label']} (the app stopped at {e['done']}/{e['total'] or '?'}; "
+            st.caption(f"INTERRUPTED: {plain(e['label'])} (the app stopped at {e['done']}/{e['total'] or '?'}; "
                        "start it again from its page)")
         if recent or stopped:
             st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
