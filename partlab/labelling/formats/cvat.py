@@ -5,8 +5,8 @@ One ``<track>`` per (person, part), labelled with the part name; ``group_id`` is
 CVAT). Every box we have is a keyframe; a box with ``outside="1"`` closes a track where
 its next exported frame has no box (CVAT would otherwise interpolate over the gap).
 ``occluded="1"`` when ``occluded > 0``; the exact fraction, ``failure``, ``source``,
-``score`` and ``state`` are per-frame attributes, so importing our own export gives
-back every box and flag. Foreign files: boxes with ``outside="1"`` are dropped, the
+``score`` and ``state`` are per-frame attributes (and ``camera``, ``X``, ``Y``, ``Z`` when some
+box has them), so importing our own export gives back every box and flag. Foreign files: boxes with ``outside="1"`` are dropped, the
 track's ``group_id - 1`` is the track id when it has one, else ids continue after the
 largest, and missing attributes take their defaults (``source`` is ``cvat`` for
 keyframes and ``interpolated`` otherwise).
@@ -28,6 +28,7 @@ from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_
 from partlab.labelling.formats.frames import all_frames, frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.tracks import has_take_columns
 
 NAME = "cvat"
 FILE_NAME = "annotations.xml"
@@ -42,13 +43,20 @@ ATTRIBUTES: dict[str, tuple[str, str, str]] = {
     "score": ("text", "", ""),
     "state": ("text", "", ""),
 }
+#: attributes of takes (the tracks CSV's camera, X, Y, Z), declared and written only when some box has them
+TAKE_ATTRIBUTES: dict[str, tuple[str, str, str]] = {
+    "camera": ("text", "", ""),
+    "X": ("text", "", ""),
+    "Y": ("text", "", ""),
+    "Z": ("text", "", ""),
+}
 
 
 def _num(v: float) -> str:
     return f"{float(v):.10g}"
 
 
-def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
+def _meta(root: ET.Element, info: VideoInfo, every: int, attributes: dict) -> None:
     meta = ET.SubElement(root, "meta")
     task = ET.SubElement(meta, "task")
     name = Path(info.path).stem if info.path else "partlab"
@@ -64,7 +72,7 @@ def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
         ET.SubElement(label, "color").text = COLOURS[part]
         ET.SubElement(label, "type").text = "rectangle"
         attrs = ET.SubElement(label, "attributes")
-        for attr_name, (input_type, default, values) in ATTRIBUTES.items():
+        for attr_name, (input_type, default, values) in attributes.items():
             a = ET.SubElement(attrs, "attribute")
             ET.SubElement(a, "name").text = attr_name
             ET.SubElement(a, "mutable").text = "True"
@@ -78,7 +86,7 @@ def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
     ET.SubElement(meta, "source").text = f"partlab, fps={_num(info.fps)}"
 
 
-def _box(track: ET.Element, r, *, outside: bool) -> None:
+def _box(track: ET.Element, r, *, outside: bool, take: bool) -> None:
     occluded = float(r.occluded)
     b = ET.SubElement(track, "box", {
         "frame": str(int(r.frame)), "keyframe": "1", "outside": "1" if outside else "0",
@@ -88,6 +96,9 @@ def _box(track: ET.Element, r, *, outside: bool) -> None:
     values = {"failure": "true" if bool(r.failure) else "false", "source": str(r.source),
               "occlusion": _num(occluded), "score": "" if math.isnan(r.score) else _num(r.score),
               "state": str(r.state)}
+    if take:
+        values.update(camera=str(r.camera), **{a: "" if math.isnan(getattr(r, a)) else _num(getattr(r, a))
+                                                for a in ("X", "Y", "Z")})
     for name, value in values.items():
         ET.SubElement(b, "attribute", {"name": name}).text = value
 
@@ -97,7 +108,8 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     root = ET.Element("annotations")
     ET.SubElement(root, "version").text = "1.1"
-    _meta(root, info, every)
+    take = has_take_columns(df)
+    _meta(root, info, every, ATTRIBUTES | TAKE_ATTRIBUTES if take else ATTRIBUTES)
     for cvat_id, ((track_id, part), rows) in enumerate(
             df.groupby(["track_id", "part"], sort=False)):
         track = ET.SubElement(root, "track", {"id": str(cvat_id), "label": part, "source": "manual",
@@ -105,11 +117,11 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
         rows = rows.sort_values("frame")
         frame_list = rows["frame"].to_numpy()
         for k, r in enumerate(rows.itertuples(index=False)):
-            _box(track, r, outside=False)
+            _box(track, r, outside=False, take=take)
             nxt = frame_list[k + 1] if k + 1 < len(frame_list) else None
             gap = int(r.frame) + every
             if (nxt is None or nxt != gap) and gap < info.frame_count:
-                _box(track, r._replace(frame=gap), outside=True)
+                _box(track, r._replace(frame=gap), outside=True, take=take)
     ET.indent(root, space="  ")
     ET.ElementTree(root).write(out_dir / FILE_NAME, encoding="utf-8", xml_declaration=True)
     if frames:  # a CVAT task holds every frame (meta size), thinned by --every
@@ -204,6 +216,8 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
                 "occluded": _attr_float(attrs.get("occlusion"), occluded_flag),
                 "state": attrs.get("state", ""),
                 "source": attrs.get("source") or ("cvat" if keyframe else "interpolated"),
+                "camera": attrs.get("camera", ""),
+                **{a: _attr_float(attrs.get(a), float("nan")) for a in ("X", "Y", "Z")},
             })
     df = finish_import(rows, skipped, str(xml))
     dup = df.duplicated(["frame", "track_id", "part"])

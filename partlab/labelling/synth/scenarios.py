@@ -40,9 +40,14 @@ class Occluder:
 
 @dataclass(frozen=True, eq=False)
 class Script:
+    """``objects``: carried objects (:class:`partlab.labelling.synth.activities.CarriedObject`);
+    ``events``: the activity truth (:class:`partlab.labelling.synth.activities.EventTruth`)."""
+
     actors: list[Actor]
     props: list[Prop] = field(default_factory=list)
     occluders: list[Occluder] = field(default_factory=list)
+    objects: list = field(default_factory=list)
+    events: list = field(default_factory=list)
 
 
 def _j(rng: np.random.Generator, scale: float) -> float:
