@@ -16,13 +16,14 @@ from partlab.app import state
 
 _JS = """
 const KEY = "partlab.prefs";
+const SENT = new WeakSet();
 export default function ({ data, setStateValue, parentElement }) {
   if (data && data.save) {
     try { localStorage.setItem(KEY, JSON.stringify(data.save)); } catch (e) { /* private mode */ }
     return;
   }
-  if (parentElement.dataset.sent) return;
-  parentElement.dataset.sent = "1";
+  if (SENT.has(parentElement)) return;
+  SENT.add(parentElement);
   let stored = {};
   try { stored = JSON.parse(localStorage.getItem(KEY) || "{}") || {}; } catch (e) { stored = {}; }
   setStateValue("stored", stored);

@@ -4,6 +4,8 @@ Run with ``partlab app`` (or ``make run``). Every page is a short script under
 ``app/views/`` that calls library functions; long work runs in :mod:`partlab.app.jobs`.
 """
 
+import os
+
 import streamlit as st
 
 st.set_page_config(page_title="partlab", layout="wide")
@@ -16,7 +18,10 @@ from partlab.labelling.config import data_dir  # noqa: E402
 
 @st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
 def _demo_ready(data: str) -> bool:
-    """Once per server process and data directory; the demo clips are tracked in the background."""
+    """Once per server process and data directory; the demo clips are tracked in the background.
+    ``PARTLAB_DEMO=0`` leaves the demo out (a shared server, or a test that measures speed)."""
+    if os.environ.get("PARTLAB_DEMO", "1") == "0":
+        return False
     ready = ensure_demo()
     if ready:
         track_demo()
