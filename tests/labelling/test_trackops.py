@@ -135,3 +135,24 @@ def test_retrack_replaces_only_the_tracks_asked_and_is_undone_as_one_step(clip):
         store.undo_run(c.id, run - 1)
     store.undo_run(c.id, run)
     pd.testing.assert_frame_equal(store.tracks(c.id), before)
+
+
+def test_review_verdicts_limit_the_export_to_accepted_frames(clip, tmp_path):
+    from partlab.labelling import formats
+
+    store, c = clip
+    store.review(c.id, 1, 0, 29, True)
+    store.review(c.id, 2, 10, 19, True)
+    rid = store.review(c.id, 1, 20, 24, False)  # newer: frames 20-24 of track 1 rejected
+    acc = store.accepted(c.id)
+    assert len(acc) == 25 + 10 and not ((acc.track_id == 1) & acc.frame.between(20, 24)).any()
+    assert store.accepted_frames(c.id) == list(range(0, 20)) + list(range(25, 30))
+    assert store.progress(c.id)["accepted_frames"] == 25
+    out = formats.export_clip(store, c.id, "mot", tmp_path / "mot", frames=False, accepted_only=True)
+    mot = pd.read_csv(next(out.rglob("gt.txt")), header=None).iloc[:, :2].set_axis(["frame", "id"], axis=1)
+    track = mot.id // 10  # MOT ids are track * 10 + part
+    assert mot.groupby(track).frame.nunique().to_dict() == {1: 25, 2: 10}
+    store.undo_review(c.id, rid)
+    assert store.progress(c.id)["accepted_frames"] == 30
+    with pytest.raises(StoreError, match="not a range"):
+        store.review(c.id, 1, 50, 70, True)

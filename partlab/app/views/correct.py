@@ -133,7 +133,7 @@ def editor_panel() -> None:
     version = s.data_version(clip.id)
     data = clip_boxes(s.url, clip.id, version)
     for message in st.session_state.pop("correct_messages", []):
-        (st.error if message.startswith("Not saved") else st.info)(message)
+        (st.error if message.startswith("Not saved") else st.info)(plain(message))
     try:
         cache = frame_cache(str(clip.path))
         cache.url(frame)
@@ -236,7 +236,7 @@ with tab_retrack:
             job = start_tracking(s, clip, tracker=tracker, start=frame, retrack=True, track_id=only,
                                  bundle_path=next((b.path for b in s.bundles(project.id)
                                                    if b.id == project.default_bundle_id), None))
-            st.success(f"Started: {job.label}")
+            st.success(f"Started: {plain(job.label)}")
         except (RuntimeError, ValueError) as exc:
             st.error(str(exc))
     if lacking:

@@ -76,7 +76,8 @@ if not clips:
     st.stop()
 rows = [dict(id=c.id, thumbnail=thumbnail(str(c.path), c.sha256), name=c.name, frames=c.frame_count,
              seconds=round(c.frame_count / c.fps, 1) if c.fps else None, fps=round(c.fps, 2),
-             size=f"{c.width}x{c.height}", state=clip_state(s, c)) for c in clips]
+             size=f"{c.width}x{c.height}", state=clip_state(s, c),
+             accepted=f"{s.progress(c.id)['accepted_frames']} of {c.frame_count}") for c in clips]
 st.dataframe(pd.DataFrame(rows), hide_index=True, width="stretch", row_height=70,
              column_config={"thumbnail": st.column_config.ImageColumn("thumbnail", width="small")})
 st.caption("Pick a clip on the Track or Correct page; new uploads become the current clip.")
