@@ -84,7 +84,10 @@ def main() -> None:
             browser.close()
     finally:
         proc.terminate()
-        proc.wait(10)
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
           f"(commit {subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True, text=True, cwd=ROOT).stdout.strip()})")
 
@@ -106,7 +109,7 @@ def run(page, url: str, shots: bool, rep: int) -> None:
         page.wait_for_timeout(60)
     shown = ev(page, "e.stats.shown.map((x) => x[1])")
     page.select_option(".pl-speed", "25")
-    page.wait_for_function("() => window.partlabEditor.frames.size >= 90")
+    page.wait_for_function("() => window.partlabEditor.frames.size >= 60")
     page.locator(".pl-frame").click()
     page.keyboard.press(" ")
     page.wait_for_timeout(4000)

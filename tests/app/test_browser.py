@@ -40,7 +40,8 @@ def _free_port() -> int:
 @pytest.fixture
 def server(tmp_path):
     port = _free_port()
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    # no demo project: tests/app/test_demo.py covers it, and rendering it would slow every first page
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), PARTLAB_DEMO="0")
     log = open(tmp_path / "server.log", "w")
     proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=log,
                             stderr=subprocess.STDOUT)
@@ -288,34 +289,9 @@ def _people_clip(tmp_path):
 
 
 @pytest.fixture
-def quiet_server(tmp_path, monkeypatch):
+def quiet_server(server):
     """The app without the demo project (nothing renders or tracks while we measure)."""
-    monkeypatch.setenv("PARTLAB_DEMO", "0")
-    yield from server.__wrapped__(tmp_path) if hasattr(server, "__wrapped__") else _serve(tmp_path)
-
-
-def _serve(tmp_path):
-    port = _free_port()
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    log = open(tmp_path / "server.log", "w")
-    proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=log,
-                            stderr=subprocess.STDOUT)
-    url = f"http://127.0.0.1:{port}"
-    try:
-        for _ in range(300):
-            try:
-                if urllib.request.urlopen(url + "/_stcore/health", timeout=1).status == 200:
-                    break
-            except OSError:
-                time.sleep(0.1)
-        yield url, proc
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-        log.close()
+    return server
 
 
 def _editor(page, expr: str):

@@ -71,7 +71,7 @@ def pack_boxes(boxes: pd.DataFrame, parts: tuple[str, ...] = PART_NAMES) -> dict
     rev = boxes["revision"].to_numpy() if "revision" in boxes else np.zeros(len(boxes), int)
     cols = zip(boxes["frame"].to_numpy().tolist(), boxes["track_id"].to_numpy().tolist(),
                boxes["part"].map(index).fillna(-1).astype(int).tolist(),
-               *(np.round(boxes[c].to_numpy(float), 2).tolist() for c in ("x", "y", "w", "h")),
+               *(boxes[c].to_numpy(float).tolist() for c in ("x", "y", "w", "h")),  # exact: a move keeps the size
                flags.tolist(), np.round(boxes["occluded"].to_numpy(float), 3).tolist(), rev.tolist())
     out: dict[int, list[list]] = {}
     for f, t, p, x, y, w, h, fl, o, r in cols:
