@@ -98,7 +98,7 @@ def pick_place(rng, camera, n_frames, fps) -> Script:
     hands = np.repeat(rest[None], n, axis=0)
     # the right hand (image left) picks the box at p1 and places it at p2, stopping a moment at each
     p1 = np.array([-0.55 + _j(rng, 0.05), 0.5 + _j(rng, 0.05), desk_h + 1.2 * hr])
-    p2 = np.array([-0.15 + _j(rng, 0.05), 0.62 + _j(rng, 0.04), desk_h + 1.2 * hr])
+    p2 = np.array([-0.3 + _j(rng, 0.04), 0.82 + _j(rng, 0.03), desk_h + 1.2 * hr])
     a0, a1 = 0.18 + _j(rng, 0.02), 0.36 + _j(rng, 0.02)  # at p1 between these (reach in, still, ...)
     b0, b1 = 0.58 + _j(rng, 0.02), 0.76 + _j(rng, 0.02)  # at p2
     w1 = bump(t, a0, a1, ramp=0.06)
@@ -123,9 +123,9 @@ def pick_place(rng, camera, n_frames, fps) -> Script:
     yaw = -0.4 * np.maximum(w1, w2) + 0.2 * np.sin(2 * np.pi * np.arange(n) / (fps * 4.0) + rng.uniform(0, 6.3))
     motion = Motion(x=zeros.copy(), z=np.full(n, 3.0), facing=np.full(n, -np.pi / 2), phase=zeros.copy(),
                     gait=zeros.copy(), wave=zeros.copy(), bend=zeros.copy(), head_yaw=yaw, hands=hands, seated=True)
-    # truth: the still moment at each place, where the paper's climax point lies
-    events = [EventTruth("pick", _frame(a0 + 0.04, n), _frame(a1 - 0.02, n), 1, "right_hand", colour=colour),
-              EventTruth("place", _frame(b0 + 0.04, n), _frame(b1 - 0.02, n), 1, "right_hand", colour=colour)]
+    # truth: the still moment at each place (the hand at the object), where the paper's climax point lies
+    events = [EventTruth("pick", _frame(a0, n), _frame(a1, n), 1, "right_hand", colour=colour),
+              EventTruth("place", _frame(b0, n), _frame(b1, n), 1, "right_hand", colour=colour)]
     return Script([Actor(app, motion, view=view, seat_cut=seat_cut)], props=props, objects=[obj], events=events)
 
 
@@ -135,7 +135,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
     b = replace(b, height_m=float(rng.uniform(1.62, 1.80)))
     n = n_frames
     t = clip_time(n)
-    z = 5.6 + _j(rng, 0.3)
+    z = 4.6 + _j(rng, 0.2)
     gap = 0.62 + _j(rng, 0.04)  # metres between the two people's feet
     xa, xb = -gap / 2 + _j(rng, 0.05), gap / 2 + _j(rng, 0.05)
     # a faces +x (image right), b faces -x: each one's right hand is on the camera's side for one of them
@@ -149,7 +149,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
         # both hands rest low at the sides when not reaching (NaN = free swing would change their look)
         hands[:, 0] = (0.2 * H, 0.02, 0.5 * H)
         hands[:, 1] = (-0.2 * H, 0.02, 0.5 * H)
-        reach = np.array([-0.05, gap / 2 - 0.06, meet_u])  # the right hand meets the other's in the middle
+        reach = np.array([-0.02, gap / 2 - 0.01, meet_u])  # the right hands meet in the middle
         hands[:, 1] = hands[:, 1] * (1 - w)[:, None] + reach[None] * w[:, None]
         if not with_object:  # a shake: small up-down movements while together
             hands[:, 1, 2] += 0.03 * np.sin(2 * np.pi * 3 * np.clip((t - t0) / (t1 - t0), 0, 1)) * w
@@ -159,7 +159,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
 
     actors = [Actor(a, motion(a, xa, 0.0)), Actor(b, motion(b, xb, np.pi))]
     objects, events = [], []
-    start, end = _frame(t0 + 0.03, n), _frame(t1 - 0.03, n)
+    start, end = _frame(t0, n), _frame(t1, n)  # the hands together
     if with_object:
         colour = _object_colour(rng)
         holder = np.full(n, 1)  # a's right hand, then b's right hand from the middle of the meeting
@@ -184,7 +184,7 @@ def clap(rng, camera, n_frames, fps) -> Script:
     H = app.height_m
     n = n_frames
     t = clip_time(n)
-    z = 5.2 + _j(rng, 0.3)
+    z = 4.4 + _j(rng, 0.2)
     x = _j(rng, 0.4)
     hands = np.full((n, 2, 3), np.nan)
     hands[:, 0] = (0.2 * H, 0.03, 0.5 * H)
@@ -193,7 +193,7 @@ def clap(rng, camera, n_frames, fps) -> Script:
     c = bump(t, t0, t1, ramp=0.06)
     u = np.clip((t - t0) / (t1 - t0), 0, 1)
     hr = HAND_R * H
-    sep = hr * 1.05 + 0.12 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))
+    sep = hr * 0.8 + 0.12 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))  # the palms touch three times
     chest = 0.72 * H + _j(rng, 0.03)
     together = np.stack([np.stack([sep, np.full(n, 0.3), np.full(n, chest)], 1),
                          np.stack([-sep, np.full(n, 0.3), np.full(n, chest)], 1)], 1)
@@ -201,7 +201,7 @@ def clap(rng, camera, n_frames, fps) -> Script:
     zeros = np.zeros(n)
     m = Motion(x=np.full(n, x), z=np.full(n, z), facing=np.full(n, -np.pi / 2), phase=zeros.copy(),
                gait=zeros.copy(), wave=zeros.copy(), bend=zeros.copy(), head_yaw=zeros.copy(), hands=hands)
-    events = [EventTruth("clap", _frame(t0 + 0.03, n), _frame(t1 - 0.03, n), 1, "left_hand", 1, "right_hand")]
+    events = [EventTruth("clap", _frame(t0, n), _frame(t1, n), 1, "left_hand", 1, "right_hand")]
     return Script([Actor(app, m)], events=events)
 
 

@@ -104,21 +104,20 @@ def hand_colour(frame: np.ndarray, foreground: np.ndarray | None, hand: Box, par
     d2 = (xx + 0.5 - cx) ** 2 + (yy + 0.5 - cy) ** 2
     disk = d2 <= R * R
     boundary = disk & (d2 >= (R - 1.5) ** 2)
-    if foreground is not None:
-        fg = foreground[y0:y1, x0:x1] > 0
+    fg = None if foreground is None else foreground[y0:y1, x0:x1] > 0
+    hx0, hy0 = max(0, int(hand.x) - x0), max(0, int(hand.y) - y0)
+    hx1, hy1 = min(x1 - x0, int(np.ceil(hand.x + hand.w)) - x0), min(y1 - y0, int(np.ceil(hand.y + hand.h)) - y0)
+    if fg is not None and fg[hy0:hy1, hx0:hx1].mean() >= 0.3:
         inside = disk & fg
         n, labels = cv2.connectedComponents(inside.astype(np.uint8), connectivity=8)
-        # the silhouette region holding the hand: the label under the hand's centre, or the largest
-        # one touching the hand's box when the centre pixel is not foreground
-        hx0, hy0 = max(0, int(hand.x) - x0), max(0, int(hand.y) - y0)
-        hx1, hy1 = min(x1 - x0, int(np.ceil(hand.x + hand.w)) - x0), min(y1 - y0, int(np.ceil(hand.y + hand.h)) - y0)
+        # the silhouette region holding the hand: the label most of the hand's box is in
         under = labels[hy0:hy1, hx0:hx1]
         under = under[under > 0]
         region = labels == np.bincount(under).argmax() if under.size else inside
         rho = float((~fg[boundary]).mean()) if boundary.any() else 1.0
-    else:
+    else:  # no silhouette here (a person standing still fades into the background model)
         region = disk
-        rho = 1.0
+        rho = 0.5
     rho += params.reliability.rho_min
     hsv = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)
     hues, sat, val = hsv[..., 0], hsv[..., 1], hsv[..., 2]
@@ -141,6 +140,25 @@ def hand_colour(frame: np.ndarray, foreground: np.ndarray | None, hand: Box, par
             keep |= _hue_distance(np.arange(HUE_BINS), m) <= reach
         shares = np.where(keep, hist, 0.0)
     return HandColour(shares, rho)
+
+
+def body_colours(frame: np.ndarray, foreground: np.ndarray | None, head: Box, params: ActivityParams) -> np.ndarray:
+    """``(180,)`` hue shares of the person's clothes: the silhouette's saturated, non-skin pixels in
+    the region below the head (chest and arms). A colour the person wears is not an object they
+    hold: the paper removes the sleeve through eq. 28's boundary vector; we remove every colour of
+    the clothes (an object of the shirt's own hue is then not seen, a limitation docs/ states)."""
+    H, W = frame.shape[:2]
+    x0, x1 = int(max(0, head.x - 0.8 * head.w)), int(min(W, head.x + 1.8 * head.w))
+    y0, y1 = int(max(0, head.y + 1.1 * head.h)), int(min(H, head.y + 3.6 * head.h))
+    if x1 - x0 < 3 or y1 - y0 < 3:
+        return np.zeros(HUE_BINS)
+    crop = frame[y0:y1, x0:x1]
+    hsv = cv2.cvtColor(crop, cv2.COLOR_BGR2HSV)
+    ok = (hsv[..., 1] >= params.region.min_saturation) & (hsv[..., 2] >= params.region.min_value)
+    ok &= _skin_model().mask(crop) == 0
+    if foreground is not None and (foreground[y0:y1, x0:x1] > 0).mean() >= 0.2:
+        ok &= foreground[y0:y1, x0:x1] > 0
+    return np.bincount(hsv[..., 0][ok].ravel(), minlength=HUE_BINS).astype(np.float64) / max(crop.shape[0] * crop.shape[1], 1)
 
 
 def fuse(observations: list[HandColour]) -> np.ndarray:

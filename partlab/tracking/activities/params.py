@@ -39,6 +39,9 @@ class Modes:
     min_pixels: int = number(10, POSITIVE_COUNT)
     # a mode within this many degrees of the hand's own skin hue is skin, not an object
     skin_margin: float = number(14.0)
+    # a colour covering at least this share of the region below the person's head (their clothes,
+    # averaged over the run) is not taken for an object
+    clothes_share: float = number(0.04, FRACTION)
 
 
 @dataclass(frozen=True)
@@ -59,10 +62,27 @@ class Decision:
     gap: int = number(3, POSITIVE_COUNT)
     # a colour is held at a decision point when its share of the fused distribution is at least this
     min_mass: float = number(0.12, FRACTION)
-    # ... and not held when it is below this (between the two: unknown, no decision from that colour)
+    # ... and not held when it is below this, or below ``absent_ratio`` of its share at the other
+    # decision point (the object already near the hand before it is picked up); between: no decision
     max_mass_absent: float = number(0.04, FRACTION)
+    absent_ratio: float = number(0.25, FRACTION)
     # two modes within this many degrees are the same colour (an object seen before and after)
     same_colour: float = number(10.0, POSITIVE)
+    # the decision points of a two-hand activity are where the hands are this many hand sides apart
+    # (the paper: "separated by a minimum pre-defined distance"), searched up to ``apart_search``
+    # frames before the join and after the separation
+    apart_size: float = number(3.0, POSITIVE)
+    apart_search: int = number(40, POSITIVE_COUNT)
+    # two hands touch when their centres are at most this many hand sides apart: what the state
+    # machine's combined state means (its ``combine_size`` is 1.3), read from the tracks themselves so
+    # that a touch the state machine saw as one hand lost still counts
+    contact_size: float = number(1.5, POSITIVE)
+    # joins of the same two hands this close in time are one activity (three claps, a shake with
+    # a few contacts): frames between one separation and the next join
+    merge_gap: int = number(30, POSITIVE_COUNT)
+    # activities less sure than this are not reported (a hand unseen at a decision point: Table 1
+    # needs both; colour around both hands that keeps a two-hand touch from being read)
+    min_confidence: float = number(0.4, FRACTION)
     # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
     # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
     still_speed: float = number(0.05, POSITIVE)

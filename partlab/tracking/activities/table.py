@@ -42,8 +42,13 @@ def _mass(held: dict[int, float], hue: int, params: ActivityParams) -> float:
 def _margin(present: list[float], absent: list[float], params: ActivityParams) -> float:
     d = params.decision
     up = min((m - d.min_mass) / max(1e-9, 1 - d.min_mass) for m in present)
-    down = min((d.max_mass_absent - m) / max(1e-9, d.max_mass_absent) for m in absent)
+    down = min(1.0 - m / max(1e-9, max(d.max_mass_absent, d.absent_ratio * max(present))) for m in absent)
     return float(max(0.0, min(1.0, 0.5 * (up + down) + 0.5)))
+
+
+def _absent(m: float, present: float, params: ActivityParams) -> bool:
+    """Not held: below ``max_mass_absent``, or a small fraction of what the other point holds."""
+    return m <= max(params.decision.max_mass_absent, params.decision.absent_ratio * present)
 
 
 def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same_person: bool,
@@ -55,8 +60,8 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
             if m < d.min_mass:
                 continue
             gained = _mass(dst_a, hue, params)
-            if (gained >= d.min_mass and _mass(dst_b, hue, params) <= d.max_mass_absent
-                    and _mass(src_a, hue, params) <= d.max_mass_absent):
+            if (gained >= d.min_mass and _absent(_mass(dst_b, hue, params), gained, params)
+                    and _absent(_mass(src_a, hue, params), m, params)):
                 return Verdict("exchange", hue, _margin([m, gained], [_mass(dst_b, hue, params),
                                                                         _mass(src_a, hue, params)], params))
     held = [m for t in (a_before, b_before, a_after, b_after) for m in t.values()]
@@ -71,12 +76,12 @@ def one_hand(before: dict, after: dict, params: ActivityParams) -> Verdict | Non
     best = None
     for hue, m in after.items():
         was = _mass(before, hue, params)
-        if m >= d.min_mass and was <= d.max_mass_absent:
+        if m >= d.min_mass and _absent(was, m, params):
             v = Verdict("pick", hue, _margin([m], [was], params))
             best = v if best is None or v.margin > best.margin else best
     for hue, m in before.items():
         now = _mass(after, hue, params)
-        if m >= d.min_mass and now <= d.max_mass_absent:
+        if m >= d.min_mass and _absent(now, m, params):
             v = Verdict("place", hue, _margin([m], [now], params))
             best = v if best is None or v.margin > best.margin else best
     return best
