@@ -62,12 +62,14 @@ def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
 
 def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path: str | Path | None = None,
                    seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False,
-                   init: pd.DataFrame | None = None) -> jobs.Job:
+                   init: pd.DataFrame | None = None, track_id: int | None = None) -> jobs.Job:
     """Track a clip in the background and store the result as a tracker run.
 
-    With ``retrack``, the tracker starts from the effective boxes at frame ``start``
-    (the user's fix) and runs to the next human-corrected frame or the end; tracker
-    boxes of other frames and every human edit stay as they are. With
+    With ``retrack``, the tracker runs between the keyframes around frame ``start``
+    (:func:`partlab.labelling.trackops.retrack_window`; only ``track_id`` when given) from
+    the effective boxes at the first of them, and replaces the boxes of those tracks in
+    that range only; every other track, every human edit and every other frame stay as
+    they are, and ``Store.undo_run`` takes the run back as one step. With
     ``init_from_boxes``, a whole-clip run starts from the stored boxes of frame
     ``start`` instead of detecting people; ``init`` gives such boxes directly (e.g. a
     synthetic scene's init.csv).
@@ -75,14 +77,20 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     from partlab.app import pipeline
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
-    stop = None
+    stop, track_ids = None, None
+    if retrack:
+        from partlab.labelling.trackops import retrack_window
+
+        start, stop, track_ids = retrack_window(store, clip.id, start, track_id)
+        if not track_ids:
+            raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
     if retrack or init_from_boxes:
         init = store.frame_boxes(clip.id, start)
         if not len(init):
             raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
         init = init.drop(columns=["revision"], errors="ignore")
-    if retrack:
-        stop = next_human_frame(store, clip.id, start)
+        if track_ids is not None:
+            init = init[init.track_id.isin(track_ids)]
     occluders = tuple(store.occluders(clip.id))
     what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
         else f"track {clip.name} ({tracker})"
@@ -99,9 +107,12 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
         df = pipeline.track_video(str(clip.path), tracker=tracker, init=init, model=model, occluders=occluders,
                                   seed=seed, progress=progress, start=start, stop=stop)
         run_id = store.save_tracker_run(clip.id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
-                                        start_frame=start, stop_frame=stop)
-        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
+                                        start_frame=start, stop_frame=stop, track_ids=track_ids)
+        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop, track_ids=track_ids)
 
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") \
+        + (f" (tracks {', '.join(map(str, track_ids))})" if track_ids else "") if retrack \
+        else f"track {clip.name} ({tracker})"
     return jobs.submit("track", what, work, clip_id=clip.id, project_id=clip.project_id)
 
 
