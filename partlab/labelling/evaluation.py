@@ -377,3 +377,96 @@ def rate_curve_figure(report: EvaluationReport):
                       xaxis_title="frames after initialisation", yaxis_title="tracking rate",
                       yaxis_range=[0, 1.05], template="plotly_white")
     return fig
+
+
+# -- annotation effort ---------------------------------------------------------------------------
+
+EDIT_IOU = 0.5  # a proposal on a truth box at IoU >= 0.5 needs no correction
+
+
+@dataclass(frozen=True)
+class EditCount:
+    """What correcting proposals into the truth costs (one part, e.g. ``person``).
+
+    ``edits``: per frame ``max(truth boxes, proposals) - proposals matched to a truth box at
+    IoU >= 0.5`` (one-to-one, Hungarian): a wrong box is moved once, a missing one drawn, a
+    spurious one deleted; plus every keyframe box the annotator drew. ``per_100``: edits per 100
+    truth boxes; ``moved``, ``drawn``, ``deleted`` split the corrections, ``keyframes`` the boxes
+    drawn before the proposals were made.
+    """
+
+    edits: int
+    truth_boxes: int
+    keyframes: int
+    moved: int
+    drawn: int
+    deleted: int
+
+    @property
+    def per_100(self) -> float:
+        return 100.0 * self.edits / self.truth_boxes if self.truth_boxes else float("nan")
+
+
+def count_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = "person",
+                keyframes: int = 0, threshold: float = EDIT_IOU) -> EditCount:
+    """Corrections that turn ``proposals`` into ``truth`` for ``part`` (see :class:`EditCount`).
+
+    ``keyframes``: boxes the annotator drew by hand to make the proposals (the init boxes of a
+    tracker run, the keyframes of an interpolation); each costs one edit. Proposals are expected
+    to contain them (at a keyframe the proposal *is* the drawn box, so it costs nothing more).
+    Track ids play no part: an annotator corrects boxes, and a swapped id on a right box is
+    corrected in the id column, which this measure does not count.
+    """
+    truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
+    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
+    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
+    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
+    moved = drawn = deleted = 0
+    for f in set(t_by) | set(k_by):
+        t = t_by.get(f, np.empty((0, 4)))
+        k = k_by.get(f, np.empty((0, 4)))
+        matched = 0
+        if len(t) and len(k):
+            iou = iou_xywh(t, k)
+            rows, cols = linear_sum_assignment(iou, maximize=True)
+            matched = int((iou[rows, cols] >= threshold).sum())
+        pairs = min(len(t), len(k))
+        moved += pairs - matched
+        drawn += len(t) - pairs
+        deleted += len(k) - pairs
+    edits = moved + drawn + deleted + int(keyframes)
+    return EditCount(edits, len(truth), int(keyframes), moved, drawn, deleted)
+
+
+def keyframe_frames(first: int, last: int, every: int) -> np.ndarray:
+    """The frames an annotator keys on a track seen from ``first`` to ``last``: every
+    ``every``-th frame from its first, and its last (where it leaves)."""
+    frames = np.arange(first, last + 1, max(int(every), 1))
+    return np.unique(np.append(frames, last))
+
+
+def keyframes_of(truth_df: pd.DataFrame, every: int, part: str = "person") -> pd.DataFrame:
+    """The truth rows of ``part`` an annotator would key with a keyframe every ``every`` frames of
+    each track (:func:`keyframe_frames`); what ``--keyframes`` and interpolation start from."""
+    truth = truth_df[truth_df["part"] == part]
+    out = []
+    for tid, g in truth.groupby("track_id"):
+        keys = keyframe_frames(int(g["frame"].min()), int(g["frame"].max()), every)
+        out.append(g[g["frame"].isin(keys)])
+    return pd.concat(out, ignore_index=True) if out else truth.iloc[:0]
+
+
+def interpolate_keyframes(keys_df: pd.DataFrame) -> pd.DataFrame:
+    """Linear interpolation of every track's boxes between its consecutive keyframes (CVAT's
+    track mode): rows ``frame, track_id, part, x, y, w, h`` for every frame from a track's first
+    keyframe to its last, per part."""
+    out = []
+    for (tid, part), g in keys_df.groupby(["track_id", "part"]):
+        g = g.sort_values("frame")
+        f = g["frame"].to_numpy(int)
+        frames = np.arange(f[0], f[-1] + 1)
+        cols = {c: np.interp(frames, f, g[c].to_numpy(float)) for c in XYWH}
+        out.append(pd.DataFrame({"frame": frames, "track_id": tid, "part": part, **cols}))
+    if not out:
+        return pd.DataFrame(columns=["frame", "track_id", "part"] + XYWH)
+    return pd.concat(out, ignore_index=True)

@@ -35,7 +35,7 @@ from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 from partlab.tracking.tracks import normalise_tracks
 
-SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk")
+SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk", "random")
 FPS = 25.0
 OCCLUDER_ID = 255
 SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
@@ -109,6 +109,15 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
     frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
 
 
+#: frame sizes of the randomized suite (:func:`random_size`)
+RANDOM_SIZES: tuple[tuple[int, int], ...] = ((480, 360), (640, 360), (640, 480), (720, 480), (768, 576), (960, 540))
+
+
+def random_size(seed: int) -> tuple[int, int]:
+    """The frame size the randomized suite renders scene ``seed`` at (one of :data:`RANDOM_SIZES`)."""
+    return RANDOM_SIZES[int(np.random.default_rng([seed, 99]).integers(len(RANDOM_SIZES)))]
+
+
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
                *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
@@ -119,7 +128,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     """
     _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
-    camera = Camera.for_frame(width, height)
+    camera = Camera.random(rng, width, height) if name == "random" else Camera.for_frame(width, height)
     script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
     background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
@@ -187,6 +196,8 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
                 visible = int(np.count_nonzero(own[mask] == a + 1))
                 rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
                              rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+        if script.lighting is not None:
+            frame = np.clip(frame * script.lighting, 0, 255).astype(np.uint8)
         frames[i] = frame if effects is None else effects.apply(frame, i)
         if owner_maps is not None:
             owner_maps[i] = owner
