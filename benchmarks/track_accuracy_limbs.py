@@ -191,7 +191,7 @@ def main() -> None:
     ap.add_argument("--width", type=int, default=320)
     ap.add_argument("--height", type=int, default=240)
     ap.add_argument("--at", type=int, default=105, help="frame of the tracking rate")
-    ap.add_argument("--params", default="{}", help='LimbParams overrides as JSON, e.g. {"lam": 2}')
+    ap.add_argument("--params", default="{}", help='LimbParams overrides as JSON, e.g. {"appearance.lam": 2}')
     ap.add_argument("--fg", choices=["model", "plate"], default="model",
                     help="foreground: the shared background model (MOG2 until tracking/background.py "
                          "lands) or the scene's empty-room plate")
@@ -199,7 +199,7 @@ def main() -> None:
                     help="track the scene as written to an mp4 and decoded again (what `partlab track` sees), "
                          "not the rendered frames")
     args = ap.parse_args()
-    params = LimbParams.from_dict({**LimbParams().to_dict(), **json.loads(args.params)})
+    params = LimbParams().updated(json.loads(args.params))
     df, summary = limbs_table(args.scenarios, args.seeds, args.frames, args.width, args.height, args.at,
                               params, args.fg, args.video)
     pd.set_option("display.width", 160)

@@ -77,7 +77,7 @@ def decode_ms(path: Path, stop: int | None = None) -> float:
 def body_ms(frames, init: pd.DataFrame, particles: int, whole: bool = False) -> tuple[float, float, int]:
     """(background ms/frame, tracker ms/frame, mean tracked people), timed on a second run over
     the clip: the first loads every compiled kernel (numba) it uses."""
-    params = BodyParams(particles_initial=particles, particles_min=particles, particles_max=particles)
+    params = BodyParams().updated({"particles.initial": particles, "particles.min": particles, "particles.max": particles})
     for _ in range(2):
         tracker = BodyTracker(params, np.random.default_rng(0), init=init, whole=whole)
         bg = BackgroundModel(params)
@@ -178,7 +178,7 @@ def main() -> None:
         from track_speed_limbs import limb_speed_rows
 
         from partlab.tracking.params import LimbParams
-        print(f"\nLimb tracker (head and hands, {LimbParams().particles} particles per target; seated people "
+        print(f"\nLimb tracker (head and hands, {LimbParams().dynamics.particles} particles per target; seated people "
               "clapping, 640x480, "
               f"{a.frames} frames; step only, a foreground of ones):")
         print(pd.DataFrame(limb_speed_rows((1, 4), a.frames, 640, 480)).to_string(

@@ -72,7 +72,7 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=240)
     args = ap.parse_args()
     print(f"limb tracker speed, {args.width}x{args.height}, {args.frames} frames, "
-          f"{LimbParams().particles} particles per target")
+          f"{LimbParams().dynamics.particles} particles per target")
     print(f"{'people':>6} {'targets':>7} {'fps':>8} {'ms/frame':>9} {'ms/target':>9}")
     for r in limb_speed_rows((1, 4), args.frames, args.width, args.height):
         print(f"{r['people']:>6} {r['targets']:>7} {r['fps']:>8.1f} {r['ms/frame']:>9.1f} {r['ms/target']:>9.2f}")

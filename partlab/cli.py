@@ -30,6 +30,17 @@ class CommandError(UserError):
     """A user-facing failure: printed as ``partlab CMD: message`` with exit code 2."""
 
 
+def seed(text: str) -> int:
+    """argparse type of ``--seed``: a whole number from 0 to 2**32 - 1 (what numpy seeds take)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 0 <= value < 2**32:
+        raise argparse.ArgumentTypeError(f"{value} is outside 0..{2**32 - 1}")
+    return value
+
+
 def _module(name: str):
     return importlib.import_module(f"partlab.commands.{name}")
 
@@ -42,6 +53,8 @@ def build_parser() -> argparse.ArgumentParser:
     from partlab import __version__
 
     parser.add_argument("--version", action="version", version=f"partlab {__version__}")
+    parser.add_argument("--debug", action="store_true",
+                        help="show the full traceback of an unexpected error instead of one line")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, help_text in COMMANDS.items():
         p = sub.add_parser(name, help=help_text, description=help_text)
@@ -58,11 +71,44 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(_module(args.command).run(args) or 0)
     except UserError as exc:
-        print(f"partlab {args.command}: {exc}", file=sys.stderr)
+        print(f"partlab {args.command}: {_one_line(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"partlab {args.command}: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # noqa: BLE001 - the top-level handler: one line, not a traceback
+        if args.debug:
+            raise
+        print(f"partlab {args.command}: {describe_unexpected(exc)} (rerun with --debug for the traceback)",
+              file=sys.stderr)
+        return 2 if isinstance(exc, (OSError, ValueError, MemoryError, RecursionError)) else 1
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def describe_os_error(exc: OSError) -> str:
+    """What went wrong with a file, in words: a full disk and permissions said as such."""
+    import errno
+
+    if exc.errno == errno.ENOSPC:
+        return "no space left on the device (earlier outputs are left as they were)"
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return f"not allowed to write here ({exc.strerror})"
+    return (exc.strerror or _one_line(exc)).lower()
+
+
+def describe_unexpected(exc: BaseException) -> str:
+    """One line for an error no check caught."""
+    if isinstance(exc, OSError):
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        return where + describe_os_error(exc)
+    if isinstance(exc, MemoryError):
+        return "out of memory (the input is too large for this machine)"
+    if isinstance(exc, RecursionError):
+        return "the input is nested too deeply to read"
+    return f"unexpected {type(exc).__name__}: {_one_line(exc)}"
 
 
 if __name__ == "__main__":  # python -m partlab.cli

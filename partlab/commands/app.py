@@ -12,16 +12,33 @@ from partlab.cli import CommandError
 PAGE = Path(__file__).resolve().parent.parent / "app" / "streamlit_app.py"
 
 
+LOOPBACK_NAMES = ("localhost", "127.0.0.1", "::1")
+
+
 def add_arguments(p) -> None:
     p.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1)")
     p.add_argument("--port", type=int, default=8501, help="port to listen on (default 8501)")
+    p.add_argument("--allowed-hosts", metavar="NAMES", default=os.environ.get("PARTLAB_ALLOWED_HOSTS", ""),
+                   help="comma-separated host names the app may be reached by besides localhost and --host "
+                        "(PARTLAB_ALLOWED_HOSTS); requests naming any other host are refused (DNS rebinding)")
 
 
-def streamlit_command(host: str, port: int) -> list[str]:
+def allowed_hosts(host: str, extra: str = "") -> list[str]:
+    """Host names a browser may use to reach the app: loopback names, the bind address (unless it is
+    a wildcard) and ``extra``. Anything else in a request's ``Host`` is refused by the server."""
+    names = list(LOOPBACK_NAMES)
+    if host not in ("0.0.0.0", "::", ""):
+        names.append(host)
+    names += [n.strip() for n in extra.split(",") if n.strip()]
+    return list(dict.fromkeys(names))
+
+
+def streamlit_command(host: str, port: int, extra_hosts: str = "") -> list[str]:
     """The command line that serves the app; also used by the browser tests.
 
     The upload limit comes from ``PARTLAB_MAX_UPLOAD_MB`` (default 1024), the same
-    number :mod:`partlab.app.uploads` checks again on the server side.
+    number :mod:`partlab.app.uploads` checks again on the server side. The Host allow-list
+    (:func:`allowed_hosts`) and CORS keep other web pages from driving the app.
     """
     from partlab.app.uploads import UploadRefused, max_upload_mb  # lazy: `partlab --help` stays light
 
@@ -39,9 +56,11 @@ def streamlit_command(host: str, port: int) -> list[str]:
         "--server.maxUploadSize", str(max_mb),
         "--server.runOnSave", "false",
         "--client.toolbarMode", "minimal",  # no "Deploy" button: this is a local labelling tool
-    ]
+        "--server.enableCORS", "true",
+        "--server.enableXsrfProtection", "true",
+    ] + [arg for name in allowed_hosts(host, extra_hosts) for arg in ("--server.allowedHosts", name)]
 
 
 def run(args) -> int:
     print(f"partlab app: serving on http://{args.host}:{args.port} (Ctrl+C to stop)", flush=True)
-    return subprocess.call(streamlit_command(args.host, args.port), env=os.environ.copy())
+    return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=os.environ.copy())

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import re
 
-from partlab.cli import CommandError
+from partlab.cli import CommandError, seed
 
 
 def add_arguments(p) -> None:
     p.add_argument("outdir", metavar="OUTDIR", help="directory to write clip.mp4, truth.csv, init.csv, scene.json")
     p.add_argument("--scenario", default="single",
                    help="single, pair_cross, pillar, distractors, crowd, bend or desk (default: single)")
-    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same scene")
+    p.add_argument("--seed", type=seed, default=0, help="random seed; the same seed gives the same scene")
     p.add_argument("--frames", type=int, default=150, help="number of frames (default: 150, 6 s at 25 fps)")
     p.add_argument("--size", default="720x480", help="frame size WIDTHxHEIGHT (default: 720x480)")
 

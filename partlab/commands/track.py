@@ -6,7 +6,7 @@ import argparse
 import csv
 from pathlib import Path
 
-from partlab.cli import CommandError
+from partlab.cli import CommandError, describe_os_error, seed
 
 
 def add_arguments(p) -> None:
@@ -22,7 +22,7 @@ def add_arguments(p) -> None:
                    help="model bundle from partlab train, or 'default' for the one shipped with partlab "
                         "(failure detection and adjustment on); without it: the built-in parameters, no "
                         "failure detection")
-    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same output")
+    p.add_argument("--seed", type=seed, default=0, help="random seed; the same seed gives the same output")
     p.add_argument("--events", metavar="EVENTS.csv",
                    help="write the events the tracker recognises (limbs/all: joins and separations)")
     p.add_argument("--occluders", metavar="FILE",
@@ -104,7 +104,7 @@ def run(args) -> int:
     try:
         write_tracks_csv(tracks, args.output)
     except OSError as exc:
-        raise CommandError(f"{args.output}: cannot write: {exc}") from None
+        raise CommandError(f"{args.output}: cannot write: {describe_os_error(exc)}") from None
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
     if args.events:

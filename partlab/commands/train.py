@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from partlab.cli import CommandError
+from partlab.cli import CommandError, seed
 
 
 def add_arguments(p) -> None:
@@ -18,7 +18,7 @@ def add_arguments(p) -> None:
     p.add_argument("--truth", metavar="TRUTH.csv", action="append", required=True,
                    help="its corrected boxes, one per --clip in the same order")
     p.add_argument("-o", "--output", metavar="BUNDLE_DIR", required=True, help="model bundle directory to write")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--from", dest="start", metavar="MODEL", default="default",
                    help="the model to improve on: 'default' (partlab's shipped bundle), a bundle directory, or "
                         "'none' (the built-in parameters without a failure detector). Its parameters are the "
@@ -98,8 +98,8 @@ def run(args) -> int:
 
         print("\nreported box extent per part (fitted vs default: scale of the tracked inner rectangle, "
               "shift in its size):")
-        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output_extent)
-        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output_extent)
+        fitted = bundle.summary.get("selection", {}).get("fitted_output_extent", bundle.body_params.output.extent)
+        table = extent_table({k: tuple(v) for k, v in fitted.items()}, BodyParams().output.extent)
         print(table.pivot(index="part", columns="term", values="fitted").round(3).to_string())
     if "selection" in bundle.summary:
         from partlab.models.selection import selection_table

@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from os import PathLike
 from pathlib import Path
 
 import numpy as np
 
 from partlab.errors import UserError
+from partlab.files import write_text
 from partlab.tracking.camera import Camera
 
 FILE_NAME = "calibration.json"
@@ -66,16 +65,8 @@ def write_calibration(cameras, path: str | PathLike) -> Path:
     """Write ``cameras`` (a mapping or a list of :class:`Camera`) as partlab JSON, atomically."""
     cams = list(cameras.values()) if isinstance(cameras, dict) else list(cameras)
     p = Path(path)
-    p.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps({"units": "mm", "cameras": [c.to_dict() for c in cams]}, indent=1)
-    fd, tmp = tempfile.mkstemp(prefix=p.name, dir=p.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_text(p, text)
     return p
 
 

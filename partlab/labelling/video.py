@@ -20,6 +20,7 @@ import cv2
 import numpy as np
 
 from partlab.errors import UserError
+from partlab.limits import check_frame_size, max_frames
 
 VIDEO_EXTENSIONS: tuple[str, ...] = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm", ".mpg", ".mpeg")
 
@@ -41,10 +42,12 @@ class VideoInfo:
         return self.frame_count / self.fps if self.fps > 0 else 0.0
 
 
-def _count_frames(cap: cv2.VideoCapture) -> int:
+def _count_frames(cap: cv2.VideoCapture, limit: int, path: Path) -> int:
     n = 0
     while cap.grab():
         n += 1
+        if n >= limit:
+            raise VideoError(f"{path}: more than the limit of {limit} frames (set PARTLAB_MAX_FRAMES to change it)")
     return n
 
 
@@ -65,15 +68,19 @@ def probe(path: str | PathLike, exact_count: bool = True) -> VideoInfo:
     try:
         if not cap.isOpened():
             raise VideoError(f"{p}: not a video OpenCV can decode (expected one of {', '.join(VIDEO_EXTENSIONS)})")
+        meta_w, meta_h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH) or 0), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT) or 0)
+        if meta_w > 0 and meta_h > 0:  # refuse a huge frame before decoding one
+            check_frame_size(meta_w, meta_h, str(p), VideoError)
         ok, frame = cap.read()
         if not ok or frame is None:
             raise VideoError(f"{p}: no decodable frame (empty or corrupt video)")
+        check_frame_size(frame.shape[1], frame.shape[0], str(p), VideoError)
         height, width = frame.shape[:2]
         fps = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
         if not np.isfinite(fps) or fps <= 0 or fps > 1000:
             fps = 25.0
         if exact_count:
-            count = 1 + _count_frames(cap)
+            count = 1 + _count_frames(cap, max_frames(), p)
         else:
             count = int(cap.get(cv2.CAP_PROP_FRAME_COUNT) or 0)
     finally:

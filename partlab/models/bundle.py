@@ -1,9 +1,10 @@
 """Model bundles: a versioned directory of everything retraining fits.
 
-Layout (format ``partlab-model-bundle``, version 1)::
+Layout (format ``partlab-model-bundle``, version 2)::
 
     BUNDLE_DIR/
-      bundle.json      format, version, created, body_params, limb_params,
+      bundle.json      format, version, created, params {key: nested parameters} (by the
+                       registry's parameter key: "body", "limbs", ...),
                        detector (dt, normalise, persist, per-SVM kernel/intercept/gamma/threshold),
                        summary (clips, sample counts, CV scores, thresholds, fitted variances),
                        files {name: sha256}, manifest_sha256
@@ -17,6 +18,10 @@ SHA-256 in the manifest (and the manifest against its own hash); a file that is
 missing, changed, not listed, or a directory without ``bundle.json`` is refused
 with a message saying which. The hashes catch corruption and edits; the safety
 comes from the formats, which cannot carry code.
+
+Version 1 (partlab 0.2, and the shipped bundle) stored ``body_params`` and ``limb_params`` as
+flat dicts; they are read as they are (:meth:`partlab.tracking.core.params.Parameters.from_dict`
+reads the flat form).
 """
 
 from __future__ import annotations
@@ -27,7 +32,7 @@ import json
 import math
 import re
 import zipfile
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from datetime import datetime, timezone
 from importlib import resources
 from os import PathLike
@@ -41,7 +46,7 @@ from partlab.models.labels import SVM_NAMES
 from partlab.tracking.params import BodyParams, LimbParams
 
 FORMAT_NAME = "partlab-model-bundle"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 MANIFEST = "bundle.json"
 _ARRAY_NAMES = ("mean", "scale", "support_vectors", "dual_coef")
 _SAFE_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*\.npz$")
@@ -60,6 +65,13 @@ class Bundle:
     failure_detector: SVMFailureDetector | None = None
     summary: dict = field(default_factory=dict)
     created: str = ""
+    #: parameters of other registry keys (trackers added after body and limbs), by key
+    more_params: dict = field(default_factory=dict)
+
+    @property
+    def params(self) -> dict:
+        """Every parameters object by the registry's key (what :func:`partlab.tracking.run.track` reads)."""
+        return {"body": self.body_params, "limbs": self.limb_params, **self.more_params}
 
 
 def _sha256(path: Path) -> str:
@@ -128,8 +140,7 @@ def save_bundle(bundle: Bundle, path: str | PathLike) -> Path:
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
         "created": bundle.created or datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "body_params": bundle.body_params.to_dict(),
-        "limb_params": bundle.limb_params.to_dict(),
+        "params": {key: p.to_dict() for key, p in bundle.params.items()},
         "detector": detector,
         "summary": bundle.summary,
         "files": files,
@@ -214,16 +225,36 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
 #: manifest records every parameter as it was at training time (for the record), but the
 #: hand-set tunables follow the installed partlab, so improving a default never needs every
 #: bundle to be retrained.
-LEARNED_BODY_FIELDS: tuple[str, ...] = ("part_noise", "output_extent")
-LEARNED_LIMB_FIELDS: tuple[str, ...] = ("sigma_v", "sigma_d", "sigma_s")
+LEARNED_BODY_FIELDS: tuple[str, ...] = ("dynamics.noise", "output.extent")
+LEARNED_LIMB_FIELDS: tuple[str, ...] = ("priors.sigma_v", "priors.sigma_d", "priors.sigma_s")
 
 
 def learned_body_params(saved: BodyParams) -> BodyParams:
-    return replace(BodyParams(), **{k: getattr(saved, k) for k in LEARNED_BODY_FIELDS})
+    return BodyParams().updated({k: saved.get(k) for k in LEARNED_BODY_FIELDS})
 
 
 def learned_limb_params(saved: LimbParams) -> LimbParams:
-    return replace(LimbParams(), **{k: getattr(saved, k) for k in LEARNED_LIMB_FIELDS})
+    return LimbParams().updated({k: saved.get(k) for k in LEARNED_LIMB_FIELDS})
+
+
+def _read_params(manifest: dict) -> tuple[BodyParams, LimbParams, dict]:
+    """The parameters of a manifest: version 2's ``params`` by key, or version 1's flat
+    ``body_params`` / ``limb_params``; the fitted fields over the installed defaults."""
+    from partlab.tracking import registry
+
+    if manifest["version"] == 1:
+        saved = {"body": manifest["body_params"], "limbs": manifest["limb_params"]}
+    else:
+        saved = manifest["params"]
+        if not isinstance(saved, dict):
+            raise ValueError("'params' must map parameter keys to parameters")
+    unknown = sorted(set(saved) - set(registry.PARAMETERS))
+    if unknown:
+        raise ValueError(f"parameters of unknown kind(s) {', '.join(unknown)} (a newer partlab's trackers?)")
+    body = learned_body_params(BodyParams.from_dict(saved["body"])) if "body" in saved else BodyParams()
+    limb = learned_limb_params(LimbParams.from_dict(saved["limbs"])) if "limbs" in saved else LimbParams()
+    more = {k: registry.params_class(k).from_dict(v) for k, v in saved.items() if k not in ("body", "limbs")}
+    return body, limb, more
 
 
 def load_bundle(path: str | PathLike) -> Bundle:
@@ -232,8 +263,7 @@ def load_bundle(path: str | PathLike) -> Bundle:
     manifest = _read_manifest(root)
     _verify_files(root, manifest)
     try:
-        body = learned_body_params(BodyParams.from_dict(manifest["body_params"]))
-        limb = learned_limb_params(LimbParams.from_dict(manifest["limb_params"]))
+        body, limb, more = _read_params(manifest)
     except (KeyError, TypeError, ValueError) as exc:
         raise BundleError(f"{root / MANIFEST}: bad parameters ({exc})") from None
     detector = None
@@ -261,7 +291,7 @@ def load_bundle(path: str | PathLike) -> Bundle:
             if isinstance(exc, BundleError):
                 raise
             raise BundleError(f"{root}: bad SVM arrays ({exc})") from None
-    return Bundle(body, limb, detector, dict(manifest.get("summary") or {}), str(manifest.get("created", "")))
+    return Bundle(body, limb, detector, dict(manifest.get("summary") or {}), str(manifest.get("created", "")), more)
 
 
 def default_bundle_path() -> Path:

@@ -1,6 +1,6 @@
 """How the body tracker's inner rectangles are reported as part boxes, fitted from corrections.
 
-The filters track inner rectangles (seed 002 sec. 4.1); ``BodyParams.output_extent``
+The filters track inner rectangles (seed 002 sec. 4.1); ``BodyParams.output.extent``
 widens them to the part's extent for output. People correct the boxes they see, so the
 corrected boxes say how far off that widening is: per part, the median ratio of the
 corrected to the reported size, and the median offset of the corrected centre, in units

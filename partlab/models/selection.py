@@ -24,7 +24,7 @@ track's first, per clip, then over clips.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
@@ -38,7 +38,7 @@ from partlab.tracking.params import BodyParams
 ValidationRun = Callable[[int, BodyParams, object], pd.DataFrame]
 #: components in the order they are tried, and the BodyParams fields each one brings
 COMPONENTS: tuple[str, ...] = ("noise", "extent", "detector")
-_FIELDS = {"noise": ("part_noise",), "extent": ("output_extent",)}
+_FIELDS = {"noise": ("dynamics.noise",), "extent": ("output.extent",)}
 
 
 def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
@@ -136,9 +136,9 @@ def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: Body
                 continue
             params, det = best_params, detector
         else:
-            params = replace(best_params, **{f: getattr(fitted, f) for f in _FIELDS[comp]})
+            params = best_params.updated({f: fitted.get(f) for f in _FIELDS[comp]})
             det = best_det
-            if all(getattr(params, f) == getattr(best_params, f) for f in _FIELDS[comp]):
+            if all(params.get(f) == best_params.get(f) for f in _FIELDS[comp]):
                 kept[comp] = False  # nothing fitted: the same model, no run needed
                 continue
         scores[f"+{comp}"] = s = score(params, det, comp)
@@ -149,8 +149,8 @@ def select_components(run: ValidationRun, truths: list[pd.DataFrame], base: Body
             base_scores = scores["builtin"]
             better = [n for n in BODY_PARTS if s[n] > base_scores[n]]
             if better and any(s[n] < base_scores[n] for n in BODY_PARTS):
-                part_params = replace(best_params, part_noise={
-                    **best_params.part_noise, **{n: fitted.part_noise[n] for n in better}})
+                part_params = best_params.updated({"dynamics.noise": {
+                    **best_params.dynamics.noise, **{n: fitted.dynamics.noise[n] for n in better}}})
                 name = "+noise(" + ",".join(better) + ")"
                 scores[name] = s_part = score(part_params, det, "noise of " + ", ".join(better))
                 if s_part["mean"] > s["mean"]:

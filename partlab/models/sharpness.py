@@ -55,7 +55,7 @@ def colour_distances(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], tru
     by_frame = {f: g for f, g in truth.groupby("frame")}
     refs: dict[tuple[int, str], np.ndarray] = {}
     out: dict[str, list[float]] = {p: [] for p in SHARPNESS_PARTS}
-    bins = params.bins_per_channel
+    bins = params.appearance.bins_per_channel
     for index, frame in frames():
         rows = by_frame.get(index)
         if rows is None:
@@ -75,5 +75,5 @@ def colour_distances(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], tru
                 rho = H.bhattacharyya(H.binned_histogram(obs, mapping, bins),
                                       H.binned_histogram(ref, mapping, bins), bins)
                 out[key[1]].append(float(1.0 - rho))
-            refs[key] = H.update_reference(ref, obs, params.model_update)
+            refs[key] = H.update_reference(ref, obs, params.appearance.model_update)
     return {p: np.asarray(v) for p, v in out.items()}

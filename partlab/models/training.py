@@ -112,7 +112,7 @@ def _apply_lam(body: BodyParams, table: pd.DataFrame,
     from partlab.models.sharpness import fit_lam
     from partlab.models.variance import MIN_SAMPLES
 
-    noise = dict(body.part_noise)
+    noise = dict(body.dynamics.noise)
     table = table.copy()
     for part, chunks in d2.items():
         values = np.concatenate(chunks) if chunks else np.zeros(0)
@@ -124,7 +124,7 @@ def _apply_lam(body: BodyParams, table: pd.DataFrame,
         noise[part] = replace(noise[part], lam=lam)
         table.loc[row, "fitted"] = lam
         table.loc[row, "applied"] = lam
-    return replace(body, part_noise=noise), table
+    return body.updated({"dynamics.noise": noise}), table
 
 
 def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], None] | None = None,
@@ -224,9 +224,9 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         from partlab.models.extent import fit_output_extent
 
         step("output extent")
-        current = (body or BodyParams()).output_extent
-        body_p = replace(body_p, output_extent=fit_output_extent([t for t, _ in tracked_runs],
-                                                                 [g for _, g in tracked_runs], current))
+        current = (body or BodyParams()).output.extent
+        body_p = body_p.updated({"output.extent": fit_output_extent([t for t, _ in tracked_runs],
+                                                                       [g for _, g in tracked_runs], current)})
     detector = SVMFailureDetector(models, dt=dt) if models else None
     selection = None
     if tracked_runs and validate:
@@ -238,16 +238,16 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         def run(i, params, det):
             return tracker_runner(clips[i][0], clips[i][1], inits[i], seed + i, params=params, failure_detector=det)
 
-        fitted = replace(base, part_noise=body_p.part_noise, output_extent=body_p.output_extent)
+        fitted = base.updated({"dynamics.noise": body_p.dynamics.noise, "output.extent": body_p.output.extent})
         chosen = select_components(run, truths, base, fitted, detector,
                                    base_tracks=[t for t, _ in tracked_runs] if body is None else None,
                                    progress=step, base_detector=start_detector)
-        body_p = replace(body_p, part_noise=chosen.body_params.part_noise,
-                         output_extent=chosen.body_params.output_extent)
+        body_p = body_p.updated({"dynamics.noise": chosen.body_params.dynamics.noise,
+                                 "output.extent": chosen.body_params.output.extent})
         new_detector = detector
         detector = chosen.failure_detector
         selection = chosen.to_dict()
-        selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output_extent.items()}
+        selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output.extent.items()}
         selection["started_from"] = "a bundle" if start is not None else "built-in"
         selection["start_detector"] = start_detector is not None
         selection["detector"] = ("new" if detector is not None and detector is new_detector else
@@ -263,7 +263,7 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
         "tnr_targets": dict(TNR_TARGETS),
         "thresholds": {n: r.threshold for n, r in reports.items()},
         "variances": table.to_dict(orient="records"),
-        "output_extent": {k: list(v) for k, v in body_p.output_extent.items()},
+        "output_extent": {k: list(v) for k, v in body_p.output.extent.items()},
         "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
     }
     if selection is not None:

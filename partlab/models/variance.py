@@ -39,7 +39,7 @@ particles cannot spread.
 
 from __future__ import annotations
 
-from dataclasses import fields, replace
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -55,6 +55,10 @@ MIN_VEL_STD: float = 0.1
 MIN_SAMPLES: int = 10
 BODY_NOISE_PARTS: tuple[str, ...] = ("head", "torso", "hipleg", "person")
 LIMB_PARTS: tuple[str, ...] = ("head", "left_hand", "right_hand")
+#: The limb sigmas a tracker reads today: ``sigma_v`` and ``sigma_d`` (eq. 25-26) compare two
+#: cameras; they are fitted and saved for the multi-camera tracker, and the table's ``applied``
+#: says ``-`` for them, since nothing applies them in one camera.
+LIMB_SIGMAS_READ: frozenset[str] = frozenset({"sigma_s"})
 
 
 def _segments(frames: np.ndarray, values: np.ndarray) -> list[np.ndarray]:
@@ -191,7 +195,7 @@ def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = Non
     filter to keep up); velocity stds always come from the truth's MA(1) fit.
     """
     defaults = defaults or BodyParams()
-    noise = dict(defaults.part_noise)
+    noise = dict(defaults.dynamics.noise)
     rows = []
     for part in BODY_NOISE_PARTS:
         base = noise.get(part, PartNoise())
@@ -220,7 +224,7 @@ def fit_body_noise(truths: list[pd.DataFrame], defaults: BodyParams | None = Non
                              source=source[k]))
         rows.append(dict(tracker="body", part=part, parameter="lam", default=base.lam, fitted=np.nan,
                          applied=base.lam, n=0, source="frames"))
-    return replace(defaults, part_noise=noise), pd.DataFrame(rows)
+    return defaults.updated({"dynamics.noise": noise}), pd.DataFrame(rows)
 
 
 def _limb_residuals(truths: list[pd.DataFrame]) -> dict[str, np.ndarray]:
@@ -265,21 +269,19 @@ def fit_limb_sigmas(truths: list[pd.DataFrame], defaults: LimbParams | None = No
         "sigma_v": (np.sqrt(np.mean(r["v"] ** 2)) if len(r["v"]) else np.nan, len(r["v"])),
         "sigma_s": (np.sqrt(np.mean(r["s"] ** 2)) if len(r["s"]) else np.nan, len(r["s"])),
     }
-    known = {f.name for f in fields(defaults)}
     new, rows = {}, []
     for name, (v, n) in est.items():
-        if name not in known:
-            continue
-        ok = np.isfinite(v) and n >= MIN_SAMPLES
-        if ok:
-            new[name] = max(float(v), MIN_STD)
-        applied = new.get(name, getattr(defaults, name))
+        default = getattr(defaults.priors, name)
+        fitted = max(float(v), MIN_STD) if np.isfinite(v) and n >= MIN_SAMPLES else np.nan
+        value = default if np.isnan(fitted) else fitted
         if keep_defaults_as_floor:
-            applied = max(applied, getattr(defaults, name))
-        rows.append(dict(tracker="limbs", part="*", parameter=name, default=getattr(defaults, name),
-                         fitted=new.get(name, np.nan), applied=applied, n=n, source="truth"))
-        new[name] = applied
-    return replace(defaults, **new), pd.DataFrame(rows)
+            value = max(value, default)
+        read = name in LIMB_SIGMAS_READ
+        rows.append(dict(tracker="limbs", part="*", parameter=name, default=default, fitted=fitted,
+                         applied=value if read else np.nan,
+                         n=n, source="truth" if read else "truth; saved, not read by the one-camera tracker"))
+        new[f"priors.{name}"] = value
+    return defaults.updated(new), pd.DataFrame(rows)
 
 
 def fit_variances(truths: list[pd.DataFrame], body: BodyParams | None = None,

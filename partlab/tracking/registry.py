@@ -101,8 +101,8 @@ def params_class(key: str) -> type:
 
 # -- the table ---------------------------------------------------------------------------------
 
-register_parameters(ParameterEntry("body", "partlab.tracking.params:BodyParams", rng_slot=0))
-register_parameters(ParameterEntry("limbs", "partlab.tracking.params:LimbParams", rng_slot=1))
+register_parameters(ParameterEntry("body", "partlab.tracking.body.params:BodyParams", rng_slot=0))
+register_parameters(ParameterEntry("limbs", "partlab.tracking.limbs.params:LimbParams", rng_slot=1))
 
 register(TrackerEntry(
     "body", "head, torso and hip-leg of every person, plus the person box (Zhao & Lee)",

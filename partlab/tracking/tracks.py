@@ -21,6 +21,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from partlab.limits import MAX_ID, max_coord, max_csv_rows
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 
@@ -122,6 +123,17 @@ def _parse_bool(text: str) -> bool | None:
     return None
 
 
+def _rows(reader, label: str):
+    """The CSV module's rows, its own errors (NUL bytes, stray quotes) said with the line."""
+    while True:
+        try:
+            yield next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            raise TracksCSVError(f"{label} line {reader.line_num}: not a CSV row ({exc})") from None
+
+
 def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
     """Read and validate a tracks CSV.
 
@@ -140,7 +152,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     else:
         label = name or "tracks CSV"
         text = source.read()
-    reader = csv.reader(io.StringIO(text))
+    reader = _rows(csv.reader(io.StringIO(text, newline="")), label)
     try:
         header = next(reader)
     except StopIteration:
@@ -156,9 +168,13 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                              f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
     index = {c: i for i, c in enumerate(header) if c in COLUMNS}
     cols: dict[str, list] = {c: [] for c in index}
+    coord_limit, row_limit = max_coord(), max_csv_rows()
     for lineno, row in enumerate(reader, start=2):
         if not row or all(not cell.strip() for cell in row):
             continue
+        if lineno - 1 > row_limit:
+            raise TracksCSVError(f"{label}: more than the limit of {row_limit} rows "
+                                 "(set PARTLAB_MAX_CSV_ROWS to change it)")
         if len(row) < len(REQUIRED_COLUMNS):
             raise TracksCSVError(f"{label} line {lineno}: {len(row)} cells, expected at least "
                                  f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
@@ -178,6 +194,8 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                     value = int(f)
                 if value < 0:
                     raise TracksCSVError(f"{where}: {value} is negative")
+                if value > MAX_ID:
+                    raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
             elif col == "part":
                 if cell not in PART_NAMES:
                     raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
@@ -192,6 +210,13 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                         raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
                     if col in ("x", "y", "w", "h", "X", "Y", "Z") and not math.isfinite(value):
                         raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and abs(value) > coord_limit:
+                        raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
+                                             "(set PARTLAB_MAX_COORD to change it)")
+                    if col == "score" and math.isinf(value):
+                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+                    if col == "occluded" and not 0.0 <= value <= 1.0:
+                        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
                     if col in ("w", "h") and value < 0:
                         raise TracksCSVError(f"{where}: negative size {value:g}")
             elif col == "failure":
@@ -246,7 +271,9 @@ def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> 
     if not has_take_columns(df):
         df = df.drop(columns=list(TAKE_COLUMNS))
     if isinstance(dest, (str, PathLike)):
-        Path(dest).parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
+        from partlab.files import replacing
+
+        with replacing(dest) as tmp:  # a full disk leaves an earlier file as it was
+            df.to_csv(tmp, index=False, float_format="%.2f", lineterminator="\n")
     else:
         df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")

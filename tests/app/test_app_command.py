@@ -22,3 +22,54 @@ def test_upload_limit_and_address(monkeypatch):
     monkeypatch.setenv("PARTLAB_MAX_UPLOAD_MB", "-3")
     with pytest.raises(CommandError, match="PARTLAB_MAX_UPLOAD_MB must be positive"):
         streamlit_command("127.0.0.1", 1)
+
+
+def test_allowed_hosts_are_loopback_the_bind_address_and_the_extras():
+    from partlab.commands.app import allowed_hosts
+
+    assert allowed_hosts("0.0.0.0") == ["localhost", "127.0.0.1", "::1"]
+    assert allowed_hosts("10.0.0.5", "lab.example.org, *.lab.example.org") == \
+        ["localhost", "127.0.0.1", "::1", "10.0.0.5", "lab.example.org", "*.lab.example.org"]
+
+
+def test_a_page_on_another_host_cannot_drive_the_app(tmp_path):
+    """DNS rebinding: a web page whose name resolves to 127.0.0.1 opens the app's websocket with
+    its own Host and Origin; the server refuses it, and still accepts the app's own address."""
+    import asyncio
+    import socket
+    import subprocess
+    import time
+    import urllib.request
+
+    import websockets
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen(streamlit_command("127.0.0.1", port), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env={**__import__("os").environ, "PARTLAB_DATA": str(tmp_path)})
+
+    async def opens(name: str, origin: str) -> bool:
+        try:
+            async with websockets.connect(f"ws://{name}:{port}/_stcore/stream", host="127.0.0.1", port=port,
+                                          origin=origin, open_timeout=20):
+                return True
+        except websockets.exceptions.InvalidStatus as exc:
+            assert exc.response.status_code == 403
+            return False
+
+    try:
+        deadline = time.time() + 120
+        while True:
+            try:
+                urllib.request.urlopen(f"http://127.0.0.1:{port}/_stcore/health", timeout=2)
+                break
+            except OSError:
+                assert time.time() < deadline, "the app did not start"
+                time.sleep(0.5)
+        assert asyncio.run(opens("127.0.0.1", f"http://127.0.0.1:{port}"))
+        assert not asyncio.run(opens("evil.example", f"http://evil.example:{port}"))
+        assert not asyncio.run(opens("127.0.0.1", "http://evil.example"))
+    finally:
+        proc.terminate()
+        proc.wait(timeout=30)

@@ -14,9 +14,8 @@ from partlab.tracking.params import BodyParams, LimbParams, PartNoise
 def bundle(trained_svms):
     _x, _y, models, reports = trained_svms
     body = BodyParams()
-    noise = dict(body.part_noise, head=PartNoise(x=1.5, y=1.25, w=1.0, h=1.0, vx=0.3, vy=0.2, lam=20.0))
-    from dataclasses import replace
-    return Bundle(replace(body, part_noise=noise), replace(LimbParams(), sigma_d=7.5),
+    noise = dict(body.dynamics.noise, head=PartNoise(x=1.5, y=1.25, w=1.0, h=1.0, vx=0.3, vy=0.2, lam=20.0))
+    return Bundle(body.updated({"dynamics.noise": noise}), LimbParams().updated({"priors.sigma_d": 7.5}),
                   SVMFailureDetector(models),
                   {"svms": {n: r.to_dict() for n, r in reports.items()}, "nan": float("nan")})
 
@@ -25,7 +24,7 @@ def test_round_trip_gives_identical_decisions(bundle, trained_svms, tmp_path):
     x = trained_svms[0][:300]
     save_bundle(bundle, tmp_path / "b")
     loaded = load_bundle(tmp_path / "b")
-    assert loaded.body_params == bundle.body_params and loaded.limb_params.sigma_d == 7.5
+    assert loaded.body_params == bundle.body_params and loaded.limb_params.priors.sigma_d == 7.5
     assert loaded.summary["nan"] is None and loaded.summary["svms"]["head"]["trained"] is True
     for name, m in bundle.failure_detector.models.items():
         np.testing.assert_array_equal(loaded.failure_detector.models[name].decision(x), m.decision(x))
@@ -49,7 +48,7 @@ def test_tampered_file_is_refused(bundle, tmp_path):
 def test_edited_manifest_is_refused(bundle, tmp_path):
     root = save_bundle(bundle, tmp_path / "b")
     m = json.loads((root / MANIFEST).read_text())
-    m["body_params"]["particles_max"] = 5000
+    m["params"]["body"]["particles"]["max"] = 5000
     (root / MANIFEST).write_text(json.dumps(m))
     with pytest.raises(BundleError, match="manifest was modified"):
         load_bundle(root)
@@ -132,10 +131,10 @@ def test_default_bundle_ships_and_keeps_only_what_validation_approved():
     assert 0.5 < scores["builtin"]["mean"] <= 1.0
     # every component it uses scored above the built-in parameters on the training clips
     if not sel["kept"]["noise"]:
-        assert b.body_params.part_noise == BodyParams().part_noise
+        assert b.body_params.dynamics.noise == BodyParams().dynamics.noise
         assert scores["+noise"]["mean"] <= scores["builtin"]["mean"]
     if not sel["kept"]["extent"]:
-        assert b.body_params.output_extent == BodyParams().output_extent
+        assert b.body_params.output.extent == BodyParams().output.extent
     assert (b.failure_detector is not None) == sel["kept"]["detector"]
     if b.failure_detector is not None:
         assert set(b.failure_detector.models) == {"head", "torso", "hipleg", "multi"}
@@ -148,14 +147,46 @@ def test_a_bundle_applies_what_was_learned_over_the_installed_defaults(tmp_path)
     from partlab.models.bundle import Bundle, load_bundle, save_bundle
     from partlab.tracking.params import BodyParams, LimbParams, PartNoise
 
-    noise = dict(BodyParams().part_noise, head=PartNoise(x=9.0, y=8.0, w=1.0, h=1.0, vx=1.0, vy=1.0, lam=7.0))
-    body = replace(BodyParams(), part_noise=noise, output_extent={"head": (2.0, 2.0, 0.0, 0.0)},
-                   particles_initial=321)
-    limb = replace(LimbParams(), sigma_d=33.0, particles=77)
+    noise = dict(BodyParams().dynamics.noise, head=PartNoise(x=9.0, y=8.0, w=1.0, h=1.0, vx=1.0, vy=1.0, lam=7.0))
+    body = BodyParams().updated({"dynamics.noise": noise, "output.extent": {"head": (2.0, 2.0, 0.0, 0.0)},
+                                 "particles.initial": 321})
+    limb = LimbParams().updated({"priors.sigma_d": 33.0, "dynamics.particles": 77})
     save_bundle(Bundle(body, limb, None, {}), tmp_path / "b")
     loaded = load_bundle(tmp_path / "b")
-    assert loaded.body_params.part_noise["head"].x == 9.0 and loaded.body_params.part_noise["head"].lam == 7.0
-    assert loaded.body_params.output_extent == {"head": (2.0, 2.0, 0.0, 0.0)}
-    assert loaded.limb_params.sigma_d == 33.0
-    assert loaded.body_params.particles_initial == BodyParams().particles_initial  # not learned
-    assert loaded.limb_params.particles == LimbParams().particles
+    assert loaded.body_params.dynamics.noise["head"].x == 9.0 and loaded.body_params.dynamics.noise["head"].lam == 7.0
+    assert loaded.body_params.output.extent == {"head": (2.0, 2.0, 0.0, 0.0)}
+    assert loaded.limb_params.priors.sigma_d == 33.0
+    assert loaded.body_params.particles.initial == BodyParams().particles.initial  # not learned
+    assert loaded.limb_params.dynamics.particles == LimbParams().dynamics.particles
+
+
+def test_parameters_are_saved_by_registry_key_and_version_1_bundles_still_load(tmp_path):
+    """Version 2 writes ``params`` by the registry's parameter key, nested by group; a version-1
+    bundle (partlab 0.2: flat ``body_params`` / ``limb_params``, like the shipped one) loads the same."""
+    import hashlib
+
+    from partlab.models.bundle import FORMAT_VERSION, Bundle, _canonical, load_bundle, save_bundle
+    from partlab.tracking.params import BodyParams, LimbParams, PartNoise
+
+    noise = dict(BodyParams().dynamics.noise, torso=PartNoise(x=7.0, y=6.0, w=2.0, h=2.0, vx=1.0, vy=1.0, lam=11.0))
+    body = BodyParams().updated({"dynamics.noise": noise})
+    limb = LimbParams().updated({"priors.sigma_s": 3.5})
+    root = save_bundle(Bundle(body, limb, None, {}), tmp_path / "v2")
+    m = json.loads((root / MANIFEST).read_text())
+    assert m["version"] == FORMAT_VERSION == 2 and set(m["params"]) == {"body", "limbs"}
+    assert m["params"]["body"]["dynamics"]["noise"]["torso"]["lam"] == 11.0
+    assert m["params"]["limbs"]["priors"]["sigma_s"] == 3.5
+    new = load_bundle(root)
+    # the same bundle as partlab 0.2 wrote it
+    flat_body = {old: body.get(new_) for old, new_ in BodyParams.FLAT.items()}
+    flat_body["part_noise"] = {k: vars(v) | {} for k, v in noise.items()}
+    flat_limb = {old: limb.get(new_) for old, new_ in LimbParams.FLAT.items()}
+    v1 = {k: v for k, v in m.items() if k not in ("params", "manifest_sha256")}
+    v1.update(version=1, body_params=json.loads(json.dumps(flat_body)), limb_params=flat_limb)
+    v1["manifest_sha256"] = hashlib.sha256(_canonical(v1)).hexdigest()
+    (tmp_path / "v1").mkdir()
+    (tmp_path / "v1" / MANIFEST).write_text(json.dumps(v1))
+    old = load_bundle(tmp_path / "v1")
+    assert old.body_params == new.body_params == body
+    assert old.limb_params == new.limb_params == limb
+    assert old.params["body"].dynamics.noise["torso"].x == 7.0

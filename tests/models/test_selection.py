@@ -12,7 +12,7 @@ DEFAULT = BodyParams()
 
 def _fake_runner(truths, shift: float = 0.0):
     """A deterministic 'tracker': reports the truth boxes moved right by ``shift`` box widths,
-    then moved and scaled by how ``params.output_extent`` differs from the built-in one (as the
+    then moved and scaled by how ``params.output.extent`` differs from the built-in one (as the
     real tracker's output would be); a detector moves nothing."""
     calls = []
 
@@ -21,8 +21,8 @@ def _fake_runner(truths, shift: float = 0.0):
         t = truths[i].copy()
         if detector == "harmful":  # its adjustments knock every head off
             t.loc[t.part == "head", "x"] += t.loc[t.part == "head", "w"]
-        for part, (sw, sh, dx, dy) in params.output_extent.items():
-            bw, bh, bdx, bdy = DEFAULT.output_extent[part]
+        for part, (sw, sh, dx, dy) in params.output.extent.items():
+            bw, bh, bdx, bdy = DEFAULT.output.extent[part]
             m = t.part == part
             w, h = t.loc[m, "w"], t.loc[m, "h"]
             cx = t.loc[m, "x"] + w / 2 + shift * w + (dx - bdx) * w
@@ -46,26 +46,26 @@ def test_part_rates_counts_half_on_and_centre_inside():
 
 def test_selection_drops_a_bad_extent_and_keeps_a_good_one():
     truths = [walking_truth(2, 20, seed=s) for s in (1, 2)]
-    hip = DEFAULT.output_extent["hipleg"]
+    hip = DEFAULT.output.extent["hipleg"]
     # (1) fitted extent that triples the hip-leg box: at most a third of it lies on the part
-    bad = replace(DEFAULT, output_extent={**DEFAULT.output_extent, "hipleg": (hip[0] * 3, hip[1] * 3, 0.0, 0.25)})
+    bad = DEFAULT.updated({"output.extent": {**DEFAULT.output.extent, "hipleg": (hip[0] * 3, hip[1] * 3, 0.0, 0.25)}})
     run, calls = _fake_runner(truths)
     sel = select_components(run, truths, DEFAULT, bad, detector="svm")
     assert sel.kept == {"noise": False, "extent": False, "detector": True}
-    assert sel.body_params.output_extent == DEFAULT.output_extent and sel.failure_detector == "svm"
+    assert sel.body_params.output.extent == DEFAULT.output.extent and sel.failure_detector == "svm"
     assert sel.scores["builtin"]["mean"] == 1.0 and sel.scores["+extent"]["hipleg"] == 0.0
     assert sel.scores["+detector"]["mean"] == 1.0  # a tie: the detector did no harm, so it stays
     assert len(calls) == 3 * 2  # built-in, +extent, +detector (noise not fitted: no run)
     # (2) the tracker reports every box 0.6 widths to the right: all centres off the part;
     # a fitted extent that shifts them back is kept, a detector that moves nothing stays (no harm)
-    good = replace(DEFAULT, output_extent={p: (sw, sh, dx - 0.6, dy) for p, (sw, sh, dx, dy)
-                                           in DEFAULT.output_extent.items()})
+    good = DEFAULT.updated({"output.extent": {p: (sw, sh, dx - 0.6, dy) for p, (sw, sh, dx, dy)
+                                              in DEFAULT.output.extent.items()}})
     run, calls = _fake_runner(truths, shift=0.6)
     base_tracks = [run(i, DEFAULT, None) for i in range(2)]
     sel = select_components(run, truths, DEFAULT, good, detector="svm", base_tracks=base_tracks)
     assert sel.scores["builtin"]["mean"] == 0.0 and sel.scores["+extent"]["mean"] == 1.0
     assert sel.kept == {"noise": False, "extent": True, "detector": True}
-    assert sel.body_params.output_extent["head"][2] == pytest.approx(-0.6)
+    assert sel.body_params.output.extent["head"][2] == pytest.approx(-0.6)
     assert len(calls) == 2 + 2 * 2  # the base tracks were given: built-in not re-run
     text = selection_table(sel.to_dict())
     assert "kept" in text and "not fitted" in text and "dropped" not in text
@@ -97,33 +97,33 @@ def test_training_from_a_bundle_keeps_its_detector_unless_the_new_one_does_no_ha
 
 def test_noise_is_tried_first_and_kept_params_carry_on():
     truths = [walking_truth(1, 10, seed=3)]
-    noisy = replace(DEFAULT, part_noise={**DEFAULT.part_noise,
-                                         "head": replace(DEFAULT.part_noise["head"], lam=35.0)})
+    noisy = DEFAULT.updated({"dynamics.noise": {**DEFAULT.dynamics.noise,
+                                                "head": replace(DEFAULT.dynamics.noise["head"], lam=35.0)}})
     run, calls = _fake_runner(truths)
     sel = select_components(run, truths, DEFAULT, noisy)
     # the fake tracker ignores the noise: a tie, so the built-in noise stays
-    assert sel.kept["noise"] is False and sel.body_params.part_noise["head"].lam == DEFAULT.part_noise["head"].lam
+    assert sel.kept["noise"] is False and sel.body_params.dynamics.noise["head"].lam == DEFAULT.dynamics.noise["head"].lam
     assert np.isclose(sel.scores["+noise"]["mean"], 1.0) and "+extent" not in sel.scores
 
 
 def test_noise_that_helps_one_part_and_hurts_another_is_kept_for_the_part_it_helps():
     truths = [walking_truth(1, 10, seed=4)]
-    fitted = replace(DEFAULT, part_noise={**DEFAULT.part_noise,
-                                          "head": replace(DEFAULT.part_noise["head"], lam=35.0),
-                                          "hipleg": replace(DEFAULT.part_noise["hipleg"], lam=36.0)})
+    fitted = DEFAULT.updated({"dynamics.noise": {**DEFAULT.dynamics.noise,
+                                                 "head": replace(DEFAULT.dynamics.noise["head"], lam=35.0),
+                                                 "hipleg": replace(DEFAULT.dynamics.noise["hipleg"], lam=36.0)}})
 
     def run(i, params, detector):  # fitted head noise knocks heads off, built-in hip-leg noise hip-legs
         t = truths[i].copy()
-        if params.part_noise["head"].lam == 35.0:
+        if params.dynamics.noise["head"].lam == 35.0:
             t.loc[t.part == "head", "x"] += t.loc[t.part == "head", "w"]
-        if params.part_noise["hipleg"].lam != 36.0:
+        if params.dynamics.noise["hipleg"].lam != 36.0:
             t.loc[t.part == "hipleg", "x"] += t.loc[t.part == "hipleg", "w"]
         return t
 
     sel = select_components(run, truths, DEFAULT, fitted)
     assert sel.kept["noise"] is True and sel.scores["+noise(hipleg)"]["mean"] == 1.0
-    assert sel.body_params.part_noise["hipleg"].lam == 36.0
-    assert sel.body_params.part_noise["head"].lam == DEFAULT.part_noise["head"].lam
+    assert sel.body_params.dynamics.noise["hipleg"].lam == 36.0
+    assert sel.body_params.dynamics.noise["head"].lam == DEFAULT.dynamics.noise["head"].lam
     text = selection_table(sel.to_dict())
     assert [line.split()[-1] for line in text.splitlines()[1:3]] == ["baseline", "dropped"]
     assert "+noise(hipleg)" in text.splitlines()[3] and text.splitlines()[3].split()[-1] == "kept"
@@ -131,14 +131,14 @@ def test_noise_that_helps_one_part_and_hurts_another_is_kept_for_the_part_it_hel
 
 def _inner_rect_runner(truths):
     """A deterministic 'tracker' for :func:`partlab.models.training.train_bundle`: its inner rectangle is the
-    true box moved right by 0.3 of its width, reported through ``params.output_extent``; with the
+    true box moved right by 0.3 of its width, reported through ``params.output.extent``; with the
     built-in extent the boxes are too large and off-centre (under half of them on the part)."""
     truth_of = {id(f): g for f, g in truths}
 
     def run(frames, fps, init, seed, params=None, failure_detector=None):
         params = params or BodyParams()
         t = truth_of[id(frames)].copy()
-        for part, (sw, sh, dx, dy) in params.output_extent.items():
+        for part, (sw, sh, dx, dy) in params.output.extent.items():
             m = t.part == part
             w, h = t.loc[m, "w"], t.loc[m, "h"]
             cx, cy = t.loc[m, "x"] + w / 2 + 0.3 * w + dx * w, t.loc[m, "y"] + h / 2 + dy * h
@@ -159,6 +159,6 @@ def test_train_bundle_validates_on_the_training_clips_and_records_it():
     assert sel["kept"] == {"noise": False, "extent": True, "detector": False}  # no SVM could be fitted
     assert sel["scores"]["builtin"]["mean"] == 0.0 and sel["scores"]["+extent"]["mean"] == 1.0
     for part in ("head", "torso", "hipleg"):
-        assert b.body_params.output_extent[part] == pytest.approx((1.0, 1.0, -0.3, 0.0), abs=1e-3)
-    assert b.body_params.part_noise == DEFAULT.part_noise and b.failure_detector is None
+        assert b.body_params.output.extent[part] == pytest.approx((1.0, 1.0, -0.3, 0.0), abs=1e-3)
+    assert b.body_params.dynamics.noise == DEFAULT.dynamics.noise and b.failure_detector is None
     assert "svms" in b.summary

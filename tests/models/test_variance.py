@@ -37,14 +37,14 @@ def test_body_fit_from_a_tracks_table_recovers_noise_and_size_steps():
             rows.append(dict(frame=f, track_id=tid, part="torso", x=cx[f] - w[f] / 2, y=cy[f] - 30, w=w[f], h=60.0))
     truth = normalise_tracks(pd.DataFrame(rows))
     body, table = fit_body_noise([truth], keep_defaults_as_floor=False)
-    n = body.part_noise["torso"]
+    n = body.dynamics.noise["torso"]
     assert abs(n.x - 2.0) / 2.0 < 0.1 and abs(n.vx - 0.5) / 0.5 < 0.1
     assert abs(n.y - 1.5) / 1.5 < 0.1 and abs(n.vy - 0.3) / 0.3 < 0.1
     assert abs(n.w - 1.2) / 1.2 < 0.1
     assert n.h == 1.0  # constant height: floored at 1 px
-    assert n.lam == BodyParams().part_noise["torso"].lam  # not fitted
+    assert n.lam == BodyParams().dynamics.noise["torso"].lam  # not fitted
     # parts without data keep their defaults
-    assert body.part_noise["head"] == BodyParams().part_noise["head"]
+    assert body.dynamics.noise["head"] == BodyParams().dynamics.noise["head"]
     t = table.set_index(["part", "parameter"])
     assert np.isnan(t.loc[("head", "x"), "fitted"]) and t.loc[("torso", "x"), "n"] == 3 * (198 + 197)
     assert "torso" in comparison_table(table)
@@ -52,7 +52,7 @@ def test_body_fit_from_a_tracks_table_recovers_noise_and_size_steps():
     assert len(fig.data) == 3 and len(fig.data[0].x) == len(table)
     # default policy: a fit only widens the defaults (torso default x = 4, vx = 1, w = 1)
     body2, table2 = fit_body_noise([truth])
-    n2 = body2.part_noise["torso"]
+    n2 = body2.dynamics.noise["torso"]
     assert n2.x == 4.0 and n2.vx == 1.0 and n2.w == pytest.approx(n.w)
     t2 = table2.set_index(["part", "parameter"])
     assert t2.loc[("torso", "x"), "fitted"] == pytest.approx(n.x) and t2.loc[("torso", "x"), "applied"] == 4.0
@@ -67,13 +67,17 @@ def test_limb_sigmas_from_known_residuals():
         rows.append(dict(frame=f, track_id=1, part="left_hand", x=hx - 5, y=hy - 5, w=10, h=10))
         rows.append(dict(frame=f, track_id=1, part="person", x=hx - 40, y=100, w=60, h=200))
     limb, table = fit_limb_sigmas([normalise_tracks(pd.DataFrame(rows))], keep_defaults_as_floor=False)
-    assert abs(limb.sigma_d - 3 * np.sqrt(6)) / (3 * np.sqrt(6)) < 0.1
-    assert abs(limb.sigma_v - 3 * np.sqrt(2)) / (3 * np.sqrt(2)) < 0.1
-    assert limb.sigma_s == 1.0  # always inside its person box: floored
+    assert abs(limb.priors.sigma_d - 3 * np.sqrt(6)) / (3 * np.sqrt(6)) < 0.1
+    assert abs(limb.priors.sigma_v - 3 * np.sqrt(2)) / (3 * np.sqrt(2)) < 0.1
+    assert limb.priors.sigma_s == 1.0  # always inside its person box: floored
     assert set(table["parameter"]) == {"sigma_d", "sigma_v", "sigma_s"}
-    assert LimbParams().sigma_d == 20.0
+    # saved, but no one-camera tracker reads sigma_v / sigma_d: the table does not call them applied
+    t = table.set_index("parameter")
+    assert np.isnan(t.loc["sigma_d", "applied"]) and np.isnan(t.loc["sigma_v", "applied"])
+    assert t.loc["sigma_s", "applied"] == 1.0 and "not read" in t.loc["sigma_d", "source"]
+    assert LimbParams().priors.sigma_d == 20.0
     floored, _ = fit_limb_sigmas([normalise_tracks(pd.DataFrame(rows))])
-    assert (floored.sigma_d, floored.sigma_v, floored.sigma_s) == (20.0, 12.0, 8.0)
+    assert (floored.priors.sigma_d, floored.priors.sigma_v, floored.priors.sigma_s) == (20.0, 12.0, 8.0)
 
 
 def test_noise_from_the_trackers_prediction_errors():
@@ -92,7 +96,7 @@ def test_noise_from_the_trackers_prediction_errors():
     # truth moves exactly linearly: residual = -(2 e_{t-1} - e_{t-2}), std 2 * sqrt(5)
     assert abs(np.std(r["cx"]) - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
     body, table = fit_body_noise([truth], tracked=[tracked], keep_defaults_as_floor=False)
-    n = body.part_noise["torso"]
+    n = body.dynamics.noise["torso"]
     assert abs(n.x - 2 * np.sqrt(5)) / (2 * np.sqrt(5)) < 0.1
     assert n.w == 1.0 and n.y == 1.0           # constant offsets are not noise: floored
     assert n.vx == 0.1                         # the truth's velocity never changes: floored

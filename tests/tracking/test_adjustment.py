@@ -110,7 +110,7 @@ def test_a_bending_persons_lost_head_is_found_by_its_model_not_put_above_the_tor
     head_true = Box(121, 81, 22, 22)
     results = {}
     for search in (0.0, 0.6):
-        params = BodyParams(shrink_given_parts=False, adjust_search=search)
+        params = BodyParams().updated({"decomposition.shrink_given_parts": False, "adjustment.search": search})
         tracker = BodyTracker(params, np.random.default_rng(3))
         person = tracker.start_track(1, {"head": head_true, "torso": Box(90, 82, 24, 20),
                                          "hipleg": Box(41, 104, 18, 40)}, ycc, mask, 0)

@@ -129,7 +129,8 @@ def test_a_walker_in_the_first_frame_leaves_a_ghost_that_starts_no_track():
     rate, n = _rate(tracks, truths, tid, "torso", 1)
     assert n >= 40 and rate >= 0.85
     # with the old start rule (seen 3 frames running, no motion needed) the ghost starts a track
-    old = BodyParams(start_min_motion=0.0, detection_margin=-1.0, ghost_edge_contrast=0.0)
+    old = BodyParams().updated({"detection.start_min_motion": 0.0, "detection.margin": -1.0,
+                               "detection.ghost_edge_contrast": 0.0})
     assert _run(BodyTracker(old, np.random.default_rng(2)), frames)["track_id"].nunique() > 1
 
 
@@ -192,13 +193,12 @@ def _mean_iou(tracks, truths, part):
 
 def test_reported_boxes_cover_the_parts_not_just_their_inner_rectangles():
     """The filters track inner rectangles; the written boxes are widened to the part's extent
-    (``BodyParams.output_extent``), so a user corrects far less. (1, 1, 0, 0) gives the paper's
+    (``BodyParams.output.extent``), so a user corrects far less. (1, 1, 0, 0) gives the paper's
     inner rectangles back, which overlap the drawn parts much less."""
-    from dataclasses import replace
 
     frames, truths = _scene(n=30)
     wide = _run(BodyTracker(BodyParams(), np.random.default_rng(1), init=_init(truths[0])), frames)
-    inner_params = replace(BodyParams(), output_extent={})
+    inner_params = BodyParams().updated({"output.extent": {}})
     inner = _run(BodyTracker(inner_params, np.random.default_rng(1), init=_init(truths[0])), frames)
     for part in ("head", "torso", "person"):
         assert _mean_iou(wide, truths, part) > _mean_iou(inner, truths, part) + 0.15, part
@@ -207,7 +207,7 @@ def test_reported_boxes_cover_the_parts_not_just_their_inner_rectangles():
     # the same filters underneath: the centres of the two outputs differ only by the shift
     w = wide[(wide.part == "torso") & (wide.frame == 20)].iloc[0]
     i = inner[(inner.part == "torso") & (inner.frame == 20)].iloc[0]
-    assert w.w == pytest.approx(i.w * BodyParams().output_extent["torso"][0], rel=1e-3)
+    assert w.w == pytest.approx(i.w * BodyParams().output.extent["torso"][0], rel=1e-3)
 
 
 def test_automatic_start_decomposes_the_blob_that_found_the_person():

@@ -45,7 +45,7 @@ def test_candidate_prior_is_the_product_of_named_terms():
     fg[:, :30] = 255
     skin = SkinModel.default()
     blobs = find_blobs(skin.mask(frame), 1, 1.5, 10)
-    c = candidate_terms(blobs, fg, skin.probability(frame), LimbParams(sigma_s=4.0))
+    c = candidate_terms(blobs, fg, skin.probability(frame), LimbParams().updated({"priors.sigma_s": 4.0}))
     assert set(c.terms) == {"silhouette", "skin"}
     np.testing.assert_allclose(c.priors, c.terms["silhouette"] * c.terms["skin"])
     order = np.argsort(c.centres[:, 0])
@@ -53,7 +53,7 @@ def test_candidate_prior_is_the_product_of_named_terms():
 
 
 def test_filter_follows_a_moving_skin_disc_and_refines_onto_it():
-    p = LimbParams(particles=200)
+    p = LimbParams().updated({"dynamics.particles": 200})
     rng = np.random.default_rng(3)
     skin = SkinModel.default()
     filt = None
@@ -64,13 +64,13 @@ def test_filter_follows_a_moving_skin_disc_and_refines_onto_it():
         cv2.circle(frame, (cx, 30), 7, SKIN, -1)
         cv2.circle(frame, (100, 50), 4, (40, 40, 200), -1)  # a red distractor (not skin)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
-        bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
+        bins = hue_bin_image(hsv, p.appearance.hue_bins, p.appearance.hue_min_saturation, p.appearance.hue_min_value)
         cands = candidate_terms(find_blobs(skin.mask(frame), 1, 1.5, 10), None, skin.probability(frame), p)
         if filt is None:
-            filt = LimbFilter((cx, 30), (14, 14), reference_histogram(bins, (cx - 7, 23, 14, 14), p.hue_bins), p, rng)
+            filt = LimbFilter((cx, 30), (14, 14), reference_histogram(bins, (cx - 7, 23, 14, 14), p.appearance.hue_bins), p, rng)
             continue
         filt.predict(rng)
-        filt.weigh(cands, integral_histogram(bins, p.hue_bins))
+        filt.weigh(cands, integral_histogram(bins, p.appearance.hue_bins))
         filt.refine(back_projection(bins, filt.ref_hist))
         filt.resample(rng)
         errors.append(np.hypot(filt.estimate[0] - cx, filt.estimate[1] - 30))

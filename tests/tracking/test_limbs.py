@@ -14,7 +14,7 @@ from partlab.tracking.tracks import records_to_frame
 SKIN = (110, 150, 210)
 BG = (90, 110, 70)
 SHIRT = (140, 60, 40)
-P = LimbParams(particles=150)
+P = LimbParams().updated({"dynamics.particles": 150})
 
 
 def clap_scene(n=60, hide_left=()):
@@ -101,7 +101,7 @@ def test_without_init_head_and_hands_start_and_are_labelled_by_position():
     t = truth[truth.frame == 13].assign(track_id=int(last.track_id.iloc[0]))
     err, _ = centre_error(last, t)
     assert err.max() < 4.0
-    assert (out.frame.min()) >= P.start_frames - 1  # nothing before a candidate was strong long enough
+    assert (out.frame.min()) >= P.states.start_frames - 1  # nothing before a candidate was strong long enough
 
 
 def test_init_with_only_body_rows_starts_limbs_automatically_after_its_ids():
@@ -183,7 +183,8 @@ def test_head_whose_confidence_stays_low_is_reacquired_by_the_face_detector():
         f = frames[t]
         cv2.circle(f, (80, 25), 11, BG, -1)
         cv2.circle(f, (140, 25), 11, SKIN, -1)
-    params = LimbParams(particles=150, reacquire_frames=3, person_radius=5.0)
+    params = LimbParams().updated({"dynamics.particles": 150, "adjustment.reacquire_frames": 3,
+                                  "labels.person_radius": 5.0})
     tr = LimbTracker(params, np.random.default_rng(0), init=truth[truth.frame == 0], face_detector=False)
     faces = FakeFaces()
     tr.face = faces
@@ -231,6 +232,6 @@ def test_a_hand_on_its_forearm_is_tracked_at_the_arm_end_not_the_blob_centre():
     assert err[hands].max() < 5.0
     assert (m.state[hands] == "normal").all()
     # with blob centres the same clip pulls the hands up their forearms
-    centres = LimbParams(particles=150, tip_span=0.0)
+    centres = LimbParams().updated({"dynamics.particles": 150, "blobs.tip_span": 0.0})
     err0, m0 = centre_error(run(LimbTracker(centres, np.random.default_rng(3), init=init), frames), truth)
     assert err0[m0.part.str.endswith("hand")].max() > 10.0

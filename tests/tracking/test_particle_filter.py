@@ -39,7 +39,7 @@ def test_filter_follows_a_moving_rectangle(compiled, monkeypatch):
         pytest.skip("numba not installed")
     monkeypatch.setattr(kernels, "HAVE_NUMBA", compiled)  # False: the numpy + OpenCV fallback
     rng = np.random.default_rng(0)
-    params = BodyParams(particles_initial=300)
+    params = BodyParams().updated({"particles.initial": 300})
     noise = PartNoise(x=3, y=3, w=0.5, h=0.5, vx=0.5, vy=0.5, lam=20)
     cx, cy = 40.0, 60.0
     pf = PartFilter(Box(cx - 8, cy - 12, 16, 24), to_ycc(_frame(rng, cx, cy)), params, noise,
@@ -62,7 +62,7 @@ def test_filter_follows_a_moving_rectangle(compiled, monkeypatch):
 
 def test_entropy_adapts_particle_count_within_bounds():
     rng = np.random.default_rng(3)
-    params = BodyParams(particles_initial=500)
+    params = BodyParams().updated({"particles.initial": 500})
     noise = PartNoise(x=3, y=3, w=0.5, h=0.5, vx=0.5, vy=0.5, lam=20)
     pf = PartFilter(Box(32, 48, 16, 24), to_ycc(_frame(rng, 40, 60)), params, noise, np.random.default_rng(4))
     # lost: the target vanishes, weights flatten, the count grows (by C = 1.2 at most) to the cap 1000

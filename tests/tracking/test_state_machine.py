@@ -8,8 +8,9 @@ import pytest
 from partlab.tracking.params import LimbParams
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation, assign_by_direction
 
-P = LimbParams(combine_distance=20.0, split_distance=30.0, lost_likelihood=0.15, recover_likelihood=0.3,
-               lost_frames=3, start_frames=3, start_prior=0.5, history_frames=10)
+P = LimbParams().updated({"states.combine_distance": 20.0, "states.split_distance": 30.0,
+                         "states.lost_likelihood": 0.15, "states.recover_likelihood": 0.3, "states.lost_frames": 3,
+                         "states.start_frames": 3, "states.start_prior": 0.5, "states.history_frames": 10})
 S = LimbState
 
 
@@ -146,8 +147,9 @@ def test_a_drifting_tracker_below_the_lost_threshold_is_not_combined():
 
 
 def test_with_sizes_the_distances_scale_with_the_targets():
-    p = LimbParams(combine_distance=20.0, split_distance=30.0, combine_size=1.3, split_size=1.8,
-                   lost_likelihood=0.15, history_frames=10)
+    p = LimbParams().updated({"states.combine_distance": 20.0, "states.split_distance": 30.0,
+                              "states.combine_size": 1.3, "states.split_size": 1.8,
+                              "states.lost_likelihood": 0.15, "states.history_frames": 10})
     m = LimbStateMachine(p)
     m.add(0, S.NORMAL)
     m.add(1, S.NORMAL)

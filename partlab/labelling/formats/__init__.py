@@ -8,6 +8,8 @@ The registry :data:`FORMATS` maps a format name to its module's ``export`` and
 
 from __future__ import annotations
 
+import dataclasses
+
 import shutil
 import tempfile
 from dataclasses import dataclass
@@ -18,7 +20,7 @@ import pandas as pd
 
 from partlab.labelling.archive import ArchiveError, is_archive, safe_extract
 from partlab.labelling.formats import coco, cvat, mot, parquet, voc, yolo
-from partlab.labelling.formats.base import ExportManifest, FormatError, check_frame_count
+from partlab.labelling.formats.base import MANIFEST_NAME, ExportManifest, FormatError, check_frame_count
 from partlab.labelling.video import VideoInfo, probe
 
 __all__ = ["FORMATS", "IMPORT_FORMATS", "FormatError", "Format", "export_dataset", "import_dataset", "export_clip",
@@ -69,16 +71,37 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise FormatError(f"{out}: exists and is not a directory; -o names the output directory")
-    if out.is_dir() and any(out.iterdir()):
-        if ExportManifest.read(out) is None:
-            raise FormatError(f"{out}: the directory is not empty and holds no partlab export; choose a new or "
-                              "empty directory (a previous partlab export there is replaced)")
-        for child in out.iterdir():  # a previous export of ours: replace it, so no stale frames stay
-            shutil.rmtree(child) if child.is_dir() and not child.is_symlink() else child.unlink()
     if frames and video_path is None and fmt != "parquet":
         raise FormatError(f"writing frames for {fmt} needs the video (or pass frames=False / --no-frames)")
-    return f.export(tracks_df, out, video_info, video_path=video_path, every=every,
-                    frames=frames and fmt != "parquet")
+    if out.is_dir() and any(out.iterdir()):
+        _remove_previous_export(out)
+    kept = {c.name for c in out.iterdir()} if out.is_dir() else set()
+    result = f.export(tracks_df, out, video_info, video_path=video_path, every=every,
+                      frames=frames and fmt != "parquet")
+    manifest = ExportManifest.read(out)
+    if manifest is not None:  # record what this export wrote, so the next one removes only that
+        written = sorted(c.name for c in out.iterdir() if c.name not in kept) + [MANIFEST_NAME]
+        dataclasses.replace(manifest, files=tuple(dict.fromkeys(written))).write(out)
+    return result
+
+
+def _remove_previous_export(out: Path) -> None:
+    """Remove the files an earlier partlab export in ``out`` listed; leave everything else."""
+    manifest = ExportManifest.read(out)
+    if manifest is None:
+        raise FormatError(f"{out}: the directory is not empty and holds no partlab export; choose a new or "
+                          "empty directory (a previous partlab export there is replaced)")
+    if not manifest.files:
+        raise FormatError(f"{out}: holds an export from an older partlab that did not list its files; "
+                          "remove it or choose another directory (nothing was deleted)")
+    for name in manifest.files:
+        child = out / name
+        if Path(name).name != name or name in ("", ".", ".."):
+            continue  # a tampered list never reaches outside the directory
+        if child.is_dir() and not child.is_symlink():
+            shutil.rmtree(child)
+        elif child.exists() or child.is_symlink():
+            child.unlink()
 
 
 def _import_dir(path: Path, f: Format, mapping, video) -> pd.DataFrame:

@@ -60,6 +60,8 @@ class ExportManifest:
     parts: tuple[str, ...] = field(default_factory=lambda: PART_NAMES)
     notes: str = ""
     version: int = MANIFEST_VERSION
+    #: top-level entries of the directory this export wrote (a later export removes only these)
+    files: tuple[str, ...] = ()
 
     @classmethod
     def for_video(cls, fmt: str, info: VideoInfo, every: int, frames_written: bool,
@@ -71,6 +73,7 @@ class ExportManifest:
         path = Path(out_dir) / MANIFEST_NAME
         d = asdict(self)
         d["parts"] = list(self.parts)
+        d["files"] = list(self.files)
         path.write_text(json.dumps(d, indent=2) + "\n", encoding="utf-8")
         return path
 
@@ -83,6 +86,7 @@ class ExportManifest:
         try:
             d = json.loads(path.read_text(encoding="utf-8"))
             d["parts"] = tuple(d.get("parts", PART_NAMES))
+            d["files"] = tuple(str(f) for f in d.get("files", ()))
             known = {k: v for k, v in d.items() if k in cls.__dataclass_fields__}
             return cls(**known)
         except (ValueError, TypeError) as exc:

@@ -140,7 +140,7 @@ def adjust_person(tracker: "BodyTracker", person: "Person", verdict: FailureVerd
         name = "head" if "head" in failed else "hipleg"
         rebuild = head_from_torso if name == "head" else hipleg_from_torso
         new = rebuild(boxes["torso"], boxes["hipleg"], boxes[name], mask, W, H)
-        found = search_on_body(f[name], f["torso"].state, new, ycc, mask, tracker.params.adjust_search)
+        found = search_on_body(f[name], f["torso"].state, new, ycc, mask, tracker.params.adjustment.search)
         if found is not None:
             # the part's own model found it on the body, away from where an upright body
             # would have it (a bent person): move there, keep the model that found it

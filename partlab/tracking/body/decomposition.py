@@ -1,7 +1,7 @@
 """Three-part decomposition of a person's foreground region (seed 002 sec. 4.1).
 
 1. Two horizontal separation lines cut the person's foreground rows by the height ratios
-   ``BodyParams.height_ratios`` (head : torso : hip-leg; the paper gives none, so adult
+   ``BodyParams.decomposition.height_ratios`` (head : torso : hip-leg; the paper gives none, so adult
    proportions are used, see the parameter's comment).
 2. Each line moves up or down while the mean colours (YCrCb) of the two sections it
    separates grow more different; a line that wanders further than
@@ -94,11 +94,11 @@ def separation_lines(colours: np.ndarray, fg: np.ndarray, top: int, bottom: int,
         return (cum_s[b] - cum_s[a]) / max(n, 1.0)
 
     height = bottom - top
-    r = np.asarray(params.height_ratios, dtype=np.float64)
+    r = np.asarray(params.decomposition.height_ratios, dtype=np.float64)
     r = r / r.sum()
     init1 = top + int(round(r[0] * height))
     init2 = top + int(round((r[0] + r[1]) * height))
-    limit = max(1, int(round(params.separation_search * height)))
+    limit = max(1, int(round(params.decomposition.separation_search * height)))
     step = max(1, height // 50)
 
     def climb(line: int, lo_bound: int, hi_bound: int, upper: int, lower: int, initial: int) -> int:

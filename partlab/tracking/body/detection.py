@@ -31,14 +31,14 @@ def person_blobs(mask: np.ndarray, params: BodyParams | None = None) -> list[Box
     out: list[tuple[int, Box]] = []
     for i in range(1, n):
         x, y, w, h, area = (int(v) for v in stats[i])
-        if h < p.min_person_height or w < p.min_person_width:
+        if h < p.detection.min_person_height or w < p.detection.min_person_width:
             continue
-        if w > p.max_person_aspect * h or h > 0.95 * H:
+        if w > p.detection.max_person_aspect * h or h > 0.95 * H:
             continue
-        b = p.detection_border
+        b = p.detection.border
         if x < b or y < b or x + w > W - b or y + h > H - b:
             continue
-        if area < p.blob_fill_min * w * h:
+        if area < p.detection.fill_min * w * h:
             continue
         out.append((area, Box(float(x), float(y), float(w), float(h))))
     out.sort(key=lambda t: -t[0])

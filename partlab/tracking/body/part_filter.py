@@ -75,11 +75,11 @@ class PartFilter:
         self.state = box_to_state(box)
         self.state[4:6] = velocity
         self.base_size = np.array([box.w, box.h], dtype=np.float64)
-        lo, hi = self.params.size_range
+        lo, hi = self.params.dynamics.size_range
         self._size_lo = (lo * self.base_size).astype(np.float32)
         self._size_hi = (hi * self.base_size).astype(np.float32)
-        n = int(n or self.params.particles_initial)
-        spread = self._sigma * np.float32(self.params.init_spread)
+        n = int(n or self.params.particles.initial)
+        spread = self._sigma * np.float32(self.params.dynamics.init_spread)
         self.particles = (self.state.astype(np.float32)
                           + self.rng.standard_normal((n, 6), dtype=np.float32) * spread)
         self._clip_sizes()
@@ -93,14 +93,14 @@ class PartFilter:
     def _refresh_map(self) -> None:
         p = self.params
         if kernels.HAVE_NUMBA:
-            smoothed = _smooth(np.asarray(self.reference, dtype=np.float64), p.equalization_smoothing)
+            smoothed = _smooth(np.asarray(self.reference, dtype=np.float64), p.appearance.equalization_smoothing)
             self.mapping, self.target, self.sqrt_target = kernels.equalize(
-                smoothed, self.reference, p.bins_per_channel, p.equalization_floor)
+                smoothed, self.reference, p.appearance.bins_per_channel, p.appearance.equalization_floor)
             return
-        self.mapping = equalization_map(self.reference, p.bins_per_channel, p.equalization_smoothing,
-                                        p.equalization_floor)
-        self.lut = fused_lut(self.mapping, p.bins_per_channel)
-        self.target = binned_histogram(self.reference, self.mapping, p.bins_per_channel)
+        self.mapping = equalization_map(self.reference, p.appearance.bins_per_channel, p.appearance.equalization_smoothing,
+                                        p.appearance.equalization_floor)
+        self.lut = fused_lut(self.mapping, p.appearance.bins_per_channel)
+        self.target = binned_histogram(self.reference, self.mapping, p.appearance.bins_per_channel)
         per_channel = self.target.reshape(3, -1)
         per_channel = per_channel / np.maximum(per_channel.sum(axis=1, keepdims=True), 1e-12)
         self.sqrt_target = np.sqrt(per_channel).reshape(-1)
@@ -151,7 +151,7 @@ class PartFilter:
         With ``anchor_x`` and ``anchor_sigma > 0`` the weights are also multiplied by
         ``exp(-0.5 ((X - anchor_x) / anchor_sigma)^2)``: a part of a body stays near the
         body's axis (the torso's centre line) instead of following a look-alike part of
-        someone else (see ``BodyParams.coherence``); ``anchor_y`` likewise keeps its height
+        someone else (see ``BodyParams.dynamics.coherence``); ``anchor_y`` likewise keeps its height
         relative to the torso near the one it started with."""
         _, rho, areas = self._similarities(ycc, self.particles)
         if kernels.HAVE_NUMBA:
@@ -224,7 +224,7 @@ class PartFilter:
 
     def _stride(self) -> int:
         """2 (every second pixel) for parts at least ``histogram_stride_min`` wide and tall."""
-        m = self.params.histogram_stride_min
+        m = self.params.appearance.histogram_stride_min
         return 2 if m > 0 and min(self.state[2], self.state[3]) >= m else 1
 
     def coast(self) -> None:
@@ -255,22 +255,22 @@ class PartFilter:
         """Bhattacharyya coefficient of a 256-level histogram with this part's model."""
         if kernels.HAVE_NUMBA:
             return float(kernels.similarity(observed, self.mapping, self.sqrt_target))
-        b = self.params.bins_per_channel
+        b = self.params.appearance.bins_per_channel
         return float(bhattacharyya(binned_histogram(observed, self.mapping, b), self.target, b))
 
     def update_model(self, observed: np.ndarray) -> None:
         """Seed 002 eq. (1) on the 256-level reference, then a new equalization map."""
-        self.reference = update_reference(self.reference, observed, self.params.model_update)
+        self.reference = update_reference(self.reference, observed, self.params.appearance.model_update)
         self._refresh_map()
 
     def resample(self) -> None:
         """Systematic resampling to the entropy-adaptive count of seed 002 eq. (2)."""
         p = self.params
         if kernels.HAVE_NUMBA:  # the weights are normalised (measure, coast, reseed)
-            self.particles, self.weights = kernels.resample(self.particles, self.weights, p.particles_c,
-                                                            p.particles_min, p.particles_max, self.rng.random())
+            self.particles, self.weights = kernels.resample(self.particles, self.weights, p.particles.c,
+                                                            p.particles.min, p.particles.max, self.rng.random())
             return
-        n = adaptive_particle_count(self.weights, p.particles_c, p.particles_min, p.particles_max)
+        n = adaptive_particle_count(self.weights, p.particles.c, p.particles.min, p.particles.max)
         idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)

@@ -126,7 +126,7 @@ def _piece_of(blob: Box, person: Box, p: BodyParams) -> bool:
     """A blob beside a tracked person box that is a part of that person the box does not cover
     (legs or head above or below it, within its width; an arm or a leg beside it, within its
     height and shorter than the person), not someone new."""
-    near = p.detection_margin * person.h * 2
+    near = p.detection.margin * person.h * 2
     across = max(0.0, min(blob.x2, person.x2) - max(blob.x, person.x))
     if across >= 0.5 * blob.w and max(person.y - blob.y2, blob.y - person.y2, 0.0) <= near:
         return True
@@ -175,7 +175,7 @@ class BodyTracker:
                 return {"person": boxes["person"]}
             return {"person": minimum_bounding_rectangle(boxes[p] for p in BODY_PARTS if p in boxes)}
         parts = {p: boxes[p] for p in BODY_PARTS if p in boxes}
-        if self.params.shrink_given_parts:
+        if self.params.decomposition.shrink_given_parts:
             parts = {p: shrink_part(ycc, mask, b, p) for p, b in parts.items()}
         if len(parts) < 3:
             person = boxes.get("person")
@@ -191,7 +191,7 @@ class BodyTracker:
         """Start tracking a person from its boxes (person and/or part boxes); ``from_mask``: the
         boxes come from the foreground mask itself (automatic detection), so it is trusted even
         while the background model is young."""
-        if not from_mask and self.frames_seen < self.params.background_warmup // 2:
+        if not from_mask and self.frames_seen < self.params.background.warmup // 2:
             mask = None  # the background model has not learnt the scene yet: decompose by contrast
         ycc = as_array(ycc)
         parts = self._part_boxes_for_start(boxes, ycc, mask)
@@ -201,8 +201,8 @@ class BodyTracker:
             b = parts[name].clip(W, H)
             if b.w < 2 or b.h < 2:
                 b = Box(b.x, b.y, max(b.w, 2.0), max(b.h, 2.0))
-            filters[name] = PartFilter(b, ycc, self.params, self.params.part_noise[name], self.rng)
-        person = Person(track_id, filters, deque(maxlen=self.params.history_frames), started=index)
+            filters[name] = PartFilter(b, ycc, self.params, self.params.dynamics.noise[name], self.rng)
+        person = Person(track_id, filters, deque(maxlen=self.params.adjustment.history_frames), started=index)
         if "torso" in filters:
             t = filters["torso"].state
             person.offsets = {n: float((f.state[1] - t[1]) / max(t[3], 1.0))
@@ -224,16 +224,16 @@ class BodyTracker:
         p = self.params
         tracked = [self._reported_person_box(person) for person in self.people.values()]
         free = mask
-        if tracked and p.detection_margin >= 0:
+        if tracked and p.detection.margin >= 0:
             free = mask.copy()
             H, W = mask.shape[:2]
             for t in tracked:
-                m = p.detection_margin
+                m = p.detection.margin
                 c = t.transformed(1 + 2 * m, 1 + 2 * m, 0.0, 0.0).clip(W, H)
                 free[int(c.y):int(np.ceil(c.y2)), int(c.x):int(np.ceil(c.x2))] = 0
         fresh: list[tuple[Box, int, Box]] = []
         for blob in person_blobs(free, p):
-            if any(blob.intersection(t) > p.detection_overlap * blob.area or _piece_of(blob, t, p) for t in tracked):
+            if any(blob.intersection(t) > p.detection.overlap * blob.area or _piece_of(blob, t, p) for t in tracked):
                 continue
             count, first = 1, blob
             if self.candidates:
@@ -242,8 +242,8 @@ class BodyTracker:
                 k = int(np.argmax(ious))
                 if ious[k] > 0.3:
                     count, first = self.candidates[k][1] + 1, self.candidates[k][2]
-            if (count >= p.start_frames and _moved(first, blob, p.start_min_motion * blob.h)
-                    and edge_contrast(frame, mask, blob) >= p.ghost_edge_contrast):
+            if (count >= p.detection.start_frames and _moved(first, blob, p.detection.start_min_motion * blob.h)
+                    and edge_contrast(frame, mask, blob) >= p.detection.ghost_edge_contrast):
                 self.start_track(self.next_id, {"person": blob}, ycc, mask, index, from_mask=True)
                 tracked.append(blob)
                 self.next_id += 1
@@ -303,7 +303,7 @@ class BodyTracker:
                 if person.occluded_by is not None or name in person.hidden_parts:
                     continue
                 q = person.observed.pop(name, None)
-                if q is not None and person.scores[name] >= p.update_min_similarity and not person.adjusted:
+                if q is not None and person.scores[name] >= p.appearance.update_min_similarity and not person.adjusted:
                     f.update_model(q)
                 f.resample()
 
@@ -324,13 +324,13 @@ class BodyTracker:
             front = self.people.get(person.occluded_by)
             predicted = {n: f.predicted_box() for n, f in person.filters.items()}
             if (front is None or not self._touching(predicted, front.part_boxes())[0]
-                    or person.occluded_frames > self.params.occlusion_max_frames):
+                    or person.occluded_frames > self.params.occlusion.max_frames):
                 person.occluded_by = None
                 person.occluded_frames = 0
         hidden = []
         for name, f in person.filters.items() if self.occluders else ():
             b = f.predicted_box()
-            if any(_overlap_fraction(b, o) >= self.params.occluder_overlap for o in self.occluders):
+            if any(_overlap_fraction(b, o) >= self.params.occlusion.occluder_overlap for o in self.occluders):
                 hidden.append(name)
         person.hidden_parts = tuple(hidden)
 
@@ -349,14 +349,14 @@ class BodyTracker:
             if torso is None or name not in person.offsets:
                 f.measure(ycc)
             else:
-                s = self.params.shared_motion
+                s = self.params.dynamics.shared_motion
                 if s > 0:  # one body moves as one: the torso's motion carries the other parts
                     step = torso[0:2] - person.prev["torso"][0:2]
                     delta = np.float32(s) * (step.astype(np.float32) - f.particles[:, 4:6])
                     f.particles[:, 0:2] += delta
                     f.particles[:, 4:6] += delta
                 ax, ay = torso[0], torso[1] + person.offsets[name] * torso[3]
-                f.measure(ycc, ax, self.params.coherence * torso[2], ay, self.params.coherence_y * torso[3])
+                f.measure(ycc, ax, self.params.dynamics.coherence * torso[2], ay, self.params.dynamics.coherence_y * torso[3])
             if name == "torso":
                 torso = f.state.copy()
             person.observed[name] = q = f.appearance(ycc)
@@ -383,13 +383,13 @@ class BodyTracker:
         p = self.params
         anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
         f = person.filters[anchor]
-        if p.release_similarity <= 0:
+        if p.occlusion.release_similarity <= 0:
             return
-        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
-        if rho < p.release_similarity:
+        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
+        if rho < p.occlusion.release_similarity:
             return
         found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
-        if any(_overlap_fraction(found, o) >= p.occluder_overlap for o in self.occluders):
+        if any(_overlap_fraction(found, o) >= p.occlusion.occluder_overlap for o in self.occluders):
             return
         delta = state[0:2] - f.state[0:2]
         for g in person.filters.values():
@@ -403,10 +403,10 @@ class BodyTracker:
         p = self.params
         anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
         f = person.filters[anchor]
-        if person.occluded_frames < 2 or p.release_similarity <= 0:
+        if person.occluded_frames < 2 or p.occlusion.release_similarity <= 0:
             return
-        state, rho = f.probe(ycc, p.release_search * float(f.state[2]))
-        if rho < p.release_similarity:
+        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
+        if rho < p.occlusion.release_similarity:
             return
         front = self.people.get(person.occluded_by)
         found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
@@ -427,7 +427,7 @@ class BodyTracker:
         p = self.params
         visible = [q for q in active if q.occluded_by is None]
         p_boxes = {q.track_id: q.box() for q in visible}
-        pad = 1 + 2 * p.occlusion_pad
+        pad = 1 + 2 * p.occlusion.pad
         for i, a in enumerate(visible):
             for b in visible[i + 1:]:
                 if a.occluded_by is not None or b.occluded_by is not None:
@@ -441,7 +441,7 @@ class BodyTracker:
                 a.touching = b.touching = True
                 sa = min(a.scores.get(n, 1.0) for n in touching_a)
                 sb = min(b.scores.get(n, 1.0) for n in touching_b)
-                if abs(sa - sb) < p.occlusion_margin:
+                if abs(sa - sb) < p.occlusion.margin:
                     continue
                 behind, front = (a, b) if sa < sb else (b, a)
                 behind.occluded_by = front.track_id
@@ -456,7 +456,7 @@ class BodyTracker:
     def _touching(self, boxes_a: dict[str, Box], boxes_b: dict[str, Box]) -> tuple[set, set]:
         """Parts of two persons that overlap by more than ``occlusion_overlap`` of the smaller."""
         ta, tb = set(), set()
-        pad = self.params.occlusion_pad
+        pad = self.params.occlusion.pad
         if pad > 0:  # inner rectangles are narrower than the parts they stand for
             grow = lambda b: Box(b.x - pad * b.w, b.y, b.w * (1 + 2 * pad), b.h)  # noqa: E731
             boxes_a = {n: grow(b) for n, b in boxes_a.items()}
@@ -464,7 +464,7 @@ class BodyTracker:
         for na, ba in boxes_a.items():
             for nb, bb in boxes_b.items():
                 smaller = min(ba.area, bb.area)
-                if smaller > 0 and ba.intersection(bb) > self.params.occlusion_overlap * smaller:
+                if smaller > 0 and ba.intersection(bb) > self.params.occlusion.overlap * smaller:
                     ta.add(na)
                     tb.add(nb)
         return ta, tb
@@ -484,15 +484,15 @@ class BodyTracker:
         frame_box = Box(0, 0, W, H)
         for person in active:
             box = person.box()
-            if box.area <= 0 or _overlap_fraction(box, frame_box) < p.leave_fraction:
+            if box.area <= 0 or _overlap_fraction(box, frame_box) < p.detection.leave_fraction:
                 del self.people[person.track_id]
                 continue
             if self.auto and mask is not None and person.occluded_by is None and not person.hidden_parts:
                 c = box.clip(W, H)
                 region = mask[int(c.y):int(c.y2), int(c.x):int(c.x2)]
                 support = float((region > 0).mean()) if region.size else 0.0
-                person.unsupported = person.unsupported + 1 if support < p.support_min else 0
-                if person.unsupported >= p.lost_frames:
+                person.unsupported = person.unsupported + 1 if support < p.detection.support_min else 0
+                if person.unsupported >= p.detection.lost_frames:
                     del self.people[person.track_id]
         for tid, q in list(self.people.items()):
             if q.occluded_by is not None and q.occluded_by not in self.people:
@@ -500,8 +500,8 @@ class BodyTracker:
 
     def report_box(self, part: str, box: Box) -> Box:
         """The box written for a part: its tracked inner rectangle widened to the part's extent
-        (``BodyParams.output_extent``), clipped to the frame."""
-        sw, sh, dx, dy = self.params.output_extent.get(part, (1.0, 1.0, 0.0, 0.0))
+        (``BodyParams.output.extent``), clipped to the frame."""
+        sw, sh, dx, dy = self.params.output.extent.get(part, (1.0, 1.0, 0.0, 0.0))
         out = box.transformed(sw, sh, dx, dy)
         size = getattr(self, "frame_size", None)
         return out.clip(*size) if size else out

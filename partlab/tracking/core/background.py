@@ -5,7 +5,7 @@ is OpenCV's implementation of that model. One model serves every tracker of a ru
 (the pipeline computes the mask once per frame). Shadows (MOG2's grey value 127) are
 dropped, and the mask is opened (removes speckle) and closed (fills holes in a body)
 with elliptic kernels. For speed the model runs on a frame scaled by
-``BodyParams.background_scale`` and the mask is scaled back; it is only used for
+``BodyParams.background.scale`` and the mask is scaled back; it is only used for
 blobs, decomposition and support, never for the colour likelihood.
 """
 
@@ -30,28 +30,28 @@ class BackgroundModel:
     def __init__(self, params: BodyParams | None = None):
         self.params = params or BodyParams()
         p = self.params
-        if not 0 < p.background_scale <= 1:
-            raise ValueError(f"background_scale must be in (0, 1], got {p.background_scale}")
+        if not 0 < p.background.scale <= 1:
+            raise ValueError(f"body.background.scale must be in (0, 1], got {p.background.scale}")
         self._mog = cv2.createBackgroundSubtractorMOG2(
-            history=int(p.background_history), varThreshold=float(p.background_var_threshold), detectShadows=True)
-        self._mog.setBackgroundRatio(float(p.background_ratio))
+            history=int(p.background.history), varThreshold=float(p.background.var_threshold), detectShadows=True)
+        self._mog.setBackgroundRatio(float(p.background.ratio))
         self._frames = 0
-        s = p.background_scale
-        self._open = _ellipse(round(p.morph_open * s))
-        self._close = _ellipse(round(p.morph_close * s))
+        s = p.background.scale
+        self._open = _ellipse(round(p.background.morph_open * s))
+        self._close = _ellipse(round(p.background.morph_close * s))
 
     def learning_rate(self) -> float:
         """``1 / min(max(2 n, warmup), history)`` for the n-th frame (the first frame initialises)."""
         p = self.params
         if self._frames == 0:
             return 1.0
-        return 1.0 / min(max(2 * self._frames, p.background_warmup), p.background_history)
+        return 1.0 / min(max(2 * self._frames, p.background.warmup), p.background.history)
 
     def apply(self, frame: np.ndarray) -> np.ndarray:
         if frame.ndim != 3 or frame.dtype != np.uint8:
             raise ValueError(f"expected a BGR (H, W, 3) uint8 frame, got {frame.shape} {frame.dtype}")
         H, W = frame.shape[:2]
-        s = self.params.background_scale
+        s = self.params.background.scale
         small = frame if s == 1 else cv2.resize(frame, (max(round(W * s), 1), max(round(H * s), 1)),
                                                 interpolation=cv2.INTER_AREA)
         raw = self._mog.apply(small, learningRate=self.learning_rate())

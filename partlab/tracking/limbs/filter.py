@@ -78,7 +78,7 @@ def candidate_terms(blobs: Blobs, foreground: np.ndarray | None, skin_probabilit
                     params: LimbParams) -> Candidates:
     """Candidates from one camera's blobs, with the prior as a product of named terms."""
     terms = {
-        "silhouette": silhouette_term(blobs.centres, foreground, params.sigma_s),
+        "silhouette": silhouette_term(blobs.centres, foreground, params.priors.sigma_s),
         "skin": skin_term(blobs, skin_probability),
     }
     priors = np.ones(len(blobs))
@@ -154,7 +154,7 @@ def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, par
         return cands
     centres, parents = [], []
     for k, pts in enumerate(points):
-        tips = blob_tips(pts, side, params.tip_span, params.tip_far, params.tip_radius)
+        tips = blob_tips(pts, side, params.blobs.tip_span, params.blobs.tip_far, params.blobs.tip_radius)
         centres.append(tips)
         parents += [k] * len(tips)
     return _expand(cands, np.concatenate(centres), np.asarray(parents, int), side)
@@ -173,7 +173,7 @@ def nearest_part_candidates(cands: Candidates, points: list[np.ndarray], near, s
     for pts in points:
         d = np.hypot(*(pts - near[None, :]).T)
         q = pts[int(np.argmin(d))]
-        centres.append(pts[np.hypot(*(pts - q).T) <= params.tip_radius * side].mean(axis=0))
+        centres.append(pts[np.hypot(*(pts - q).T) <= params.blobs.tip_radius * side].mean(axis=0))
     return _expand(cands, np.asarray(centres).reshape(-1, 2), np.arange(len(points)), side)
 
 
@@ -211,17 +211,17 @@ class LimbFilter:
         self.params = params
         self.size = (float(size[0]), float(size[1]))
         # no reference yet (the caller fills it in): flat until then
-        self.ref_hist = (np.full(params.hue_bins, 1.0 / params.hue_bins) if ref_hist is None
+        self.ref_hist = (np.full(params.appearance.hue_bins, 1.0 / params.appearance.hue_bins) if ref_hist is None
                          else np.asarray(ref_hist, dtype=float))
-        self.particles = np.zeros((params.particles, 4))
+        self.particles = np.zeros((params.dynamics.particles, 4))
         self.reset(centre, rng)
         self.confidence = 1.0
-        self.weights = np.full(params.particles, 1.0 / params.particles)
+        self.weights = np.full(params.dynamics.particles, 1.0 / params.dynamics.particles)
 
     def reset(self, centre, rng: np.random.Generator, spread: float | None = None) -> None:
         """Particles around ``centre`` with zero velocity (start, recovery, split)."""
-        s = self.params.noise_xy if spread is None else spread
-        n = self.params.particles
+        s = self.params.dynamics.noise_xy if spread is None else spread
+        n = self.params.dynamics.particles
         self.particles = np.zeros((n, 4))
         self.particles[:, :2] = np.asarray(centre, dtype=float)[None, :] + rng.normal(0.0, s, (n, 2))
         self.estimate = np.asarray(centre, dtype=float).copy()
@@ -234,8 +234,8 @@ class LimbFilter:
     def predict(self, rng: np.random.Generator, scale: float = 1.0) -> None:
         """Second-order dynamics (seed 003 sec. 3): position += velocity, both with white noise."""
         p, n = self.params, len(self.particles)
-        self.particles[:, 2:] = p.velocity_decay * self.particles[:, 2:] + rng.normal(0.0, p.noise_v * scale, (n, 2))
-        self.particles[:, :2] += self.particles[:, 2:] + rng.normal(0.0, p.noise_xy * scale, (n, 2))
+        self.particles[:, 2:] = p.dynamics.velocity_decay * self.particles[:, 2:] + rng.normal(0.0, p.dynamics.noise_v * scale, (n, 2))
+        self.particles[:, :2] += self.particles[:, 2:] + rng.normal(0.0, p.dynamics.noise_xy * scale, (n, 2))
 
     def particle_boxes(self) -> np.ndarray:
         w, h = self.size
@@ -252,11 +252,11 @@ class LimbFilter:
         likelihood level the state machine thresholds.
         """
         p = self.params
-        blob = np.minimum(blob_likelihood(self.particles[:, :2], candidates, p.sigma_xy), 1.0)
-        hue = hue_confidence(box_histograms(integral, self.particle_boxes()), self.ref_hist, p.lam)
+        blob = np.minimum(blob_likelihood(self.particles[:, :2], candidates, p.priors.sigma_xy), 1.0)
+        hue = hue_confidence(box_histograms(integral, self.particle_boxes()), self.ref_hist, p.appearance.lam)
         score = blob * hue
         self.confidence = float(score.max()) if score.size else 0.0
-        w = score + p.blob_floor
+        w = score + p.priors.blob_floor
         total = w.sum()
         self.weights = w / total if total > 0 else np.full(len(w), 1.0 / len(w))
         self.estimate = (self.weights[:, None] * self.particles[:, :2]).sum(axis=0)
@@ -266,9 +266,9 @@ class LimbFilter:
         """Mean shift from the PF mean on the back-projection, then shift the samples
         by the same amount (seed 003 sec. 3: "redistribute the samples")."""
         p = self.params
-        if backproj is None or p.mean_shift_iterations <= 0:
+        if backproj is None or p.appearance.mean_shift_iterations <= 0:
             return
-        x, y, w, h = mean_shift(backproj, self.box(), p.mean_shift_iterations, p.mean_shift_eps)
+        x, y, w, h = mean_shift(backproj, self.box(), p.appearance.mean_shift_iterations, p.appearance.mean_shift_eps)
         self.shift_to((x + w / 2, y + h / 2))
 
     def shift_to(self, centre) -> None:
@@ -286,7 +286,7 @@ class LimbFilter:
         """``h_ref = (1 - a) h_ref + a h`` with ``a`` = ``model_update``, when the estimate is confident."""
         if hist is None or hist.sum() <= 0:
             return
-        a = self.params.model_update
+        a = self.params.appearance.model_update
         self.ref_hist = (1 - a) * self.ref_hist + a * hist
 
 

@@ -129,7 +129,7 @@ class LimbStateMachine:
     def add(self, tracker: int, state: LimbState = LimbState.UNINITIALIZED) -> None:
         if tracker in self._status:
             raise ValueError(f"tracker {tracker} already exists")
-        self._status[tracker] = _Status(LimbState(state), history=deque(maxlen=max(self.params.history_frames, 1)))
+        self._status[tracker] = _Status(LimbState(state), history=deque(maxlen=max(self.params.states.history_frames, 1)))
 
     def state(self, tracker: int) -> LimbState:
         return self._status[tracker].state
@@ -180,33 +180,33 @@ class LimbStateMachine:
         for t, s in self._status.items():
             obs = observations.get(t, Observation())
             # likelihood counters
-            s.low = s.low + 1 if obs.likelihood < p.lost_likelihood else 0
+            s.low = s.low + 1 if obs.likelihood < p.states.lost_likelihood else 0
 
         for t, s in list(self._status.items()):
             obs = observations.get(t, Observation())
             if t in moved:
                 continue
             if s.state == LimbState.UNINITIALIZED:
-                s.strong = s.strong + 1 if obs.prior >= p.start_prior else 0
-                if s.strong >= p.start_frames:
+                s.strong = s.strong + 1 if obs.prior >= p.states.start_prior else 0
+                if s.strong >= p.states.start_frames:
                     move(t, LimbState.UNLABELLED, "strong candidate")
             elif s.state in (LimbState.NORMAL, LimbState.UNLABELLED):
-                if s.low >= p.lost_frames:
+                if s.low >= p.states.lost_frames:
                     move(t, LimbState.LOST, "low likelihood")
                 elif s.state == LimbState.UNLABELLED and obs.labelled:
                     move(t, LimbState.NORMAL, "labelled")
             elif s.state == LimbState.LOST:
-                if obs.likelihood >= p.recover_likelihood:
+                if obs.likelihood >= p.states.recover_likelihood:
                     move(t, LimbState.NORMAL if obs.labelled else LimbState.UNLABELLED, "recovered")
             elif s.state == LimbState.COMBINED and self.is_leader(t):
                 b = s.partner
                 modes = np.asarray(obs.modes, float).reshape(-1, 2)
-                if s.low >= p.lost_frames:
+                if s.low >= p.states.lost_frames:
                     self._end_join(frame, t, b, "lost")
                     move(t, LimbState.LOST, "combined target lost", b)
                     move(b, LimbState.LOST, "combined target lost", t)
                 elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > distance_threshold(
-                        p.split_distance, p.split_size, obs.size):
+                        p.states.split_distance, p.states.split_size, obs.size):
                     pos_a, pos_b = assign_by_direction(s.before, modes[:2])
                     self._end_join(frame, t, b, "split")
                     move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
@@ -234,14 +234,14 @@ class LimbStateMachine:
         # drifting (its blob vanished), and must not be combined with the target it drifts onto
         ids = [t for t, s in self._status.items() if s.state == LimbState.NORMAL
                and observations.get(t, Observation()).position is not None
-               and observations[t].likelihood >= p.lost_likelihood]
+               and observations[t].likelihood >= p.states.lost_likelihood]
         pairs = []
         for i, a in enumerate(ids):
             for b in ids[i + 1:]:
                 d = float(np.hypot(*(np.subtract(observations[a].position, observations[b].position))))
                 size = (observations[a].size + observations[b].size) / 2 if (
                     observations[a].size > 0 and observations[b].size > 0) else 0.0
-                if d < distance_threshold(p.combine_distance, p.combine_size, size):
+                if d < distance_threshold(p.states.combine_distance, p.states.combine_size, size):
                     pairs.append((d, a, b))
         used: set[int] = set()
         for _, a, b in sorted(pairs):
@@ -260,7 +260,7 @@ class LimbStateMachine:
         n = min(len(ha), len(hb))
         pairs = list(zip(ha[len(ha) - n:], hb[len(hb) - n:]))
         for pa, pb in reversed(pairs):
-            if np.hypot(*(pa - pb)) >= distance_threshold(self.params.combine_distance, self.params.combine_size,
+            if np.hypot(*(pa - pb)) >= distance_threshold(self.params.states.combine_distance, self.params.states.combine_size,
                                                        self._sizes.get(a, 0.0)):
                 return pa - pb
         if pairs:

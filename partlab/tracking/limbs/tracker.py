@@ -173,33 +173,33 @@ class LimbTracker:
 
         # 1. observations ------------------------------------------------------------------
         starting = self._init.get(index, [])
-        if starting and p.skin_adapt:
+        if starting and p.skin.adapt:
             # the given boxes show these people's skin against this scene: a Bayes skin model
             # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
             # accepts, because their colours fill far more of the frame than the boxes.
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
-                                         bins=self.skin.bins, ybins=p.skin_ybins, prior=self.skin,
-                                         keep_mass=p.skin_keep_mass, keep_recall=p.skin_keep_recall,
-                                         threshold=p.skin_threshold, keep_min_side=p.skin_keep_min_side)
+                                         bins=self.skin.bins, ybins=p.skin.ybins, prior=self.skin,
+                                         keep_mass=p.skin.keep_mass, keep_recall=p.skin.keep_recall,
+                                         threshold=p.skin.threshold, keep_min_side=p.skin.keep_min_side)
         skin_prob = self.skin.probability(frame)
-        skin_mask = skin_prob >= p.skin_threshold
+        skin_mask = skin_prob >= p.skin.threshold
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
         if fg is not None:
             skin_mask &= fg
-        if p.skin_open > 1:  # remove speckle left by noise
-            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin_open, p.skin_open))
+        if p.skin.open > 1:  # remove speckle left by noise
+            kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin.open, p.skin.open))
             skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
         people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
-        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blob_alpha, self._min_area(starting))
+        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blobs.alpha, self._min_area(starting))
         cands = candidate_terms(blobs, fg, skin_prob, p)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
-        bins = hue_bin_image(hsv, p.hue_bins, p.hue_min_saturation, p.hue_min_value)
+        bins = hue_bin_image(hsv, p.appearance.hue_bins, p.appearance.hue_min_saturation, p.appearance.hue_min_value)
         skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)  # skin_mask is within the support
         # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
         # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
         # The colour likelihood and the mean shift therefore run on the "skin-colour
         # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
-        integral = integral_histogram(skin_bins, p.hue_bins)
+        integral = integral_histogram(skin_bins, p.appearance.hue_bins)
 
         for track_id, part, box in starting:
             self._start(box, skin_bins, track_id, part)
@@ -239,11 +239,11 @@ class LimbTracker:
             own_c, owners = seen_by(t)
             before, prev, tgt.prev = tgt.filter.estimate.copy(), tgt.prev, None
             if state == LimbState.LOST:
-                tgt.filter.reset(self._search_centre(t), self.rng, spread=p.lost_search)
+                tgt.filter.reset(self._search_centre(t), self.rng, spread=p.dynamics.lost_search)
                 obs_c = self._unclaimed(own_c, exclude=t)
             elif state == LimbState.COMBINED:
                 # the pair's filter sees only candidates no other tracker explains (its own blobs)
-                tgt.filter.predict(self.rng, p.combined_noise_scale)
+                tgt.filter.predict(self.rng, p.dynamics.combined_noise_scale)
                 side = self._hand_side(t)
                 if side is not None:  # two hands: each blob's part nearest the pair
                     own_c = not_heads(nearest_part_candidates(cands, points(), tgt.filter.estimate, side, p))
@@ -256,13 +256,13 @@ class LimbTracker:
                 # one end per blob, the one nearest the predicted hand: the other end of its arm
                 # is its elbow, and a posterior split between both ends would put it mid-arm
                 at = tgt.filter.estimate if state == LimbState.LOST else \
-                    before if prev is None else before + p.velocity_decay * (before - prev)
+                    before if prev is None else before + p.dynamics.velocity_decay * (before - prev)
                 ends = np.bincount(own_c.parents, minlength=len(blobs))[obs_c.parents] >= 2
                 keep = nearest_per_parent(obs_c, at)
                 if state != LimbState.LOST:
                     # an arm's end farther than tip_gate sides is another part of it (an elbow
                     # when the hand end merged into another blob): not this hand
-                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.tip_gate * max(tgt.size)
+                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.blobs.tip_gate * max(tgt.size)
                     keep &= ~(ends & far)
                 obs_c, ends = self._subset(obs_c, keep), ends[keep]
                 if len(obs_c):
@@ -270,7 +270,7 @@ class LimbTracker:
             tgt.filter.weigh(obs_c, integral)
             modes: tuple = ()
             if state == LimbState.COMBINED:
-                radius = p.mode_search * distance_threshold(p.split_distance, p.split_size, self._side(t))
+                radius = p.states.mode_search * distance_threshold(p.states.split_distance, p.states.split_size, self._side(t))
                 # a kernel as wide as the search: the particles sit on one mode, the other may be far
                 m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
                 modes = tuple(map(tuple, m[:2]))
@@ -286,11 +286,11 @@ class LimbTracker:
             tgt.filter.resample(self.rng)
             if state == LimbState.NORMAL:
                 tgt.prev = before
-            if tgt.filter.confidence >= p.recover_likelihood and state != LimbState.LOST:
+            if tgt.filter.confidence >= p.states.recover_likelihood and state != LimbState.LOST:
                 tgt.last = tgt.filter.estimate.copy()
                 tgt.anchor = self._head_of(t)
                 if state == LimbState.NORMAL:
-                    tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.hue_bins))
+                    tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.appearance.hue_bins))
             observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
                                           labelled=tgt.labelled, modes=modes, size=self._side(t))
             self._place_pair(t, modes)
@@ -334,7 +334,7 @@ class LimbTracker:
         if any(self.targets[m].part not in hands for m in members):
             return None
         side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
-        return side if self.params.tip_span > 0 and side >= self.params.tip_min_side else None
+        return side if self.params.blobs.tip_span > 0 and side >= self.params.blobs.tip_min_side else None
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
@@ -375,8 +375,8 @@ class LimbTracker:
         sizes = [t.size[0] * t.size[1] for t in self.targets.values() if t.filter is not None]
         sizes += [float(b[2] * b[3]) for _, _, b in starting]
         if not sizes:
-            return self.params.min_blob_area
-        return min(self.params.min_blob_area, 0.25 * min(sizes))
+            return self.params.blobs.min_area
+        return min(self.params.blobs.min_area, 0.25 * min(sizes))
 
     def _support(self, fg: np.ndarray, index: int) -> np.ndarray:
         """The foreground plus a neighbourhood of every tracked target.
@@ -392,7 +392,7 @@ class LimbTracker:
             if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
                 continue
             c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else self._search_centre(t)
-            w, h = tgt.size[0] * self.params.support_scale, tgt.size[1] * self.params.support_scale
+            w, h = tgt.size[0] * self.params.blobs.support_scale, tgt.size[1] * self.params.blobs.support_scale
             boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
         if not boxes:
             return fg
@@ -424,7 +424,7 @@ class LimbTracker:
         patch = skin_bins[max(y, 0):min(y + h, hgt), max(x, 0):min(x + w, wid)]
         if patch.size == 0 or (patch >= 0).sum() < 0.1 * max(w * h, 1):
             return None
-        return reference_histogram(skin_bins, box, self.params.hue_bins)
+        return reference_histogram(skin_bins, box, self.params.appearance.hue_bins)
 
     def _fill_references(self, skin_bins: np.ndarray) -> None:
         """Targets started without a usable reference take their person's face colour (seed 003
@@ -438,8 +438,8 @@ class LimbTracker:
                 ref = head.ref_hist.copy()
             else:
                 vals = skin_bins[skin_bins >= 0]
-                ref = (np.bincount(vals, minlength=self.params.hue_bins).astype(float) if vals.size
-                       else np.ones(self.params.hue_bins))
+                ref = (np.bincount(vals, minlength=self.params.appearance.hue_bins).astype(float) if vals.size
+                       else np.ones(self.params.appearance.hue_bins))
                 ref = ref / ref.sum()
             tgt.ref_hist = ref
             tgt.filter.ref_hist = ref.copy()
@@ -461,7 +461,7 @@ class LimbTracker:
         if len(cands) == 0 or not live:
             return np.full(len(cands), -1), np.zeros(len(cands), bool)
         est = np.array([self.targets[t].filter.estimate for t in live])
-        reach = np.array([max(self.targets[t].size) / 2 + self.params.sigma_xy for t in live])
+        reach = np.array([max(self.targets[t].size) / 2 + self.params.priors.sigma_xy for t in live])
         d = np.hypot(cands.centres[:, None, 0] - est[None, :, 0], cands.centres[:, None, 1] - est[None, :, 1])
         j = d.argmin(axis=1)
         return np.asarray(live)[j], d[np.arange(len(cands)), j] <= reach[j]
@@ -492,7 +492,7 @@ class LimbTracker:
                 continue
             if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
                 d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
-                keep &= d > max(tgt.size) / 2 + self.params.sigma_xy
+                keep &= d > max(tgt.size) / 2 + self.params.priors.sigma_xy
         return self._subset(cands, keep)
 
     def _propose(self, cands: Candidates, observations: dict[int, Observation]) -> None:
@@ -506,7 +506,7 @@ class LimbTracker:
                 d = np.hypot(*(free.centres - tgt.candidate[None, :]).T)
                 d[list(used)] = np.inf
                 j = int(np.argmin(d))
-                if d[j] <= 2 * self.params.sigma_xy + self.params.noise_xy:
+                if d[j] <= 2 * self.params.priors.sigma_xy + self.params.dynamics.noise_xy:
                     used.add(j)
                     tgt.candidate, tgt.candidate_box, tgt.missed = free.centres[j].copy(), free.boxes[j].copy(), 0
                     observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
@@ -519,7 +519,7 @@ class LimbTracker:
                 t = self._new_tracker(tgt, LimbState.UNINITIALIZED)
                 observations[t] = Observation(position=tuple(tgt.candidate), prior=float(free.priors[j]))
         for t in pending:  # forget candidates that vanished
-            if self.targets[t].missed > self.params.start_frames:
+            if self.targets[t].missed > self.params.states.start_frames:
                 self.machine.remove(t)
                 self.targets.pop(t)
 
@@ -554,7 +554,7 @@ class LimbTracker:
             elif head is not None:
                 hid, htgt = head
                 right_side = cx < htgt.filter.estimate[0]  # image left of the head
-                side = ("right_hand" if right_side else "left_hand") if p.facing_camera else \
+                side = ("right_hand" if right_side else "left_hand") if p.labels.facing_camera else \
                     ("left_hand" if right_side else "right_hand")
                 taken = self._parts_of(htgt.track_id)
                 other = "left_hand" if side == "right_hand" else "right_hand"
@@ -562,7 +562,7 @@ class LimbTracker:
                     self._assign(t, htgt.track_id, side)
                 elif other not in taken:
                     self._assign(t, htgt.track_id, other)
-            elif tgt.unlabelled_frames >= p.head_guess_frames:
+            elif tgt.unlabelled_frames >= p.labels.head_guess_frames:
                 self._assign(t, self._next_person, "head")
                 self._next_person += 1
             if tgt.labelled and t in observations:
@@ -582,7 +582,7 @@ class LimbTracker:
             if tgt.part != "head" or tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
                 continue
             d = float(np.hypot(*(np.asarray(point) - tgt.filter.estimate)))
-            if d <= self.params.person_radius * tgt.size[1] and d < best_d:
+            if d <= self.params.labels.person_radius * tgt.size[1] and d < best_d:
                 best, best_d = (t, tgt), d
         return best
 
@@ -597,8 +597,8 @@ class LimbTracker:
                 continue
             if self.machine.state(t) == LimbState.COMBINED:
                 continue
-            tgt.low_frames = tgt.low_frames + 1 if tgt.filter.confidence < p.reacquire_confidence else 0
-            if tgt.low_frames < p.reacquire_frames:
+            tgt.low_frames = tgt.low_frames + 1 if tgt.filter.confidence < p.adjustment.reacquire_confidence else 0
+            if tgt.low_frames < p.adjustment.reacquire_frames:
                 continue
             if faces is None:
                 faces = self._faces(frame)
@@ -608,15 +608,15 @@ class LimbTracker:
             last = tgt.last if tgt.last is not None else tgt.filter.estimate
             d = np.hypot(*(centres - last[None, :]).T)
             j = int(np.argmin(d))
-            if d[j] > p.person_radius * tgt.size[1]:
+            if d[j] > p.labels.person_radius * tgt.size[1]:
                 continue
             tgt.filter.reset(centres[j], self.rng)
-            ref = reference_histogram(skin_bins, faces[j], p.hue_bins)
+            ref = reference_histogram(skin_bins, faces[j], p.appearance.hue_bins)
             if ref is not None:  # replace the colour reference with the face's (sec. 3)
                 tgt.filter.ref_hist = ref
             tgt.last, tgt.low_frames = centres[j].copy(), 0
             o = observations[t]
-            observations[t] = Observation(tuple(centres[j]), max(o.likelihood, p.recover_likelihood),
+            observations[t] = Observation(tuple(centres[j]), max(o.likelihood, p.states.recover_likelihood),
                                           o.prior, o.labelled, o.modes, o.size)
 
     # -- acting on transitions -----------------------------------------------------------------
