@@ -39,7 +39,7 @@ class Combined:
         return body + limbs
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
-        body = records_to_frame(self._body_rows) if self._body_rows else empty_tracks()
+        body = self.body.table(self._body_rows)
         limbs = records_to_frame(self._limb_rows) if self._limb_rows else empty_tracks()
         mapping = {} if self.from_init else match_limb_people(body, limbs)
         offset = 0 if self.from_init else LIMB_ID_OFFSET
