@@ -87,10 +87,10 @@ def first_boxes(truth: pd.DataFrame) -> pd.DataFrame:
     return truth.sort_values("frame").groupby("track_id").head(1).reset_index(drop=True)
 
 
-def methods(truth: pd.DataFrame, auto: bool, keys: tuple[int, ...]):
+def methods(truth: pd.DataFrame, auto: bool, keys: tuple[int, ...], init: pd.DataFrame | None = None):
     """(name, kind, init/keyframes table) of what is compared on one clip."""
     out = [(f"interp {k}", "interp", keyframes_of(truth, k)) for k in (10, 25)]
-    out.append(("body init", "init", first_boxes(truth)))
+    out.append(("body init", "init", first_boxes(truth) if init is None else init))
     for k in keys:
         out.append((f"body keys {k}", "keys", keyframes_of(truth, k)))
     if auto:
@@ -99,6 +99,7 @@ def methods(truth: pd.DataFrame, auto: bool, keys: tuple[int, ...]):
 
 
 def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[pd.DataFrame, float, int]:
+    n_keys = table["track_id"].nunique() if kind == "init" else None
     """(proposals, seconds per frame, keyframe boxes) of one method."""
     t0 = time.perf_counter()
     if kind == "interp":
@@ -106,7 +107,7 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
         return props, 0.0, len(table)
     if kind == "init":
         props = track(take, "body", init=table, seed=seed).tracks
-        n = len(table)
+        n = n_keys  # one box drawn per track (part rows of a synthetic init count as one person box)
     elif kind == "keys":
         from partlab.tracking.keyframes import track_with_keyframes
 
@@ -124,9 +125,15 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
     return props, (time.perf_counter() - t0) / max(take.frame_count, 1), n
 
 
-def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, hog: bool = False) -> pd.DataFrame:
+PART_RATES = ("head", "torso", "hipleg")
+
+
+def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, hog: bool = False,
+               init: pd.DataFrame | None = None, part_truth: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Every method on one clip; ``part_truth`` (synthetic scenes): also the head, torso and hip-leg
+    rates at frame 105 after initialisation of the ``body init`` runs."""
     rows = []
-    ms = methods(truth, auto, keys)
+    ms = methods(truth, auto, keys, init)
     if hog:
         ms.append(("HOG+SORT", "hog_sort", None))
     for label, kind, table in ms:
@@ -134,6 +141,11 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
             props, spf, n = run_method(take, truth, kind, table, seed)
             rows.append({"clip": name, "method": label, "seed": seed, "ms/frame": 1000 * spf,
                          **measure(truth, props, n)})
+            if part_truth is not None and kind == "init":
+                rep = evaluate(part_truth, props, hota=False)
+                for part in PART_RATES:
+                    rows[-1][f"{part}@105"] = rep.rate_at(part)
+                    rows[-1][f"{part}@105 n"] = int(rep.counts[part].get(105, 0)) if part in rep.counts else 0
             print(f"  {name:10s} {label:14s} seed {seed}: " + ", ".join(
                 f"{k} {v:.3f}" if isinstance(v, float) else f"{k} {v}" for k, v in rows[-1].items()
                 if k not in ("clip", "method", "seed")), flush=True)
@@ -155,16 +167,23 @@ def summarise(df: pd.DataFrame) -> pd.DataFrame:
 def synth_suite(n_scenes: int, seeds, keys, frames: int) -> pd.DataFrame:
     """The randomized suite: scene ``s`` is scenario ``random`` at seed ``100 + s``."""
     from partlab.labelling.synth import make_scene
+    from partlab.labelling.synth.scene import random_size
 
     out = []
     for s in range(n_scenes):
-        scene = make_scene("random", seed=100 + s, n_frames=frames)
-        truth = scene.truth[scene.truth["part"] == "person"][["frame", "track_id", "part", "x", "y", "w", "h"]]
+        seed = 100 + s
+        scene = make_scene("random", seed=seed, n_frames=frames, width=random_size(seed)[0],
+                           height=random_size(seed)[1])
+        # the truth from each track's init frame on (people walking in: once wholly in view, as an
+        # annotator would start them); the slivers before are not counted
+        start = scene.init.groupby("track_id")["frame"].min()
+        tr = scene.truth[scene.truth["frame"] >= scene.truth["track_id"].map(start)]
+        truth = tr[tr["part"] == "person"][["frame", "track_id", "part", "x", "y", "w", "h"]].reset_index(drop=True)
         take = MemoryTake(scene.frames, scene.fps)
         h, w = scene.frames.shape[1:3]
-        print(f"synthetic random seed {100 + s}: {w}x{h}, {truth.track_id.nunique()} people", flush=True)
-        out.append(clip_table(f"synth{100 + s}", take, truth.reset_index(drop=True), seeds, auto=True,
-                              keys=keys))
+        print(f"synthetic random seed {seed}: {w}x{h}, {truth.track_id.nunique()} people", flush=True)
+        out.append(clip_table(f"synth{seed}", take, truth, seeds, auto=True, keys=keys, init=scene.init,
+                              part_truth=tr))
     df = pd.concat(out, ignore_index=True)
     return df
 
@@ -209,6 +228,16 @@ def main() -> None:
         print("\nrandomized synthetic suite, mean over scenes and seeds:")
         print(synth.groupby("method", sort=False)[["rate", "mota", "idf1", "edits/100"]].mean().to_string(
             float_format=lambda v: f"{v:.3f}"))
+        init = synth[synth["method"] == "body init"]
+        print("\nrandomized suite, body init: rate at frame 105 after initialisation, pooled over scenes "
+              "(people seen 105 frames after their start) and seeds")
+        for part in PART_RATES:
+            n = init[f"{part}@105 n"].fillna(0)
+            r = (init[f"{part}@105"].fillna(0) * n).sum() / max(n.sum(), 1)
+            per_seed = [(g[f"{part}@105"].fillna(0) * g[f"{part}@105 n"]).sum() / max(g[f"{part}@105 n"].sum(), 1)
+                        for _, g in init.groupby("seed")]
+            print(f"  {part}: {r:.3f} over {int(n.sum())} person-runs (per seed {np.mean(per_seed):.3f} ± "
+                  f"{np.std(per_seed, ddof=1) if len(per_seed) > 1 else 0:.3f})")
 
 
 if __name__ == "__main__":

@@ -207,6 +207,12 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
     truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
+    if name == "random":  # people walking in start where an annotator would: once wholly in view
+        person = truth[truth["part"] == "person"]
+        inside = person[(person["x"] >= 2) & (person["y"] >= 2) & (person["x"] + person["w"] <= width - 2)
+                        & (person["y"] + person["h"] <= height - 2)]
+        start = inside.groupby("track_id")["frame"].min()
+        first = truth["track_id"].map(start).fillna(first)
     init = truth[truth["frame"] == first].reset_index(drop=True)
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
                  tuple(a.appearance for a in script.actors), background, owner_maps)
