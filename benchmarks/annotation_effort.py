@@ -126,6 +126,7 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
 
 
 PART_RATES = ("head", "torso", "hipleg")
+ONLY: list[str] = []  # --methods
 
 
 def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, hog: bool = False,
@@ -134,6 +135,8 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
     rates at frame 105 after initialisation of the ``body init`` runs."""
     rows = []
     ms = methods(truth, auto, keys, init)
+    if ONLY:
+        ms = [m for m in ms if any(m[0].startswith(o) for o in ONLY)]
     if hog:
         ms.append(("HOG+SORT", "hog_sort", None))
     for label, kind, table in ms:
@@ -200,8 +203,10 @@ def main() -> None:
     ap.add_argument("--skip-otb", action="store_true")
     ap.add_argument("--skip-synth", action="store_true")
     ap.add_argument("--csv", type=Path, help="write every run's row here")
+    ap.add_argument("--methods", default="", help="only these methods (comma-separated prefixes, e.g. 'body keys,body auto')")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",") if s]
+    ONLY[:] = [m.strip() for m in a.methods.split(",") if m.strip()]
     keys = tuple(int(k) for k in a.keys.split(",") if k)
     tables = []
     if not a.skip_pets:

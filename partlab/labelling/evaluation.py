@@ -14,8 +14,8 @@ their ``person`` boxes, as in that figure. (For rectangles "half on the true box
 in it, closed; the centre test is kept because the definition names it.)
 
 Tracks are matched to truth by ``track_id`` when the ids agree (runs from ``--init``
-keep them): every truth track has a tracker track of the same id whose boxes overlap it
-with IoU >= 0.5 at their first common frame. Otherwise (automatic runs) each truth track
+keep them): at least 80 % of the truth tracks have a tracker track of the same id whose boxes
+overlap them with IoU >= 0.3 at their first common frame (:func:`ids_agree`). Otherwise (automatic runs) each truth track
 is matched to the tracker track with the greatest mean IoU over the truth's boxes
 (Hungarian assignment, scipy), and the report says so.
 
@@ -45,7 +45,14 @@ from partlab.tracking.tracks import normalise_tracks
 DEFAULT_AT = 105  # seed 002 reports its rates at the 105th frame after initialisation
 MIN_COVER = 0.5  # seed 002: a box is wrong when half of it or more covers other things
 MOT_IOU = 0.5  # the usual MOTChallenge threshold for a match
-ID_AGREE_IOU = 0.5  # same-id boxes overlapping this much at their first common frame: ids agree
+# Ids agree when at least ID_AGREE_SHARE of the truth tracks have a same-id tracker track overlapping
+# them by ID_AGREE_IOU at their first common frame. A run from --init starts every track on its
+# truth box, but its person box is the tracker's own (the body tracker's: the minimum bounding
+# rectangle of the decomposed parts, IoU 0.35-0.85 with the drawn box on PETS09-S2L1) and a track
+# may be gone (ended early); automatic runs number their tracks 1, 2, ... in their own order, and
+# the chance that 80 % of them overlap the same-numbered truth track at its start is nil.
+ID_AGREE_IOU = 0.3
+ID_AGREE_SHARE = 0.8
 MOT_METRICS: tuple[str, ...] = ("mota", "motp", "idf1", "num_switches", "num_false_positives", "num_misses",
                                 "num_objects", "precision", "recall")
 PERSON_MBR = "person_mbr"
@@ -156,15 +163,17 @@ def _pair_iou(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame:
 
 
 def ids_agree(truth: pd.DataFrame, tracks: pd.DataFrame) -> bool:
-    """True when every truth track's same-id tracker track overlaps it (IoU >= 0.5, averaged
-    over the parts both have) at their first common frame, as in runs started from ``--init``."""
+    """True when the truth tracks' same-id tracker tracks overlap them (IoU >= :data:`ID_AGREE_IOU`,
+    averaged over the parts both have) at their first common frame for at least
+    :data:`ID_AGREE_SHARE` of the truth tracks, as in runs started from ``--init``."""
     m = truth[["frame", "track_id", "part"] + XYWH].merge(
         tracks[["frame", "track_id", "part"] + XYWH], on=["frame", "track_id", "part"], suffixes=("_t", "_k"))
-    if m.empty or set(truth["track_id"]) - set(m["track_id"]):
+    if m.empty:
         return False
     m["iou"] = _rowwise_iou(m[[c + "_t" for c in XYWH]].to_numpy(), m[[c + "_k" for c in XYWH]].to_numpy())
     first = m[m["frame"] == m.groupby("track_id")["frame"].transform("min")]
-    return bool((first.groupby("track_id")["iou"].mean() >= ID_AGREE_IOU).all())
+    agree = int((first.groupby("track_id")["iou"].mean() >= ID_AGREE_IOU).sum())
+    return agree >= ID_AGREE_SHARE * truth["track_id"].nunique()
 
 
 def match_tracks(truth: pd.DataFrame, tracks: pd.DataFrame, how: str = "auto") -> tuple[str, pd.DataFrame]:

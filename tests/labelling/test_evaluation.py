@@ -223,3 +223,18 @@ def test_interpolation_between_keyframes_meets_them_and_is_linear():
     wrong = [f for f in range(31) if abs(interp.set_index("frame").loc[f, "x"] - x[f]) > 10 / 3]
     assert e.moved == len(wrong) and e.edits == len(wrong) + 3
     assert 0 < len(wrong) < 20
+
+
+def test_ids_agree_on_a_run_from_init_with_a_loose_start_and_a_track_gone():
+    from partlab.labelling.evaluation import ids_agree
+
+    truth = _rows([(f, k, "person", 100.0 * k + f, 0, 20, 40) for k in range(1, 6) for f in range(5)])
+    run = truth[truth.track_id != 5].copy()  # track 5 ended early (withdrawn)
+    run.loc[run.track_id == 2, "w"] = 50.0   # the tracker's own person box: IoU 0.4 with the drawn one
+    assert ids_agree(truth, run)
+    assert match_tracks(truth, run)[0] == "track_id"
+    shuffled = run.assign(track_id=run["track_id"].map({1: 3, 2: 4, 3: 1, 4: 2}))
+    assert not ids_agree(truth, shuffled)  # automatic numbering: same numbers, other people
+    assert match_tracks(truth, shuffled)[0] == "iou"
+    few = truth[truth.track_id <= 3]  # 3 of 5 truth tracks: not enough to call the ids the same
+    assert not ids_agree(truth, few)
