@@ -8,7 +8,7 @@ HOST ?= 127.0.0.1
 PORT ?= 8501
 export PARTLAB_DATA ?= $(CURDIR)/partlab-data
 
-.PHONY: run test venv clean
+.PHONY: run test venv peers clean
 
 $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
@@ -28,12 +28,29 @@ $(VENV)/.installed-test: pyproject.toml $(VENV)/.installed
 
 venv: $(VENV)/.installed
 
+# Peers whose pins conflict with ours, each in its own venv, called by the tests as subprocesses
+# (tests/labelling/formats/test_peers_venv.py, tests/labelling/test_labelstudio_server.py):
+# Label Studio (server, converter, tools) and FiftyOne. The Label Studio data directory is initialised
+# once (its migrations take minutes); the end-to-end test starts a server on a copy of it.
+PEERS ?= .venv-peers
+$(PEERS)/%/.installed:
+	$(PYTHON) -m venv $(PEERS)/$*
+	$(PEERS)/$*/bin/python -m pip install --quiet $(if $(filter labelstudio,$*),label-studio label-studio-converter,fiftyone)
+	touch $@
+
+$(PEERS)/labelstudio-data/label_studio.sqlite3: $(PEERS)/labelstudio/.installed
+	LABEL_STUDIO_BASE_DATA_DIR=$(CURDIR)/$(PEERS)/labelstudio-data $(PEERS)/labelstudio/bin/label-studio init partlab \
+	  --username test@example.com --password partlab-test --user-token abcdef0123456789abcdef0123456789 \
+	  --enable-legacy-api-token --agree-fix-sqlite --quiet
+
+peers: $(PEERS)/labelstudio/.installed $(PEERS)/fiftyone/.installed $(PEERS)/labelstudio-data/label_studio.sqlite3
+
 run: $(VENV)/.installed
 	$(PY) -m partlab.app.demo
 	$(PY) -m partlab app --host $(HOST) --port $(PORT)
 
-test: $(VENV)/.installed-test
+test: $(VENV)/.installed-test peers
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 clean:
-	rm -rf $(VENV) build *.egg-info
+	rm -rf $(VENV) $(PEERS) build *.egg-info

@@ -56,11 +56,11 @@ def main() -> None:
                 g = mm.io.loadtxt(str(out / "gt" / "gt.txt"), fmt="mot15-2D")
                 line += f"; motmetrics rows {len(g)} (truth {len(kept)})"
             elif fmt == "coco":
-                c = COCO(str(out / "annotations.json"))
+                c = COCO(str(out / "annotations" / "instances_default.json"))
                 line += f"; pycocotools images {len(c.getImgIds())} anns {len(c.getAnnIds())} (truth {len(kept)})"
             if fmt in ("cvat", "voc", "yolo"):
                 t1 = time.perf_counter()
-                ds = Dataset.import_from(str(out), fmt)
+                ds = Dataset.import_from(str(out), "voc") if fmt == "voc" else Dataset.import_from(str(out))  # detected
                 anns = [a for it in ds for a in it.annotations if not a.attributes.get("outside", False)]
                 line += (f"; datumaro items {len(ds)} boxes {len(anns)} (truth {len(kept)}, "
                          f"{time.perf_counter() - t1:.1f} s)")

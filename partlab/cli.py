@@ -19,10 +19,11 @@ COMMANDS: dict[str, str] = {
     "track": "track people's parts in a video and write a tracks CSV",
     "train": "train failure detectors and variance parameters from corrected clips",
     "eval": "compare tracks with truth: per-part tracking rates and MOT metrics",
-    "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet)",
-    "import": "import a dataset (mot, cvat, coco) as a tracks CSV",
+    "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet, labelstudio)",
+    "import": "import a dataset (mot, cvat, coco, parquet, labelstudio) as a tracks CSV",
     "synth": "render a synthetic scene with exact ground truth",
     "app": "start the Streamlit labelling app (headless)",
+    "serve-ml": "serve partlab as a Label Studio ML backend (predict part boxes, retrain from annotations)",
 }
 
 
@@ -42,7 +43,7 @@ def seed(text: str) -> int:
 
 
 def _module(name: str):
-    return importlib.import_module(f"partlab.commands.{name}")
+    return importlib.import_module(f"partlab.commands.{name.replace('-', '_')}")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -16,8 +16,9 @@ from partlab.labelling.config import data_dir
 from partlab.labelling.store import Clip, Store
 from partlab.labelling.video import VideoError
 
-#: what the uploader offers (the issue's list plus common aliases OpenCV reads).
-UPLOAD_EXTENSIONS: tuple[str, ...] = ("mp4", "avi", "mov", "mkv", "m4v")
+#: what the uploader offers (the issue's list plus common aliases OpenCV reads), and a zip of JPEG/PNG
+#: frames (an image sequence, :class:`partlab.labelling.video.FrameFiles`)
+UPLOAD_EXTENSIONS: tuple[str, ...] = ("mp4", "avi", "mov", "mkv", "m4v", "zip")
 DEFAULT_MAX_UPLOAD_MB = 1024
 
 

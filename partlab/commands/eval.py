@@ -1,4 +1,5 @@
-"""``partlab eval TRUTH.csv TRACKS.csv [--at 105] [--json] [--plot OUT.html]``."""
+"""``partlab eval TRUTH.csv TRACKS.csv [--at 105] [--json] [--plot OUT.html]``, and
+``partlab eval TRUTH_EVENTS.csv EVENTS.csv --events``: per-kind precision and recall of activities."""
 
 from __future__ import annotations
 
@@ -17,6 +18,11 @@ def add_arguments(p) -> None:
                    help="write the rate-against-frame-offset figure (self-contained HTML)")
     p.add_argument("--match", choices=["auto", "id", "iou"], default="auto",
                    help="match tracks to truth by track_id, by mean IoU (Hungarian), or auto (default)")
+    p.add_argument("--events", action="store_true",
+                   help="the two files are events (truth, then found: partlab track --events): per-kind "
+                        "precision and recall at temporal IoU >= --event-iou")
+    p.add_argument("--event-iou", type=float, default=0.5, metavar="IOU",
+                   help="temporal IoU an event needs to match the truth (default 0.5)")
 
 
 def _format(report) -> str:
@@ -33,7 +39,23 @@ def _format(report) -> str:
                 f"{mot}\n")
 
 
+def _run_events(args) -> int:
+    from partlab.labelling.events import evaluate_events, read_events
+
+    if not 0 < args.event_iou <= 1:
+        raise CommandError(f"--event-iou must be in (0, 1], got {args.event_iou}")
+    table = evaluate_events(read_events(args.truth), read_events(args.tracks), iou=args.event_iou)
+    if args.json:
+        print(table.reset_index().to_json(orient="records"))
+    else:
+        print(f"events matched at temporal IoU >= {args.event_iou:g} (same kind, one to one)\n"
+              f"{table.round(3).to_string()}")
+    return 0
+
+
 def run(args) -> int:
+    if args.events:
+        return _run_events(args)
     from partlab.labelling.evaluation import EvaluationError, evaluate, rate_curve_figure
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
 

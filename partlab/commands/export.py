@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from partlab.cli import CommandError
 
-FORMATS = ["mot", "cvat", "coco", "yolo", "voc", "parquet"]
+FORMATS = ["mot", "cvat", "coco", "yolo", "voc", "parquet", "labelstudio"]
 
 
 def add_arguments(p) -> None:
@@ -16,7 +16,7 @@ def add_arguments(p) -> None:
     p.add_argument("--every", type=int, default=1, metavar="N",
                    help="keep only frames whose index is a multiple of N (default 1: all)")
     p.add_argument("--frames", action=__import__("argparse").BooleanOptionalAction, default=True,
-                   help="write the annotated frames as JPEG (default: yes; parquet never writes frames)")
+                   help="write the annotated frames as JPEG (default: yes; parquet and labelstudio never write frames)")
 
 
 def run(args) -> int:

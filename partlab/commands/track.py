@@ -132,9 +132,15 @@ def run(args) -> int:
     if args.events:
         if result.events is None:
             raise CommandError(f"--events: tracker {args.tracker!r} recognises no events "
-                               "(limbs and all write the limbs' joins)")
-        from partlab.tracking.limbs.tracker import write_events
+                               "(limbs and all write the hands' activities)")
+        from partlab.files import replacing
 
-        write_events(result.events, args.events)
-        print(f"wrote {len(result.events)} event(s) to {args.events}")
+        try:
+            with replacing(args.events) as tmp:
+                result.events.to_csv(tmp, index=False, lineterminator="\n")
+        except OSError as exc:
+            raise CommandError(f"{args.events}: cannot write: {describe_os_error(exc)}") from None
+        kinds = result.events["kind"].value_counts().to_dict() if len(result.events) else {}
+        print(f"wrote {len(result.events)} event(s) to {args.events}"
+              + (f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""))
     return 0

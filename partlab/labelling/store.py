@@ -24,16 +24,17 @@ from os import PathLike
 from pathlib import Path
 
 import pandas as pd
-from sqlalchemy import (Boolean, DateTime, Float, ForeignKey, Integer, String, Text, UniqueConstraint, create_engine,
-                        delete, event, func, select)
+from sqlalchemy import (JSON, Boolean, DateTime, Float, ForeignKey, Integer, String, Text, UniqueConstraint,
+                        create_engine, delete, event, func, insert, select)
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column
 
+from partlab.labelling import migrations
 from partlab.labelling.config import data_dir, database_url
 from partlab.labelling.video import VideoError, probe, store_by_hash
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import check_part
-from partlab.tracking.tracks import COLUMNS, TAKE_COLUMNS, normalise_tracks
+from partlab.tracking.tracks import COLUMNS, normalise_tracks
 
 
 class StoreError(ValueError):
@@ -103,6 +104,10 @@ class TrackerBoxRow(Base):
     failure: Mapped[bool] = mapped_column(Boolean, default=False)
     occluded: Mapped[float] = mapped_column(Float, default=0.0)
     state: Mapped[str] = mapped_column(String(40), default="")
+    camera: Mapped[str] = mapped_column(String(100), default="", server_default="")
+    X: Mapped[float | None] = mapped_column("world_x", Float, nullable=True)
+    Y: Mapped[float | None] = mapped_column("world_y", Float, nullable=True)
+    Z: Mapped[float | None] = mapped_column("world_z", Float, nullable=True)
 
 
 class EditRow(Base):
@@ -124,6 +129,10 @@ class EditRow(Base):
     deleted: Mapped[bool] = mapped_column(Boolean, default=False)
     author: Mapped[str] = mapped_column(String(100), default="")
     created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+    camera: Mapped[str] = mapped_column(String(100), default="", server_default="")
+    X: Mapped[float | None] = mapped_column("world_x", Float, nullable=True)
+    Y: Mapped[float | None] = mapped_column("world_y", Float, nullable=True)
+    Z: Mapped[float | None] = mapped_column("world_z", Float, nullable=True)
     # The unique key is what makes a concurrent stale write fail even between two
     # processes that both passed the revision check.
     __table_args__ = (UniqueConstraint("clip_id", "frame", "track_id", "part", "revision"),)
@@ -148,6 +157,61 @@ class BundleRow(Base):
     summary: Mapped[str] = mapped_column(Text, default="{}")
     created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
     __table_args__ = (UniqueConstraint("project_id", "name"),)
+
+
+class TakeRow(Base):
+    """A take: one or more synchronized streams (revision 2)."""
+
+    __tablename__ = "takes"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    project_id: Mapped[int] = mapped_column(ForeignKey("projects.id"), index=True)
+    name: Mapped[str] = mapped_column(String(300))
+    path: Mapped[str] = mapped_column(Text, default="")
+    fps: Mapped[float | None] = mapped_column(Float, nullable=True)
+    #: what belongs to the world frame rather than one camera (units, origin, source file...)
+    calibration: Mapped[dict] = mapped_column(JSON, default=dict)
+    created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+    __table_args__ = (UniqueConstraint("project_id", "name"),)
+
+
+class StreamRow(Base):
+    """One stream of a take, in the take's order; its video is a clip (at most one take's stream)."""
+
+    __tablename__ = "streams"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    take_id: Mapped[int] = mapped_column(ForeignKey("takes.id"), index=True)
+    name: Mapped[str] = mapped_column(String(100))
+    position: Mapped[int] = mapped_column(Integer)
+    clip_id: Mapped[int | None] = mapped_column(ForeignKey("clips.id"), nullable=True)
+    depth_path: Mapped[str] = mapped_column(Text, default="")
+    #: ``Camera.to_dict()`` of the stream, or None when uncalibrated
+    calibration: Mapped[dict | None] = mapped_column(JSON, nullable=True)
+    __table_args__ = (UniqueConstraint("take_id", "name"), UniqueConstraint("take_id", "position"),
+                      UniqueConstraint("clip_id"))
+
+
+class EventRow(Base):
+    """One revision of one event (an activity between two frames); ``deleted`` marks a deletion."""
+
+    __tablename__ = "events"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    clip_id: Mapped[int] = mapped_column(ForeignKey("clips.id"), index=True)
+    take_id: Mapped[int | None] = mapped_column(ForeignKey("takes.id"), nullable=True)
+    #: the event's identity across its revisions, unique within the clip
+    event_id: Mapped[int] = mapped_column(Integer)
+    revision: Mapped[int] = mapped_column(Integer)
+    start_frame: Mapped[int] = mapped_column(Integer)
+    end_frame: Mapped[int] = mapped_column(Integer)
+    type: Mapped[str] = mapped_column(String(40))
+    tracks: Mapped[list] = mapped_column(JSON, default=list)
+    parts: Mapped[list] = mapped_column(JSON, default=list)
+    confidence: Mapped[float | None] = mapped_column(Float, nullable=True)
+    attributes: Mapped[dict] = mapped_column(JSON, default=dict)
+    source: Mapped[str] = mapped_column(String(20), default="human")
+    deleted: Mapped[bool] = mapped_column(Boolean, default=False)
+    author: Mapped[str] = mapped_column(String(100), default="")
+    created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+    __table_args__ = (UniqueConstraint("clip_id", "event_id", "revision"),)
 
 
 @dataclass(frozen=True)
@@ -181,6 +245,40 @@ class BundleRecord:
     path: Path
     summary: dict
     created: datetime
+
+
+@dataclass(frozen=True)
+class StreamRecord:
+    name: str
+    position: int
+    clip_id: int | None
+    calibration: dict | None
+    depth_path: str
+
+
+@dataclass(frozen=True)
+class TakeRecord:
+    id: int
+    project_id: int
+    name: str
+    path: str
+    fps: float | None
+    calibration: dict
+    streams: tuple[StreamRecord, ...]
+    created: datetime
+
+
+#: columns of :meth:`Store.events`
+EVENT_COLUMNS = ["event_id", "revision", "start_frame", "end_frame", "type", "tracks", "parts", "confidence",
+                 "attributes", "source", "author", "take_id"]
+
+
+def _nan(v: float | None) -> float:
+    return float("nan") if v is None else float(v)
+
+
+def _num_or_none(v) -> float | None:
+    return None if v is None or pd.isna(v) else float(v)
 
 
 def _project(r: ProjectRow) -> Project:
@@ -218,9 +316,25 @@ def _engine(url: str):
                     cur.execute("PRAGMA foreign_keys=ON")
                     cur.execute("PRAGMA busy_timeout=30000")
                     cur.close()
-            Base.metadata.create_all(eng)
+            try:
+                migrations.upgrade(eng)
+            except migrations.SchemaError as exc:
+                eng.dispose()
+                raise StoreError(str(exc)) from None
             _ENGINES[url] = eng
         return eng
+
+
+def _point(before: dict | None, camera: str | None, xyz) -> dict:
+    """camera and X, Y, Z of an edit: the given ones, else the box's current ones."""
+    out = dict(camera=str(camera) if camera is not None else (before or {}).get("camera") or "")
+    if xyz is not None:
+        if len(xyz) != 3:
+            raise StoreError(f"a 3D point needs X, Y, Z (mm), got {len(xyz)} numbers")
+        out.update(X=_num_or_none(xyz[0]), Y=_num_or_none(xyz[1]), Z=_num_or_none(xyz[2]))
+    else:
+        out.update({k: (before or {}).get(k) for k in ("X", "Y", "Z")})
+    return out
 
 
 class Store:
@@ -324,11 +438,12 @@ class Store:
                 dict(clip_id=clip_id, run_id=run.id, frame=int(r.frame), track_id=int(r.track_id), part=r.part,
                      x=float(r.x), y=float(r.y), w=float(r.w), h=float(r.h),
                      score=None if pd.isna(r.score) else float(r.score), failure=bool(r.failure),
-                     occluded=float(r.occluded), state=str(r.state))
+                     occluded=float(r.occluded), state=str(r.state), camera=str(r.camera),
+                     X=_num_or_none(r.X), Y=_num_or_none(r.Y), Z=_num_or_none(r.Z))
                 for r in df.itertuples(index=False)
             ]
             if records:
-                s.execute(TrackerBoxRow.__table__.insert(), records)
+                s.execute(insert(TrackerBoxRow), records)  # ORM keys: X -> world_x
             s.commit()
             return run.id
 
@@ -352,12 +467,13 @@ class Store:
             eq = select(EditRow).join(newest, (EditRow.clip_id == clip_id) & (EditRow.frame == newest.c.frame)
                                       & (EditRow.track_id == newest.c.track_id) & (EditRow.part == newest.c.part)
                                       & (EditRow.revision == newest.c.rev))
-            tracker = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h,
-                        float("nan") if r.score is None else r.score, r.failure, r.occluded, r.state, "tracker", 0)
+            tracker = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, _nan(r.score), r.failure, r.occluded,
+                        r.state, "tracker", r.camera, _nan(r.X), _nan(r.Y), _nan(r.Z), 0)
                        for r in s.scalars(tq)]
             edits = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, float("nan"), r.failure, r.occluded, "",
-                      "human", r.revision, r.deleted) for r in s.scalars(eq)]
-        cols = [c for c in COLUMNS if c not in TAKE_COLUMNS] + ["revision"]
+                      "human", r.camera, _nan(r.X), _nan(r.Y), _nan(r.Z), r.revision, r.deleted)
+                     for r in s.scalars(eq)]
+        cols = list(COLUMNS) + ["revision"]
         tdf = pd.DataFrame(tracker, columns=cols)
         edf = pd.DataFrame(edits, columns=cols + ["deleted"])
         if len(edf):
@@ -393,10 +509,12 @@ class Store:
 
     def edit_box(self, clip_id: int, frame: int, track_id: int, part: str, box: Box | None, *,
                  failure: bool | None = None, occluded: float | None = None, expected_revision: int,
-                 author: str = "") -> int:
+                 author: str = "", camera: str | None = None,
+                 xyz: tuple[float, float, float] | None = None) -> int:
         """Write a human edit of one box (``box=None`` deletes it); returns the new revision.
 
-        ``failure``/``occluded`` left as None keep their current values. Refused with
+        ``failure``/``occluded``/``camera`` (stream name) and ``xyz`` (world mm; a tuple of NaN
+        clears it) left as None keep their current values. Refused with
         :class:`StaleEditError` when the newest revision is not ``expected_revision``.
         """
         check_part(part)
@@ -419,7 +537,7 @@ class Store:
                           failure=bool(failure) if failure is not None else bool(before and before["failure"]),
                           occluded=float(occluded) if occluded is not None else
                           float(before["occluded"]) if before else 0.0,
-                          deleted=box is None, author=author)
+                          deleted=box is None, author=author, **_point(before, camera, xyz))
             s.add(row)
             try:
                 s.commit()
@@ -441,12 +559,14 @@ class Store:
                                            EditRow.track_id == track_id, EditRow.part == part)
                      .order_by(EditRow.revision.desc()).limit(1))
         if e is not None:
-            return dict(x=e.x, y=e.y, w=e.w, h=e.h, failure=e.failure, occluded=e.occluded, deleted=e.deleted)
+            return dict(x=e.x, y=e.y, w=e.w, h=e.h, failure=e.failure, occluded=e.occluded, deleted=e.deleted,
+                        camera=e.camera, X=e.X, Y=e.Y, Z=e.Z)
         t = s.scalar(select(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame == frame,
                                                  TrackerBoxRow.track_id == track_id, TrackerBoxRow.part == part)
                      .limit(1))
         if t is not None:
-            return dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded, deleted=False)
+            return dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded, deleted=False,
+                        camera=t.camera, X=t.X, Y=t.Y, Z=t.Z)
         return None
 
     def history(self, clip_id: int, frame: int, track_id: int, part: str) -> pd.DataFrame:
@@ -455,10 +575,11 @@ class Store:
                                                    EditRow.track_id == track_id, EditRow.part == part)
                              .order_by(EditRow.revision)).all()
             return pd.DataFrame([dict(revision=r.revision, x=r.x, y=r.y, w=r.w, h=r.h, failure=r.failure,
-                                      occluded=r.occluded, deleted=r.deleted, author=r.author, created=r.created)
+                                      occluded=r.occluded, deleted=r.deleted, author=r.author, created=r.created,
+                                      camera=r.camera, X=_nan(r.X), Y=_nan(r.Y), Z=_nan(r.Z))
                                  for r in rows],
                                 columns=["revision", "x", "y", "w", "h", "failure", "occluded", "deleted", "author",
-                                         "created"])
+                                         "created", "camera", "X", "Y", "Z"])
 
     def undo(self, clip_id: int, frame: int, track_id: int, part: str, expected_revision: int,
              author: str = "") -> int:
@@ -477,13 +598,15 @@ class Store:
                                                   EditRow.revision == current - 1))
             if prev is not None:
                 content = dict(x=prev.x, y=prev.y, w=prev.w, h=prev.h, failure=prev.failure,
-                               occluded=prev.occluded, deleted=prev.deleted)
+                               occluded=prev.occluded, deleted=prev.deleted, camera=prev.camera,
+                               X=prev.X, Y=prev.Y, Z=prev.Z)
             else:
                 t = s.scalar(select(TrackerBoxRow).where(
                     TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame == frame,
                     TrackerBoxRow.track_id == track_id, TrackerBoxRow.part == part).limit(1))
                 if t is not None:
-                    content = dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded, deleted=False)
+                    content = dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded,
+                                   deleted=False, camera=t.camera, X=t.X, Y=t.Y, Z=t.Z)
                 else:
                     content = dict(x=0.0, y=0.0, w=0.0, h=0.0, failure=False, occluded=0.0, deleted=True)
             s.add(EditRow(clip_id=clip_id, frame=frame, track_id=track_id, part=part, revision=current + 1,
@@ -557,3 +680,155 @@ class Store:
                     raise StoreError(f"bundle {bundle_id} does not belong to project {p.name!r}")
             p.default_bundle_id = bundle_id
             s.commit()
+
+    # --------------------------------------------------------------------- takes
+    def add_take(self, project_id: int, name: str, streams: list[dict], *, path: str = "",
+                 fps: float | None = None, calibration: dict | None = None) -> TakeRecord:
+        """Register a take: ``streams`` in order, each ``dict(name=, clip_id=, calibration=None,
+        depth_path="")`` where ``calibration`` is ``Camera.to_dict()`` (JSON); a clip is at most
+        one stream of one take."""
+        self.project(project_id)
+        if not streams:
+            raise StoreError(f"take {name!r} needs at least one stream")
+        names = [str(st["name"]) for st in streams]
+        if len(set(names)) != len(names):
+            raise StoreError(f"take {name!r}: stream names repeat ({', '.join(names)})")
+        with self._session() as s:
+            if s.scalar(select(TakeRow).where(TakeRow.project_id == project_id, TakeRow.name == name)):
+                raise StoreError(f"a take named {name!r} exists already in this project")
+            row = TakeRow(project_id=project_id, name=name, path=str(path), fps=fps, calibration=calibration or {})
+            s.add(row)
+            s.flush()
+            for position, st in enumerate(streams):
+                clip_id = st.get("clip_id")
+                if clip_id is not None and s.get(ClipRow, clip_id) is None:
+                    raise StoreError(f"take {name!r}, stream {st['name']!r}: no clip with id {clip_id}")
+                s.add(StreamRow(take_id=row.id, name=str(st["name"]), position=position, clip_id=clip_id,
+                                calibration=st.get("calibration"), depth_path=str(st.get("depth_path") or "")))
+            try:
+                s.commit()
+            except IntegrityError:
+                s.rollback()
+                raise StoreError(f"take {name!r}: a clip of it is already a stream of another take") from None
+            return self.take(row.id)
+
+    def import_take(self, project_id: int, path: str | PathLike, name: str | None = None) -> TakeRecord:
+        """Add a take folder (or one video) from :func:`partlab.labelling.take.open_take`: each
+        stream's video becomes a clip, each camera its stream's calibration."""
+        from partlab.labelling.take import open_take
+
+        with open_take(path) as take:
+            streams = []
+            for st in take.streams_:
+                if st.color is None:
+                    raise StoreError(f"{path}: stream {st.name!r} has no colour video; the store keeps videos")
+                clip = self.add_clip(project_id, st.color.path, name=f"{Path(path).name}/{st.name}")
+                streams.append(dict(name=st.name, clip_id=clip.id,
+                                    calibration=st.camera.to_dict() if st.camera is not None else None,
+                                    depth_path=str(st.depth.path) if st.depth is not None else ""))
+            return self.add_take(project_id, name or Path(path).name, streams, path=str(Path(path).resolve()),
+                                 fps=take.fps, calibration=dict(take.meta))
+
+    def take(self, take_id: int) -> TakeRecord:
+        with self._session() as s:
+            row = s.get(TakeRow, take_id)
+            if row is None:
+                raise StoreError(f"no take with id {take_id}")
+            streams = s.scalars(select(StreamRow).where(StreamRow.take_id == take_id).order_by(StreamRow.position))
+            return TakeRecord(row.id, row.project_id, row.name, row.path, row.fps, dict(row.calibration or {}),
+                              tuple(StreamRecord(st.name, st.position, st.clip_id, st.calibration, st.depth_path)
+                                    for st in streams), row.created)
+
+    def takes(self, project_id: int) -> list[TakeRecord]:
+        with self._session() as s:
+            ids = list(s.scalars(select(TakeRow.id).where(TakeRow.project_id == project_id).order_by(TakeRow.id)))
+        return [self.take(i) for i in ids]
+
+    def take_of_clip(self, clip_id: int) -> tuple[TakeRecord, str] | None:
+        """The take a clip is a stream of and the stream's name, or None."""
+        with self._session() as s:
+            st = s.scalar(select(StreamRow).where(StreamRow.clip_id == clip_id))
+            if st is None:
+                return None
+            take_id, name = st.take_id, st.name
+        return self.take(take_id), name
+
+    # -------------------------------------------------------------------- events
+    def add_event(self, clip_id: int, start_frame: int, end_frame: int, type: str, *, tracks=(), parts=(),
+                  confidence: float | None = None, attributes: dict | None = None, source: str = "human",
+                  author: str = "", take_id: int | None = None) -> int:
+        """Record an event over frames ``start_frame..end_frame`` (inclusive); returns its ``event_id``
+        (its first revision is 1)."""
+        self._check_event(clip_id, start_frame, end_frame, type, parts)
+        with self._session() as s:
+            for _ in range(3):  # two writers may pick the same new id: the unique key refuses one
+                event_id = int(s.scalar(select(func.max(EventRow.event_id)).where(EventRow.clip_id == clip_id))
+                               or 0) + 1
+                s.add(EventRow(clip_id=clip_id, take_id=take_id, event_id=event_id, revision=1,
+                               start_frame=int(start_frame), end_frame=int(end_frame), type=str(type),
+                               tracks=[int(t) for t in tracks], parts=[str(p) for p in parts],
+                               confidence=_num_or_none(confidence), attributes=dict(attributes or {}),
+                               source=source, author=author))
+                try:
+                    s.commit()
+                    return event_id
+                except IntegrityError:
+                    s.rollback()
+        raise StoreError(f"could not add an event to clip {clip_id}: too many concurrent writers")
+
+    def edit_event(self, clip_id: int, event_id: int, *, expected_revision: int, author: str = "",
+                   delete: bool = False, **changes) -> int:
+        """Append a revision of an event with ``changes`` (any of start_frame, end_frame, type, tracks,
+        parts, confidence, attributes, source) or ``delete=True``; returns the new revision. Refused
+        with :class:`StaleEditError` when the newest revision is not ``expected_revision``."""
+        allowed = {"start_frame", "end_frame", "type", "tracks", "parts", "confidence", "attributes", "source"}
+        unknown = sorted(set(changes) - allowed)
+        if unknown:
+            raise StoreError(f"events have no field(s) {', '.join(unknown)}; expected {', '.join(sorted(allowed))}")
+        with self._session() as s:
+            last = s.scalar(select(EventRow).where(EventRow.clip_id == clip_id, EventRow.event_id == event_id)
+                            .order_by(EventRow.revision.desc()).limit(1))
+            if last is None:
+                raise StoreError(f"no event {event_id} in clip {clip_id}")
+            if last.revision != expected_revision:
+                raise StaleEditError(f"event {event_id} of clip {clip_id} was changed by someone else (revision "
+                                     f"{last.revision}, you had {expected_revision}); reload and apply it again")
+            fields = {k: getattr(last, k) for k in allowed} | {"take_id": last.take_id}
+            fields.update(changes)
+            self._check_event(clip_id, fields["start_frame"], fields["end_frame"], fields["type"], fields["parts"])
+            s.add(EventRow(clip_id=clip_id, event_id=event_id, revision=last.revision + 1, deleted=delete,
+                           author=author, **fields))
+            try:
+                s.commit()
+            except IntegrityError:
+                s.rollback()
+                raise StaleEditError(f"event {event_id} of clip {clip_id} was changed by someone else; "
+                                     "reload and apply it again") from None
+            return last.revision + 1
+
+    def events(self, clip_id: int, *, history: bool = False) -> pd.DataFrame:
+        """The newest revision of every event of a clip that is not deleted (``history=True``: every
+        revision, with ``deleted``), sorted by start frame."""
+        with self._session() as s:
+            q = select(EventRow).where(EventRow.clip_id == clip_id).order_by(EventRow.event_id, EventRow.revision)
+            rows = [dict(event_id=r.event_id, revision=r.revision, start_frame=r.start_frame, end_frame=r.end_frame,
+                         type=r.type, tracks=list(r.tracks or []), parts=list(r.parts or []),
+                         confidence=_nan(r.confidence), attributes=dict(r.attributes or {}), source=r.source,
+                         author=r.author, take_id=r.take_id, deleted=bool(r.deleted), created=r.created)
+                    for r in s.scalars(q)]
+        df = pd.DataFrame(rows, columns=EVENT_COLUMNS + ["deleted", "created"])
+        if history:
+            return df.reset_index(drop=True)
+        df = df.drop_duplicates("event_id", keep="last")
+        df = df[~df["deleted"].astype(bool)].drop(columns=["deleted", "created"])
+        return df.sort_values(["start_frame", "event_id"], kind="stable").reset_index(drop=True)
+
+    def _check_event(self, clip_id: int, start: int, end: int, type: str, parts) -> None:
+        clip = self.clip(clip_id)
+        if not 0 <= int(start) <= int(end) < clip.frame_count:
+            raise StoreError(f"event frames {start}..{end} are not an interval inside clip {clip.name!r} "
+                             f"(0..{clip.frame_count - 1})")
+        if not str(type).strip():
+            raise StoreError("an event needs a type (e.g. clap, handshake, exchange, pick, place)")
+        for p in parts:
+            check_part(p)

@@ -30,7 +30,7 @@ import numpy as np
 
 from partlab.errors import UserError
 from partlab.labelling.calibration import FILE_NAME as CALIBRATION_FILE, read_calibration
-from partlab.labelling.video import VIDEO_EXTENSIONS, VideoClip
+from partlab.labelling.video import VIDEO_EXTENSIONS, VideoClip, is_image_sequence
 from partlab.tracking.camera import Camera
 from partlab.tracking.frame import DEFAULT_STREAM, Frame, FrameSet
 
@@ -195,9 +195,9 @@ def _stream_list(folder: Path) -> list[dict]:
 def open_take(path: str | PathLike) -> Take:
     """A take from a video file or a take folder; raises :class:`TakeError` naming what is wrong."""
     p = Path(path)
-    if not p.exists():
+    if not p.exists() and not is_image_sequence(p):
         raise TakeError(f"{p}: no such file or folder")
-    if p.is_file():
+    if p.is_file() or is_image_sequence(p):  # a video, or one stream of frames (folder, zip, %06d pattern)
         clip = VideoClip(p)
         return Take(p, [Stream(DEFAULT_STREAM, clip)], fps=clip.fps)
     specs = _stream_list(p)

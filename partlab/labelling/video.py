@@ -1,5 +1,10 @@
 """Video input through OpenCV: metadata, seeking and iteration by decode index.
 
+A clip is a video file or an image sequence (:class:`FrameFiles`): a folder of JPEG/PNG frames, a
+zip of them, or a printf pattern such as ``img1/%06d.jpg``, as MOTChallenge, OTB and CVAT tasks ship
+them. Frame ``i`` of a sequence is its ``i``-th file in the order of the number in the file names
+(``0001.jpg`` is frame 0); a gap in that numbering is refused, since it would shift every later frame.
+
 The frame index is the decoder's: frame ``i`` is the ``i``-th frame OpenCV decodes
 from the start. The app, the trackers and every export use this one numbering
 (browser players and other decoders may disagree on frame counts). Seeking decodes
@@ -9,8 +14,11 @@ that seek inexactly it falls back to decoding from the start.
 
 from __future__ import annotations
 
+import configparser
 import hashlib
+import re
 import shutil
+import zipfile
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -23,6 +31,10 @@ from partlab.errors import UserError
 from partlab.limits import check_frame_size, max_frames
 
 VIDEO_EXTENSIONS: tuple[str, ...] = (".mp4", ".avi", ".mov", ".mkv", ".m4v", ".webm", ".mpg", ".mpeg")
+IMAGE_EXTENSIONS: tuple[str, ...] = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+#: fps of an image sequence that does not state one (a MOT ``seqinfo.ini`` beside it does):
+#: PAL video's rate, which most of the public sequences (MOT, PETS) were recorded at
+SEQUENCE_FPS = 25.0
 
 
 class VideoError(UserError):
@@ -42,6 +54,136 @@ class VideoInfo:
         return self.frame_count / self.fps if self.fps > 0 else 0.0
 
 
+_NUMBER = re.compile(r"(\d+)(?!.*\d)")  # the last run of digits in a name
+
+
+def _order(names: list[str], where: str) -> list[str]:
+    """``names`` in frame order (by the last number in each stem; by name when some have none),
+    refusing a gap or a repeat in the numbering."""
+    stems = [Path(n).stem for n in names]
+    numbers = [m.group(1) for m in map(_NUMBER.search, stems) if m]
+    if len(numbers) != len(names):
+        return sorted(names)
+    pairs = sorted(zip((int(n) for n in numbers), names))
+    nums = [k for k, _ in pairs]
+    repeated = [k for k, j in zip(nums, nums[1:]) if k == j]
+    if repeated:
+        raise VideoError(f"{where}: two frames are numbered {repeated[0]}; expected one image per frame number")
+    gaps = [(a, b) for a, b in zip(nums, nums[1:]) if b != a + 1]
+    if gaps:
+        a, b = gaps[0]
+        raise VideoError(f"{where}: frame files jump from number {a} to {b} ({len(gaps)} gap(s)); a missing "
+                         "frame would shift every later one. Fill or renumber the sequence")
+    return [n for _, n in pairs]
+
+
+def _is_image(name: str) -> bool:
+    base = name.rsplit("/", 1)[-1]
+    return Path(base).suffix.lower() in IMAGE_EXTENSIONS and not base.startswith(".") and "__MACOSX" not in name
+
+
+def _pattern(name: str) -> re.Pattern | None:
+    """The file names a printf pattern like ``%06d.jpg`` matches, or None when ``name`` is none."""
+    parts = re.split(r"(%0?\d*d)", name)
+    if len(parts) != 3:
+        return None
+    return re.compile("^" + re.escape(parts[0]) + r"(\d+)" + re.escape(parts[2]) + "$")
+
+
+def is_image_sequence(path: str | PathLike) -> bool:
+    """True for a folder holding image files (and no video), a ``.zip`` of images, or a ``%d`` pattern."""
+    p = Path(path)
+    if _pattern(p.name) is not None:
+        return True
+    if p.is_dir():
+        entries = [e for e in p.iterdir() if e.is_file()]
+        return (any(_is_image(e.name) for e in entries) and not (p / "take.json").exists()
+                and not any(e.suffix.lower() in VIDEO_EXTENSIONS for e in entries))
+    if p.is_file() and p.suffix.lower() == ".zip":
+        try:
+            with zipfile.ZipFile(p) as zf:
+                return any(_is_image(n) for n in zf.namelist())
+        except (zipfile.BadZipFile, OSError):
+            return False
+    return False
+
+
+class FrameFiles:
+    """An image sequence read by frame index (BGR ``uint8``); see the module docstring."""
+
+    def __init__(self, path: str | PathLike):
+        self.path = Path(path)
+        self._zip: zipfile.ZipFile | None = None
+        p = self.path
+        rx = _pattern(p.name)
+        if rx is not None:
+            folder = p.parent
+            if not folder.is_dir():
+                raise VideoError(f"{folder}: no such folder (from the pattern {p.name})")
+            names = [e.name for e in folder.iterdir() if rx.match(e.name)]
+            self._files: list = [folder / n for n in _order(names, str(p))]
+        elif p.is_dir():
+            names = [e.name for e in p.iterdir() if e.is_file() and _is_image(e.name)]
+            self._files = [p / n for n in _order(names, str(p))]
+        elif p.suffix.lower() == ".zip":
+            try:
+                self._zip = zipfile.ZipFile(p)
+            except (zipfile.BadZipFile, OSError) as exc:
+                raise VideoError(f"{p}: not a readable zip of frames ({exc})") from None
+            members = [i.filename for i in self._zip.infolist() if not i.is_dir() and _is_image(i.filename)]
+            self._files = _order(members, str(p))
+        else:
+            raise VideoError(f"{p}: not an image sequence (a folder of frames, a zip of them or a %06d pattern)")
+        if not self._files:
+            raise VideoError(f"{p}: no frames ({', '.join(IMAGE_EXTENSIONS)} files) in this sequence")
+        if len(self._files) > max_frames():
+            raise VideoError(f"{p}: more than the limit of {max_frames()} frames (set PARTLAB_MAX_FRAMES to change it)")
+        self.width = self.height = 0
+        first = self.read(0)
+        check_frame_size(first.shape[1], first.shape[0], str(p), VideoError)
+        self.height, self.width = first.shape[:2]
+
+    def __len__(self) -> int:
+        return len(self._files)
+
+    def name(self, index: int) -> str:
+        f = self._files[index]
+        return f if isinstance(f, str) else f.name
+
+    def read(self, index: int) -> np.ndarray:
+        f = self._files[index]
+        if self._zip is not None:
+            image = cv2.imdecode(np.frombuffer(self._zip.read(f), np.uint8), cv2.IMREAD_COLOR)
+        else:
+            image = cv2.imread(str(f), cv2.IMREAD_COLOR)
+        if image is None:
+            raise VideoError(f"{self.path}: frame {index} ({self.name(index)}) is not an image OpenCV can read")
+        if self.width and (image.shape[1], image.shape[0]) != (self.width, self.height):
+            raise VideoError(f"{self.path}: frame {index} ({self.name(index)}) is {image.shape[1]}x{image.shape[0]} "
+                             f"but the sequence starts at {self.width}x{self.height}")
+        return image
+
+    def fps(self) -> float:
+        """``frameRate`` of a MOT ``seqinfo.ini`` in the folder or its parent, else :data:`SEQUENCE_FPS`."""
+        base = self.path if self.path.is_dir() else self.path.parent
+        for ini in (base / "seqinfo.ini", base.parent / "seqinfo.ini"):
+            if ini.is_file():
+                seq = configparser.ConfigParser()
+                try:
+                    seq.read(ini, encoding="utf-8")
+                    rate = float(seq["Sequence"]["frameRate"])
+                except (configparser.Error, KeyError, ValueError):
+                    continue
+                if 0 < rate <= 1000:
+                    return rate
+        return SEQUENCE_FPS
+
+    def close(self) -> None:
+        if self._zip is not None:
+            self._zip.close()
+            self._zip = None
+
+
 def _count_frames(cap: cv2.VideoCapture, limit: int, path: Path) -> int:
     n = 0
     while cap.grab():
@@ -58,10 +200,17 @@ def probe(path: str | PathLike, exact_count: bool = True) -> VideoInfo:
     often wrong, and the decoder's count is the one every other part uses).
     """
     p = Path(path)
+    if is_image_sequence(p):
+        seq = FrameFiles(p)
+        try:
+            return VideoInfo(p, seq.fps(), int(seq.width), int(seq.height), len(seq))
+        finally:
+            seq.close()
     if not p.exists():
         raise VideoError(f"{p}: no such file")
     if p.is_dir():
-        raise VideoError(f"{p}: is a directory, not a video file")
+        raise VideoError(f"{p}: is a directory with no frames (expected a video file, or a folder of "
+                         f"{'/'.join(IMAGE_EXTENSIONS[:2])}/png frames)")
     if p.stat().st_size == 0:
         raise VideoError(f"{p}: the file is empty")
     cap = cv2.VideoCapture(str(p))
@@ -96,6 +245,7 @@ class VideoClip:
         self.path = self.info.path
         self._cap: cv2.VideoCapture | None = None
         self._next = 0  # index of the frame the capture will return next
+        self._files: FrameFiles | None = FrameFiles(self.path) if is_image_sequence(self.path) else None
 
     @property
     def fps(self) -> float:
@@ -126,6 +276,8 @@ class VideoClip:
         if self._cap is not None:
             self._cap.release()
             self._cap = None
+        if self._files is not None:
+            self._files.close()
 
     def __enter__(self) -> "VideoClip":
         return self
@@ -137,6 +289,8 @@ class VideoClip:
         """Frame ``index`` (0-based decode index)."""
         if not 0 <= index < self.frame_count:
             raise IndexError(f"frame {index} is outside the clip (0..{self.frame_count - 1})")
+        if self._files is not None:
+            return self._files.read(index)
         cap = self._open()
         if index < self._next or index - self._next > 50:
             cap.set(cv2.CAP_PROP_POS_FRAMES, index)
@@ -160,6 +314,14 @@ class VideoClip:
     def frames(self, start: int = 0, stop: int | None = None) -> Iterator[tuple[int, np.ndarray]]:
         """Yield ``(index, frame)`` from ``start`` up to ``stop`` (exclusive), decoding once."""
         stop = self.frame_count if stop is None else min(stop, self.frame_count)
+        if self._files is not None:
+            files = FrameFiles(self.path)  # its own reader, as each call decodes independently
+            try:
+                for i in range(start, stop):
+                    yield i, files.read(i)
+            finally:
+                files.close()
+            return
         cap = cv2.VideoCapture(str(self.path))
         try:
             if start > 0:

@@ -90,5 +90,11 @@ def build(params, rngs, context):
     """The registry's factory for ``all``."""
     from partlab.tracking import body, limbs
 
-    return Combined(body.build(params, rngs, context), limbs.build(params, rngs, context),
-                    from_init=context.init is not None)
+    plain = {k: v for k, v in params.items() if k != "activities"}
+    combined = Combined(body.build(plain, rngs, context), limbs.build(plain, rngs, context),
+                        from_init=context.init is not None)
+    if "activities" in params:  # activities over the merged tracks, so they name the ids as written
+        from partlab.tracking.activities import with_activities
+
+        return with_activities(combined, params["activities"])
+    return combined

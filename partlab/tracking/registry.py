@@ -103,16 +103,18 @@ def params_class(key: str) -> type:
 
 register_parameters(ParameterEntry("body", "partlab.tracking.body.params:BodyParams", rng_slot=0))
 register_parameters(ParameterEntry("limbs", "partlab.tracking.limbs.params:LimbParams", rng_slot=1))
+register_parameters(ParameterEntry("activities", "partlab.tracking.activities.params:ActivityParams", rng_slot=9))
 
 register(TrackerEntry(
     "body", "head, torso and hip-leg of every person, plus the person box (Zhao & Lee)",
     "partlab.tracking.body:build", ("body",), ("person", "head", "torso", "hipleg")))
 register(TrackerEntry(
-    "limbs", "head and both hands of every person (parallel filters over skin blobs, state machine)",
-    "partlab.tracking.limbs:build", ("limbs",), ("head", "left_hand", "right_hand")))
+    "limbs", "head and both hands of every person (parallel filters over skin blobs, state machine), "
+    "with their activities (clap, handshake, exchange, pick, place)",
+    "partlab.tracking.limbs:build", ("limbs", "activities"), ("head", "left_hand", "right_hand")))
 register(TrackerEntry(
     "all", "body and limbs together, one track id per person",
-    "partlab.tracking.combined:build", ("body", "limbs"),
+    "partlab.tracking.combined:build", ("body", "limbs", "activities"),
     ("person", "head", "torso", "hipleg", "left_hand", "right_hand")))
 register(TrackerEntry(
     "whole", "one box per person (Zhao & Lee's whole-body baseline, Fig. 4(d))",

@@ -34,3 +34,26 @@ def test_save_upload_adds_a_clip_or_refuses_garbage(store, clip_file, tmp_path):
         save_upload(store, project.id, "broken.mp4", b"this is not a video" * 100)
     assert [c.name for c in store.clips(project.id)] == ["walker.mp4"]
     assert not any((tmp_path / "partlab-data" / "uploads").iterdir())  # temporary files removed
+
+
+def test_a_zip_of_frames_uploads_as_a_clip(store, clip_file, tmp_path):
+    import io
+    import zipfile
+
+    import cv2
+
+    from partlab.labelling.video import VideoClip
+
+    cap = cv2.VideoCapture(str(clip_file))
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w") as zf:
+        for k in range(5):
+            ok, frame = cap.read()
+            zf.writestr(f"seq/{k + 1:06d}.png", cv2.imencode(".png", frame)[1].tobytes())
+    cap.release()
+    project = store.create_project("z")
+    clip = save_upload(store, project.id, "frames.zip", buf.getvalue())
+    assert (clip.name, clip.frame_count, clip.width, clip.height, clip.fps) == ("frames.zip", 5, 96, 72, 25.0)
+    assert VideoClip(clip.path).read(4).shape == (72, 96, 3)
+    with pytest.raises(UploadRefused, match=r"refused: notes\.zip: not a video OpenCV can decode"):
+        save_upload(store, project.id, "notes.zip", b"PK\x03\x04 not really a zip" * 10)

@@ -97,9 +97,8 @@ def test_mota_and_idf1_known_by_hand():
 def test_eval_agrees_with_motmetrics_own_pipeline(tmp_path, monkeypatch):
     """Export truth and a noisy run as MOTChallenge files, let motmetrics load and match them."""
     from partlab.labelling.formats import export_dataset
-    from partlab.labelling.formats.mot import mot_id
+    from partlab.labelling.formats.mot import part_file
     from partlab.labelling.video import VideoInfo
-    from partlab.tracking.parts import PART_NAMES
 
     rng = np.random.default_rng(4)
     rows = []
@@ -117,17 +116,16 @@ def test_eval_agrees_with_motmetrics_own_pipeline(tmp_path, monkeypatch):
     monkeypatch.setattr(np, "asfarray", lambda a, dtype=float: np.asarray(a, dtype=dtype), raising=False)
     gt_dir = export_dataset(truth, "mot", tmp_path / "gt", info, frames=False)
     dt_dir = export_dataset(noisy, "mot", tmp_path / "dt", info, frames=False)
-    gt = mm.io.loadtxt(str(gt_dir / "gt" / "gt.txt"), fmt="mot15-2D")
-    dt = mm.io.loadtxt(str(dt_dir / "gt" / "gt.txt"), fmt="mot15-2D")
-    for part in ("head", "torso", "hipleg"):
-        c = PART_NAMES.index(part) + 1
-        acc = mm.utils.compare_to_groundtruth(gt[gt.ClassId == c], dt[dt.ClassId == c], "iou", distth=0.5)
+    for part in ("head", "torso", "hipleg"):  # each part is its own MOT file, gt/<part>.txt
+        gt = mm.io.loadtxt(str(gt_dir / "gt" / part_file(part)), fmt="mot15-2D")
+        dt = mm.io.loadtxt(str(dt_dir / "gt" / part_file(part)), fmt="mot15-2D")
+        acc = mm.utils.compare_to_groundtruth(gt, dt, "iou", distth=0.5)
         theirs = mm.metrics.create().compute(acc, metrics=["mota", "idf1", "num_switches"], name=part)
         assert ours.loc[part, "mota"] == pytest.approx(theirs.loc[part, "mota"], abs=1e-12)
         assert ours.loc[part, "idf1"] == pytest.approx(theirs.loc[part, "idf1"], abs=1e-12)
         assert ours.loc[part, "num_switches"] == theirs.loc[part, "num_switches"]
     assert ours.loc["torso", "num_switches"] >= 1 and 0.5 < ours.loc["overall", "mota"] < 1.0
-    assert mot_id(1, 2) == 13
+    assert part_file("head") == "head.txt" and part_file("person") == "gt.txt"
 
 
 def test_iou_distance_is_nan_below_half():

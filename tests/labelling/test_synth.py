@@ -130,11 +130,11 @@ def test_every_scenario_renders_valid_truth(name, tmp_path):
     init = read_tracks_csv(out / "init.csv")
     meta = json.loads((out / "scene.json").read_text())
     assert meta["name"] == name and meta["n_frames"] == 12 and (meta["width"], meta["height"]) == (240, 160)
-    n_tracks = {"pair_cross": 2, "crowd": 4}.get(name, 1)
+    n_tracks = {"pair_cross": 2, "crowd": 4, "exchange": 2, "handshake": 2}.get(name, 1)
     assert sorted(truth.track_id.unique()) == list(range(1, n_tracks + 1))
     assert (truth.source == "truth").all() and truth.occluded.between(0, 1).all()
     assert sorted(truth.frame.unique()) == list(range(12))
-    expected_parts = set(BOX_PARTS) - ({"hipleg"} if name == "desk" else set())
+    expected_parts = set(BOX_PARTS) - ({"hipleg"} if name in ("desk", "pick_place") else set())
     for tid, rows in truth.groupby("track_id"):
         assert set(rows.part) == expected_parts
         assert set(init[init.track_id == tid].part) == expected_parts

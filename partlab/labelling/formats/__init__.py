@@ -19,7 +19,8 @@ from typing import Callable
 import pandas as pd
 
 from partlab.labelling.archive import ArchiveError, is_archive, safe_extract
-from partlab.labelling.formats import coco, cvat, mot, parquet, voc, yolo
+from partlab.labelling.formats import coco, cvat, labelstudio, mot, parquet, voc, yolo
+from partlab.labelling.formats.alignment import align_frames
 from partlab.labelling.formats.base import MANIFEST_NAME, ExportManifest, FormatError, check_frame_count
 from partlab.labelling.video import VideoInfo, probe
 
@@ -48,7 +49,11 @@ FORMATS: dict[str, Format] = {
     "yolo": Format("yolo", "YOLO (Ultralytics): data.yaml, images/, labels/", yolo.export),
     "voc": Format("voc", "Pascal VOC: Annotations/, JPEGImages/, ImageSets/", voc.export),
     "parquet": Format("parquet", "Parquet and CSV of every box and flag", parquet.export, parquet.import_),
+    "labelstudio": Format("labelstudio", "Label Studio video tracks: tasks.json (videorectangle), labeling_config.xml",
+                          labelstudio.export, labelstudio.import_, labelstudio.annotated_frame_count),
 }
+#: formats whose files carry no frames (the clip itself goes to the other tool)
+NO_FRAMES = ("parquet", "labelstudio")
 IMPORT_FORMATS: tuple[str, ...] = tuple(n for n, f in FORMATS.items() if f.import_ is not None)
 
 
@@ -71,13 +76,13 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise FormatError(f"{out}: exists and is not a directory; -o names the output directory")
-    if frames and video_path is None and fmt != "parquet":
+    if frames and video_path is None and fmt not in NO_FRAMES:
         raise FormatError(f"writing frames for {fmt} needs the video (or pass frames=False / --no-frames)")
     if out.is_dir() and any(out.iterdir()):
         _remove_previous_export(out)
     kept = {c.name for c in out.iterdir()} if out.is_dir() else set()
     result = f.export(tracks_df, out, video_info, video_path=video_path, every=every,
-                      frames=frames and fmt != "parquet")
+                      frames=frames and fmt not in NO_FRAMES)
     manifest = ExportManifest.read(out)
     if manifest is not None:  # record what this export wrote, so the next one removes only that
         written = sorted(c.name for c in out.iterdir() if c.name not in kept) + [MANIFEST_NAME]
@@ -104,7 +109,8 @@ def _remove_previous_export(out: Path) -> None:
             child.unlink()
 
 
-def _import_dir(path: Path, f: Format, mapping, video) -> pd.DataFrame:
+def _import_dir(path: Path, f: Format, mapping, video, frame_offset: int) -> pd.DataFrame:
+    info = None
     if video is not None:
         info = video if isinstance(video, VideoInfo) else probe(video)
         stated = f.frame_count(path) if f.frame_count else None
@@ -114,15 +120,31 @@ def _import_dir(path: Path, f: Format, mapping, video) -> pd.DataFrame:
             manifest.check_video(info)
         elif stated is not None:
             check_frame_count(stated, info, f"the {f.name} annotations")
-    return f.import_(path, mapping)
+    if f.name == "labelstudio":  # percentages of the frame: the clip gives the size when the file does not
+        df = f.import_(path, mapping, size=(info.width, info.height) if info is not None else None)
+    else:
+        df = f.import_(path, mapping)
+    if frame_offset:
+        attrs = df.attrs
+        df = df.assign(frame=df["frame"] + int(frame_offset))
+        df.attrs = dict(attrs, images={k + int(frame_offset): v for k, v in attrs.get("images", {}).items()})
+    if info is not None:
+        df = align_frames(df, info, clip_path=None if isinstance(video, VideoInfo) else video, source=str(path))
+    df.attrs.pop("images", None)  # paths into a temporary extraction are of no use to the caller
+    return df
 
 
-def import_dataset(path, fmt: str, mapping=None, video=None) -> pd.DataFrame:
+def import_dataset(path, fmt: str, mapping=None, video=None, frame_offset: int = 0) -> pd.DataFrame:
     """Read a ``fmt`` dataset (our export directory, the format's own file, or a zip/tar of
     either) as a tracks table. ``mapping`` maps foreign label names or class ids to part
-    names (dict, JSON text or ``"face=head,1=person"``). With ``video`` (path or
-    :class:`VideoInfo`) the clip's frame count must match the one the files state.
-    ``df.attrs['skipped']`` counts boxes whose labels map to no part.
+    names (dict, JSON text or ``"face=head,1=person"``). ``frame_offset`` is added to the frames
+    read (``-1`` for files numbered from 1 that our readers cannot tell are).
+
+    With ``video`` (path or :class:`VideoInfo`) the clip's frame count must match the one the
+    files state, and the frames are lined up with the clip by :func:`~.alignment.align_frames`:
+    by the images' content when the dataset holds its frames (a shift of up to two frames is
+    corrected and recorded in ``df.attrs['frame_shift']``), and boxes on frames the clip does not
+    have are refused. ``df.attrs['skipped']`` counts boxes whose labels map to no part.
     """
     f = _format(fmt)
     if f.import_ is None:
@@ -140,8 +162,8 @@ def import_dataset(path, fmt: str, mapping=None, video=None) -> pd.DataFrame:
             entries = [e for e in root.iterdir() if not e.name.startswith(("__MACOSX", "."))]
             if len(entries) == 1 and entries[0].is_dir():
                 root = entries[0]
-            return _import_dir(root, f, mapping, video)
-    return _import_dir(p, f, mapping, video)
+            return _import_dir(root, f, mapping, video, frame_offset)
+    return _import_dir(p, f, mapping, video, frame_offset)
 
 
 def _clip_dir_name(clip) -> str:

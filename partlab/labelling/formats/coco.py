@@ -1,8 +1,16 @@
-"""COCO detection JSON (``annotations.json``) with its frames in ``images/``.
+"""COCO detection JSON with its frames, in the layouts COCO readers look for by default.
+
+Layout (one export opens in each reader without options)::
+
+    annotations/instances_default.json   the JSON (Datumaro's and the COCO API's layout: subset "default")
+    images/frame_000042.jpg ...          the annotated frames (Datumaro: ``images/``)
+    labels.json, data/                   the same JSON and frames as hard links (FiftyOne's
+                                         ``COCODetectionDataset`` defaults), no extra disk space
 
 One image entry per exported frame (``id = frame + 1``, our decoder index in
 ``frame_id``), one annotation per box with ``track_id``, the part as its category
-(``id = part_index + 1``) and our flags in ``attributes`` (``occluded`` as a boolean
+(``id = part_index + 1``), a top-level ``score`` (the tracker's, 1.0 for boxes without one, so
+``COCO.loadRes`` and ``COCOeval`` take the file as detections) and our flags in ``attributes`` (``occluded`` as a boolean
 the way CVAT and Datumaro write it, the exact fraction in ``occlusion``). ``info``
 states the fps and frame count of the clip. Importing a foreign file takes the frame
 from ``frame_id``, else from the digits ending the file name, else from the image's
@@ -21,12 +29,15 @@ import pandas as pd
 
 from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
                                     thinned_tracks)
-from partlab.labelling.formats.frames import frame_name, write_frames
+from partlab.labelling.formats.frames import frame_name, link_or_copy, link_tree, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
 
 NAME = "coco"
-FILE_NAME = "annotations.json"
+FILE_NAME = "annotations/instances_default.json"
+FIFTYONE_LABELS = "labels.json"
+FIFTYONE_DATA = "data"
+OLD_FILE_NAME = "annotations.json"  # partlab 0.2 exports
 
 
 def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, every: int = 1,
@@ -42,6 +53,7 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
             "id": k, "image_id": int(r.frame) + 1, "category_id": cat[r.part],
             "bbox": [float(r.x), float(r.y), float(r.w), float(r.h)], "area": float(r.w * r.h),
             "iscrowd": 0, "segmentation": [], "track_id": int(r.track_id),
+            "score": 1.0 if math.isnan(r.score) else float(r.score),
             "attributes": {"occluded": bool(r.occluded > 0), "occlusion": float(r.occluded),
                            "failure": bool(r.failure), "source": str(r.source),
                            "score": None if math.isnan(r.score) else float(r.score), "state": str(r.state),
@@ -56,9 +68,12 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
         "annotations": annotations,
         "categories": categories,
     }
+    (out_dir / FILE_NAME).parent.mkdir(parents=True, exist_ok=True)
     (out_dir / FILE_NAME).write_text(json.dumps(doc, indent=1), encoding="utf-8")
+    link_or_copy(out_dir / FILE_NAME, out_dir / FIFTYONE_LABELS)
     if frames:
-        write_frames(video_path, info, keep, out_dir / "images", name=frame_name)
+        written = write_frames(video_path, info, keep, out_dir / "images", name=frame_name)
+        link_tree(written.values(), out_dir / FIFTYONE_DATA)
     ExportManifest.for_video(NAME, info, every, frames).write(out_dir)
     return out_dir
 
@@ -66,13 +81,15 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
 def _find_json(path: Path) -> Path:
     if path.is_file():
         return path
-    if (path / FILE_NAME).is_file():
-        return path / FILE_NAME
+    for name in (FILE_NAME, OLD_FILE_NAME, FIFTYONE_LABELS):
+        if (path / name).is_file():
+            return path / name
     found = sorted(path.glob("*.json")) + sorted((path / "annotations").glob("*.json"))
     found = [p for p in found if p.name != "partlab.json"]
     if len(found) == 1:
         return found[0]
-    raise FormatError(f"{path}: expected a COCO JSON file ({FILE_NAME}, or one .json in annotations/)")
+    raise FormatError(f"{path}: expected a COCO JSON file ({FILE_NAME}, {FIFTYONE_LABELS}, or one .json in "
+                      "annotations/)")
 
 
 def annotated_frame_count(path: Path) -> int | None:
@@ -100,12 +117,24 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     cats = {c.get("id"): str(c.get("name", c.get("id"))) for c in doc["categories"] if isinstance(c, dict)}
     images = sorted((im for im in doc["images"] if isinstance(im, dict)), key=lambda im: im.get("id", 0))
     frame_of: dict = {}
+    origin = set()
     for position, im in enumerate(images):
         if isinstance(im.get("frame_id"), int):
             frame_of[im.get("id")] = im["frame_id"]
+            origin.add("frame_id")
         else:
             m = re.search(r"(\d+)$", Path(str(im.get("file_name", ""))).stem)
             frame_of[im.get("id")] = int(m.group(1)) if m else position
+            origin.add("file names" if m else "image order")
+    image_of = {}
+    subset = js.stem.split("_", 1)[1] if js.stem.startswith("instances_") else "default"
+    roots = [js.parent, js.parent / "images", js.parent / FIFTYONE_DATA, js.parent.parent / "images",
+             js.parent.parent / "images" / subset, js.parent.parent / FIFTYONE_DATA]
+    for im in images:
+        name = str(im.get("file_name", ""))
+        found = next((r / name for r in roots if name and (r / name).is_file()), None)
+        if found is not None:
+            image_of[frame_of[im.get("id")]] = found
     rows: list[dict] = []
     skipped: dict[str, int] = {}
     for a in doc["annotations"]:
@@ -120,10 +149,15 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         if not (isinstance(bbox, list) and len(bbox) == 4):
             raise FormatError(f"{js}: annotation {a.get('id')} has no [x, y, w, h] bbox")
         attrs = a.get("attributes") if isinstance(a.get("attributes"), dict) else {}
-        track_id = a.get("track_id", attrs.get("track_id"))
+        if attrs.get("outside") is True:  # a CVAT track's end, kept by Datumaro: no box there
+            skipped["outside (track ended)"] = skipped.get("outside (track ended)", 0) + 1
+            continue
+        track_id = a.get("track_id", attrs.get("person", attrs.get("track_id")))
         if track_id is None:
             track_id = a.get("id", len(rows))
-        score = attrs.get("score", a.get("score"))
+        score = attrs.get("score", attrs.get("confidence", a.get("score")))
+        if isinstance(score, str):
+            score = float(score) if score.strip() else None
         occlusion = attrs.get("occlusion", 1.0 if attrs.get("occluded") else 0.0)
         rows.append({
             "frame": frame_of[a["image_id"]], "track_id": int(track_id), "part": part,
@@ -132,4 +166,7 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
             "failure": bool(attrs.get("failure", False)), "occluded": float(occlusion),
             "state": str(attrs.get("state", "")), "source": str(attrs.get("source", NAME)),
         })
-    return finish_import(rows, skipped, str(js))
+    df = finish_import(rows, skipped, str(js))
+    df.attrs["images"] = image_of
+    df.attrs["frame_origin"] = "frame_id" if origin == {"frame_id"} else " and ".join(sorted(origin))
+    return df

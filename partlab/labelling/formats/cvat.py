@@ -1,15 +1,19 @@
 """CVAT for video 1.1 XML (``annotations.xml``): the lossless format.
 
-One ``<track>`` per (person, part), labelled with the part name; ``group_id`` is
-``track_id + 1`` so CVAT shows one person's parts as a group (0 means "no group" in
-CVAT). Every box we have is a keyframe; a box with ``outside="1"`` closes a track where
+One ``<track>`` per (person, part), labelled with the part name, the person (our ``track_id``) in
+an immutable ``person`` attribute on every box (not ``track_id``: Datumaro sets that one to the CVAT track). The tracks are not grouped: Datumaro (and CVAT's own
+COCO export) merge the shapes of a group into one instance, which would turn a person's four parts
+into one box. The frames are ``images/frame_000042.png`` (PNG, where Datumaro looks for a video task's
+frames). Every box we have is a keyframe; a box with ``outside="1"`` closes a track where
 its next exported frame has no box (CVAT would otherwise interpolate over the gap).
-``occluded="1"`` when ``occluded > 0``; the exact fraction, ``failure``, ``source``,
-``score`` and ``state`` are per-frame attributes, so importing our own export gives
-back every box and flag. Foreign files: boxes with ``outside="1"`` are dropped, the
+``occluded="1"`` when ``occluded > 0``; the exact fraction (``occlusion``), ``failure``, ``source``,
+``confidence`` (the score) and ``state`` are per-frame attributes (and ``camera``, ``X``, ``Y``, ``Z``
+when some box has them), so importing our own export gives back every box and flag. Foreign files:
+boxes with ``outside="1"`` are dropped, the
 track's ``group_id - 1`` is the track id when it has one, else ids continue after the
 largest, and missing attributes take their defaults (``source`` is ``cvat`` for
-keyframes and ``interpolated`` otherwise).
+keyframes and ``interpolated`` otherwise). The track id of a box is its ``person`` attribute, else
+its track's ``group_id - 1`` (partlab 0.2 exports and grouped CVAT tasks), else a new id per track.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_
 from partlab.labelling.formats.frames import all_frames, frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.tracks import has_take_columns
 
 NAME = "cvat"
 FILE_NAME = "annotations.xml"
@@ -36,11 +41,19 @@ COLOURS = {"person": "#33ddff", "head": "#fa3253", "torso": "#34d1b7", "hipleg":
            "right_shoulder": "#f59331", "left_elbow": "#2a7dd1", "right_elbow": "#d12a7d"}
 #: per-frame attributes: name -> (CVAT input type, default value, values line)
 ATTRIBUTES: dict[str, tuple[str, str, str]] = {
+    "person": ("number", "0", "0;1000000;1"),  # track_id; Datumaro keeps its own "track_id"
     "failure": ("checkbox", "false", "false\ntrue"),
     "source": ("text", "tracker", "tracker"),
     "occlusion": ("text", "0", "0"),
-    "score": ("text", "", ""),
+    "confidence": ("text", "", ""),  # the tracker's score; not "score", which Datumaro parses as a number
     "state": ("text", "", ""),
+}
+#: attributes of takes (the tracks CSV's camera, X, Y, Z), declared and written only when some box has them
+TAKE_ATTRIBUTES: dict[str, tuple[str, str, str]] = {
+    "camera": ("text", "", ""),
+    "X": ("text", "", ""),
+    "Y": ("text", "", ""),
+    "Z": ("text", "", ""),
 }
 
 
@@ -48,7 +61,7 @@ def _num(v: float) -> str:
     return f"{float(v):.10g}"
 
 
-def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
+def _meta(root: ET.Element, info: VideoInfo, every: int, attributes: dict) -> None:
     meta = ET.SubElement(root, "meta")
     task = ET.SubElement(meta, "task")
     name = Path(info.path).stem if info.path else "partlab"
@@ -64,10 +77,10 @@ def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
         ET.SubElement(label, "color").text = COLOURS[part]
         ET.SubElement(label, "type").text = "rectangle"
         attrs = ET.SubElement(label, "attributes")
-        for attr_name, (input_type, default, values) in ATTRIBUTES.items():
+        for attr_name, (input_type, default, values) in attributes.items():
             a = ET.SubElement(attrs, "attribute")
             ET.SubElement(a, "name").text = attr_name
-            ET.SubElement(a, "mutable").text = "True"
+            ET.SubElement(a, "mutable").text = "False" if attr_name == "person" else "True"
             ET.SubElement(a, "input_type").text = input_type
             ET.SubElement(a, "default_value").text = default
             ET.SubElement(a, "values").text = values
@@ -78,16 +91,19 @@ def _meta(root: ET.Element, info: VideoInfo, every: int) -> None:
     ET.SubElement(meta, "source").text = f"partlab, fps={_num(info.fps)}"
 
 
-def _box(track: ET.Element, r, *, outside: bool) -> None:
+def _box(track: ET.Element, r, *, outside: bool, take: bool) -> None:
     occluded = float(r.occluded)
     b = ET.SubElement(track, "box", {
         "frame": str(int(r.frame)), "keyframe": "1", "outside": "1" if outside else "0",
         "occluded": "1" if occluded > 0 else "0",
         "xtl": _num(r.x), "ytl": _num(r.y), "xbr": _num(r.x + r.w), "ybr": _num(r.y + r.h), "z_order": "0",
     })
-    values = {"failure": "true" if bool(r.failure) else "false", "source": str(r.source),
-              "occlusion": _num(occluded), "score": "" if math.isnan(r.score) else _num(r.score),
+    values = {"person": str(int(r.track_id)), "failure": "true" if bool(r.failure) else "false", "source": str(r.source),
+              "occlusion": _num(occluded), "confidence": "" if math.isnan(r.score) else _num(r.score),
               "state": str(r.state)}
+    if take:
+        values.update(camera=str(r.camera), **{a: "" if math.isnan(getattr(r, a)) else _num(getattr(r, a))
+                                                for a in ("X", "Y", "Z")})
     for name, value in values.items():
         ET.SubElement(b, "attribute", {"name": name}).text = value
 
@@ -97,25 +113,25 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     root = ET.Element("annotations")
     ET.SubElement(root, "version").text = "1.1"
-    _meta(root, info, every)
+    take = has_take_columns(df)
+    _meta(root, info, every, ATTRIBUTES | TAKE_ATTRIBUTES if take else ATTRIBUTES)
     for cvat_id, ((track_id, part), rows) in enumerate(
             df.groupby(["track_id", "part"], sort=False)):
-        track = ET.SubElement(root, "track", {"id": str(cvat_id), "label": part, "source": "manual",
-                                              "group_id": str(int(track_id) + 1)})
+        track = ET.SubElement(root, "track", {"id": str(cvat_id), "label": part, "source": "manual"})
         rows = rows.sort_values("frame")
         frame_list = rows["frame"].to_numpy()
         for k, r in enumerate(rows.itertuples(index=False)):
-            _box(track, r, outside=False)
+            _box(track, r, outside=False, take=take)
             nxt = frame_list[k + 1] if k + 1 < len(frame_list) else None
             gap = int(r.frame) + every
             if (nxt is None or nxt != gap) and gap < info.frame_count:
-                _box(track, r._replace(frame=gap), outside=True)
+                _box(track, r._replace(frame=gap), outside=True, take=take)
     ET.indent(root, space="  ")
     ET.ElementTree(root).write(out_dir / FILE_NAME, encoding="utf-8", xml_declaration=True)
     if frames:  # a CVAT task holds every frame (meta size), thinned by --every
-        write_frames(video_path, info, all_frames(info, every), out_dir / "images", name=frame_name)
+        write_frames(video_path, info, all_frames(info, every), out_dir / "images", name=frame_name, ext=".png")
     ExportManifest.for_video(NAME, info, every, frames,
-                             notes="CVAT track group_id = track_id + 1").write(out_dir)
+                             notes="the person of a box is its track_id attribute").write(out_dir)
     return out_dir
 
 
@@ -166,7 +182,9 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         raise FormatError(f"{xml}: no <track> elements; expected CVAT for video 1.1 XML{hint}")
     names = parse_mapping(mapping)
     groups = [int(t.get("group_id", "0") or 0) for t in tracks]
-    next_id = max([g - 1 for g in groups if g > 0], default=-1) + 1
+    stated = [int(float(a.text)) for a in root.iter("attribute")
+              if a.get("name") == "person" and (a.text or "").strip().lstrip("-").replace(".", "", 1).isdigit()]
+    next_id = max([g - 1 for g in groups if g > 0] + stated, default=-1) + 1
     rows: list[dict] = []
     skipped: dict[str, int] = {}
     for t, group in zip(tracks, groups):
@@ -196,16 +214,27 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
             attrs = {a.get("name"): (a.text or "") for a in b.findall("attribute")}
             keyframe = b.get("keyframe", "1") == "1"
             occluded_flag = 1.0 if b.get("occluded") == "1" else 0.0
+            try:
+                box_track = int(float(attrs["person"])) if attrs.get("person", "").strip() else track_id
+            except ValueError:
+                box_track = track_id
             rows.append({
-                "frame": frame, "track_id": track_id, "part": part,
+                "frame": frame, "track_id": box_track, "part": part,
                 "x": xtl, "y": ytl, "w": xbr - xtl, "h": ybr - ytl,
-                "score": _attr_float(attrs.get("score"), float("nan")),
+                "score": _attr_float(attrs.get("confidence", attrs.get("score")), float("nan")),
                 "failure": attrs.get("failure", "false").strip().lower() in ("true", "1", "yes"),
                 "occluded": _attr_float(attrs.get("occlusion"), occluded_flag),
                 "state": attrs.get("state", ""),
                 "source": attrs.get("source") or ("cvat" if keyframe else "interpolated"),
+                "camera": attrs.get("camera", ""),
+                **{a: _attr_float(attrs.get(a), float("nan")) for a in ("X", "Y", "Z")},
             })
     df = finish_import(rows, skipped, str(xml))
+    images = xml.parent / "images"
+    if images.is_dir():  # a CVAT task's frames: images/frame_000042.png (or .jpg)
+        df.attrs["images"] = {int(p.stem[6:]): p for p in images.iterdir()
+                              if p.stem.startswith("frame_") and p.stem[6:].isdigit()}
+    df.attrs["frame_origin"] = "CVAT frame numbers"
     dup = df.duplicated(["frame", "track_id", "part"])
     if dup.any():
         raise FormatError(f"{xml}: {int(dup.sum())} boxes repeat a (frame, group, label); two CVAT tracks of "

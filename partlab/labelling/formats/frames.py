@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import os
+import shutil
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterable
 
 import cv2
 import numpy as np
@@ -42,7 +44,7 @@ def write_frames(video_path, info: VideoInfo, frames: np.ndarray, out_dir: Path,
         return written
     clip = VideoClip(video_path, info)
     stop = max(wanted) + 1
-    params = [int(cv2.IMWRITE_JPEG_QUALITY), JPEG_QUALITY]
+    params = [int(cv2.IMWRITE_JPEG_QUALITY), JPEG_QUALITY] if ext.lower() in (".jpg", ".jpeg") else []
     for index, image in tqdm(clip.frames(0, stop), total=stop, desc="writing frames", unit="frame",
                              leave=False, disable=None):
         if index in wanted:
@@ -55,3 +57,26 @@ def write_frames(video_path, info: VideoInfo, frames: np.ndarray, out_dir: Path,
         raise FormatError(f"{video_path}: could not decode frame(s) {sorted(missing)[:5]}; the clip is shorter "
                           "than the one annotated")
     return written
+
+
+def link_or_copy(src: Path, dest: Path) -> Path:
+    """``dest`` as a hard link to ``src`` (no extra disk space), or a copy where links are refused.
+
+    Used where two peers want the same files under different names (Datumaro's ``images/`` and
+    FiftyOne's ``data/``); symbolic links are avoided because zip archives drop what they point to.
+    """
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    if dest.exists():
+        dest.unlink()
+    try:
+        os.link(src, dest)
+    except OSError:
+        shutil.copyfile(src, dest)
+    return dest
+
+
+def link_tree(files: Iterable[Path], out_dir: Path) -> None:
+    """Hard-link (or copy) each of ``files`` into ``out_dir`` under its own name."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for f in files:
+        link_or_copy(Path(f), out_dir / Path(f).name)

@@ -1,18 +1,25 @@
-"""MOTChallenge ground truth: ``seqinfo.ini``, ``gt/gt.txt``, ``gt/labels.txt`` and optional ``img1/``.
+"""MOTChallenge ground truth: ``seqinfo.ini``, ``gt/gt.txt`` (people), ``gt/<part>.txt`` and ``img1/``.
 
 ``gt.txt`` rows are ``frame, id, x, y, w, h, conf, class, visibility`` (MOT16/17
 layout): frames, ids and pixel coordinates count from 1 (the devkit's Matlab convention,
-which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider the box), ``class`` is the
-1-based line of ``gt/labels.txt`` naming the part (where Datumaro's ``mot_seq`` reads
-it), and ``visibility = 1 - occluded``.
-MOT ids must be unique per object, and each of our people has several parts, so the id
-of (track_id, part) is ``10 * track_id + part_index + 1`` (part_index in
-:data:`partlab.tracking.parts.BOX_PARTS`); the importer inverts this for our own exports
-(recognised by ``partlab.json``). Foreign files keep their ids as track ids; rows with
-``conf == 0`` in a ``gt.txt`` are ignored boxes in MOTChallenge and are skipped, and
-10-column MOT15 files (no class) are read as ``pedestrian``. Datumaro copies MOT
-coordinates without the 1-pixel shift, so boxes it converted from another format into
-MOT come in one pixel up and left.
+which motmetrics undoes by subtracting 1 from x and y), ``conf`` is 1 (consider the box) and
+``visibility = 1 - occluded``.
+
+Class map. ``gt/gt.txt`` holds the ``person`` boxes only, as class 1, MOT17's ``pedestrian``, so
+TrackEval's MOTChallenge reader and the MOT devkits evaluate it as it is (MOT17's classes 2..13 are
+other things: person on vehicle, car, ..., crowd, and TrackEval refuses a pedestrian evaluation with
+any other class in it). Each other box part has its own file ``gt/<part>.txt`` (``head.txt``,
+``torso.txt``, ``hipleg.txt``, ``left_hand.txt``, ``right_hand.txt``) in the same layout
+with class 1 meaning "this part", so TrackEval evaluates a part with
+``GT_LOC_FORMAT='{gt_folder}/{seq}/gt/head.txt'``. The id of a box is ``track_id + 1`` in every
+file: one person has one MOT id across its parts. ``gt/labels.txt`` names class 1 (``person``) for
+Datumaro's ``mot_seq``, which reads ``gt/gt.txt``.
+
+Foreign files keep their ids as track ids; rows with ``conf == 0`` in a ``gt.txt`` are ignored
+boxes in MOTChallenge and are skipped, and 10-column MOT15 files (no class) are read as
+``pedestrian``. Frames are read from the file (1-based); ``seqinfo.ini``'s ``seqLength`` is the
+frame count the sequence states. Datumaro copies MOT coordinates without the 1-pixel shift, so boxes
+it converted from another format into MOT come in one pixel up and left.
 """
 
 from __future__ import annotations
@@ -31,13 +38,13 @@ from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import BOX_PARTS
 
 NAME = "mot"
-ID_STRIDE = 10  # > len(BOX_PARTS): ids of one person's parts share all digits but the last
-ID_RULE = f"MOT id = {ID_STRIDE} * track_id + part_index + 1, part_index in {list(BOX_PARTS)}"
+ID_RULE = "MOT id = track_id + 1; gt/gt.txt holds person boxes (class 1), gt/<part>.txt each other part"
+PEDESTRIAN = 1  # MOT16/17 class 1
 
 
-def mot_id(track_id: np.ndarray, part_index: np.ndarray) -> np.ndarray:
-    """1-based MOT object id of each (track_id, part_index)."""
-    return ID_STRIDE * np.asarray(track_id, dtype=np.int64) + np.asarray(part_index, dtype=np.int64) + 1
+def part_file(part: str) -> str:
+    """The file under ``gt/`` holding ``part``'s boxes."""
+    return "gt.txt" if part == "person" else f"{part}.txt"
 
 
 def _num(v: float) -> str:
@@ -49,13 +56,15 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     df, keep = thinned_tracks(df, info, video_path, every, out_dir)
     df = df[df["part"].isin(BOX_PARTS)]  # MOT holds boxes; 3D joints (shoulders, elbows) are not boxes
     (out_dir / "gt").mkdir(exist_ok=True)
-    part_index = df["part"].map({p: i for i, p in enumerate(BOX_PARTS)}).to_numpy()
-    ids = mot_id(df["track_id"].to_numpy(), part_index)
     vis = np.clip(1.0 - df["occluded"].to_numpy(dtype=float), 0.0, 1.0)
-    with open(out_dir / "gt" / "gt.txt", "w", encoding="utf-8") as f:
-        for r, i, c, v in zip(df.itertuples(index=False), ids, part_index, vis):
-            f.write(f"{r.frame + 1},{i},{_num(r.x + 1)},{_num(r.y + 1)},{_num(r.w)},{_num(r.h)},1,{c + 1},{_num(v)}\n")
-    (out_dir / "gt" / "labels.txt").write_text("".join(f"{p}\n" for p in BOX_PARTS), encoding="utf-8")
+    lines: dict[str, list[str]] = {"person": []}
+    for r, v in zip(df.itertuples(index=False), vis):
+        lines.setdefault(r.part, []).append(
+            f"{r.frame + 1},{int(r.track_id) + 1},{_num(r.x + 1)},{_num(r.y + 1)},{_num(r.w)},{_num(r.h)},1,"
+            f"{PEDESTRIAN},{_num(v)}\n")
+    for part, ls in lines.items():
+        (out_dir / "gt" / part_file(part)).write_text("".join(ls), encoding="utf-8")
+    (out_dir / "gt" / "labels.txt").write_text("person\n", encoding="utf-8")
     seq = configparser.ConfigParser()
     seq.optionxform = str  # MOT keys are camelCase
     seq["Sequence"] = {
@@ -116,11 +125,38 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     root = path if path.is_dir() else (gt.parent.parent if gt.parent.name == "gt" else gt.parent)
     manifest = ExportManifest.read(root)
     ours = manifest is not None and manifest.format == NAME
+    if ours and path.is_dir():
+        frames = []
+        for part in BOX_PARTS:
+            f = gt.parent / part_file(part)
+            if f.is_file() and f.stat().st_size:
+                frames.append(_read(f, None, root, ours=True, part=part))
+        df = pd.concat(frames, ignore_index=True) if frames else _read(gt, mapping, root, ours=True)
+        return finish_import(df.to_dict("records"), {}, str(gt))
+    df = _read(gt, mapping, root, ours=False)
+    img_dir = root / read_seqinfo(root).get("imDir", "img1") if root.is_dir() else None
+    if img_dir is not None and img_dir.is_dir():
+        df.attrs["images"] = _images_by_frame(img_dir)
+    df.attrs["frame_origin"] = "MOT frame numbers (1-based)"
+    return df
+
+
+def _images_by_frame(img_dir: Path) -> dict[int, Path]:
+    """0-based frame -> image of a MOT ``img1/`` (named by their 1-based frame)."""
+    out = {}
+    for p in img_dir.iterdir():
+        if p.stem.isdigit() and p.suffix.lower() in (".jpg", ".jpeg", ".png", ".bmp"):
+            out[int(p.stem) - 1] = p
+    return out
+
+
+def _read(gt: Path, mapping, root: Path, ours: bool, part: str | None = None) -> pd.DataFrame:
+    """Rows of one MOT file; ``part`` names the part of every row (our ``gt/<part>.txt``)."""
     labels_path = next((p for p in (gt.parent / "labels.txt", root / "labels.txt") if p.is_file()), None)
     labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path else []
     names = parse_mapping(mapping)
     names.setdefault("1", "person")  # MOT16/17 class 1 is 'pedestrian'
-    is_gt = gt.name == "gt.txt"
+    is_gt = gt.name.startswith("gt")
     rows: list[dict] = []
     skipped: dict[str, int] = {}
     with open(gt, newline="", encoding="utf-8") as f:
@@ -150,15 +186,15 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
             if is_gt and conf == 0:
                 skipped["conf=0 (ignored)"] = skipped.get("conf=0 (ignored)", 0) + 1
                 continue
-            part = map_label(label, names)
-            if part is None:
+            box_part = part or map_label(label, names)
+            if box_part is None:
                 skipped[label] = skipped.get(label, 0) + 1
                 continue
             vis = v[8] if len(v) == 9 else 1.0
             rows.append({
                 "frame": frame - 1,
-                "track_id": (oid - 1) // ID_STRIDE if ours else oid,
-                "part": part, "x": v[2] - 1.0, "y": v[3] - 1.0, "w": v[4], "h": v[5],
+                "track_id": oid - 1 if ours else oid,
+                "part": box_part, "x": v[2] - 1.0, "y": v[3] - 1.0, "w": v[4], "h": v[5],
                 "score": float("nan") if is_gt else conf,
                 "occluded": float(np.clip(1.0 - vis, 0.0, 1.0)) if 0.0 <= vis <= 1.0 else 0.0,
                 "source": NAME,

@@ -1,5 +1,8 @@
 """Pascal VOC for detector training: ``Annotations/*.xml``, ``JPEGImages/``, ``ImageSets/Main/default.txt``.
 
+``labels/`` and ``data/`` hold the same XML files and frames as hard links (no extra disk space):
+FiftyOne's ``VOCDetectionDataset`` looks there by default, Datumaro's ``voc`` in the VOC names.
+
 One XML per exported frame, an ``<object>`` per box named after the part. VOC boxes are
 integer pixels, 1-based and inclusive (``xmin = x + 1``, ``xmax = x + w``), inside the
 image: boxes are clipped to the frame and ``truncated`` is 1 when clipping cut them.
@@ -18,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.labelling.formats.base import ExportManifest, thinned_tracks
-from partlab.labelling.formats.frames import frame_name, write_frames
+from partlab.labelling.formats.frames import frame_name, link_tree, write_frames
 from partlab.labelling.formats.yolo import clipped_xyxy
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
@@ -81,7 +84,9 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
         "# label:color_rgb:parts:actions\nbackground:0,0,0::\n" + "".join(
             f"{p}:{(37 * i) % 256},{(91 * i) % 256},{(53 * i) % 256}::\n" for i, p in enumerate(PART_NAMES, 1)),
         encoding="utf-8")
+    link_tree(sorted((out_dir / "Annotations").glob("*.xml")), out_dir / "labels")
     if frames:
-        write_frames(video_path, info, keep, out_dir / "JPEGImages", name=frame_name)
+        written = write_frames(video_path, info, keep, out_dir / "JPEGImages", name=frame_name)
+        link_tree(written.values(), out_dir / "data")
     ExportManifest.for_video(NAME, info, every, frames).write(out_dir)
     return out_dir

@@ -40,9 +40,14 @@ class Occluder:
 
 @dataclass(frozen=True, eq=False)
 class Script:
+    """``objects``: carried objects (:class:`partlab.labelling.synth.activities.CarriedObject`);
+    ``events``: the activity truth (:class:`partlab.labelling.synth.activities.EventTruth`)."""
+
     actors: list[Actor]
     props: list[Prop] = field(default_factory=list)
     occluders: list[Occluder] = field(default_factory=list)
+    objects: list = field(default_factory=list)
+    events: list = field(default_factory=list)
     lighting: np.ndarray | None = None  # (H, W, 3) float32 gain on the whole frame (None: as drawn)
 
 

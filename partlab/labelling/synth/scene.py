@@ -30,12 +30,17 @@ from partlab.labelling.synth.background import CameraEffects, draw_props, room, 
 from partlab.labelling.synth.camera import Camera
 from partlab.labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
                                     colour_table, draw_figure)
+from partlab.labelling.synth.activities import BUILDERS as ACTIVITY_BUILDERS
+from partlab.labelling.synth.activities import HANDS
 from partlab.labelling.synth.scenarios import BUILDERS, Script
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
 from partlab.tracking.tracks import normalise_tracks
 
-SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk", "random")
+SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk",
+                              "pick_place", "exchange", "handshake", "clap", "random")
+#: the columns of a scene's event truth (``events.csv``)
+EVENT_TRUTH_COLUMNS = ("kind", "start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b", "colour")
 FPS = 25.0
 OCCLUDER_ID = 255
 SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
@@ -62,6 +67,7 @@ class Scene:
     appearances: tuple[Appearance, ...] = ()  # the people's colours, by track_id - 1
     background: np.ndarray | None = None  # (H, W, 3) uint8: the empty room (no shadows, flicker or noise)
     owners: np.ndarray | None = None  # (T, H, W) uint8 who is seen where: 0 room, k track k, 255 occluder
+    events: pd.DataFrame | None = None  # activity truth (EVENT_TRUTH_COLUMNS), scenes with activities only
 
 
 def _check(name: str, seed: int, n_frames: int, width: int, height: int) -> None:
@@ -129,7 +135,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.random(rng, width, height) if name == "random" else Camera.for_frame(width, height)
-    script: Script = BUILDERS[name](rng, camera, n_frames, FPS)
+    script: Script = {**BUILDERS, **ACTIVITY_BUILDERS}[name](rng, camera, n_frames, FPS)
     background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
@@ -174,6 +180,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             frame[cy1:cy2, cx1:cx2][on] = colours
             owner[cy1:cy2, cx1:cx2][on] = a + 1
             drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
+        _draw_objects(frame, script.objects, drawn, i)
         for o, tex in zip(script.occluders, occ_tex):
             x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
@@ -214,8 +221,41 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
         start = inside.groupby("track_id")["frame"].min()
         first = truth["track_id"].map(start).fillna(first)
     init = truth[truth["frame"] == first].reset_index(drop=True)
+    events = None
+    if script.events:
+        events = pd.DataFrame([(e.kind, e.start_frame, e.end_frame, e.track_id_a, e.part_a, e.track_id_b, e.part_b,
+                                "" if e.colour is None else "#%02x%02x%02x" % tuple(reversed(e.colour)))
+                               for e in script.events], columns=list(EVENT_TRUTH_COLUMNS))
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
-                 tuple(a.appearance for a in script.actors), background, owner_maps)
+                 tuple(a.appearance for a in script.actors), background, owner_maps, events)
+
+
+def _draw_objects(frame: np.ndarray, objects, drawn, i: int) -> None:
+    """Carried objects at frame ``i``: in front of the holding hand (a little below its centre, so
+    the hand still shows), or where they rest."""
+    import cv2
+
+    figs = {a: (fig, box) for a, fig, _, box in drawn}
+    for obj in objects:
+        h = int(obj.holder[i])
+        if h < 0:
+            if not np.all(np.isfinite(obj.rest[i])):
+                continue
+            centre, r = obj.rest[i], None
+        else:
+            got = figs.get(h // 2)
+            mask = None if got is None else got[0].masks.get(HANDS[h % 2])
+            if mask is None or not mask.any():
+                continue
+            ys, xs = np.nonzero(mask)
+            x0, y0 = got[0].origin
+            hand_r = max(2.0, 0.5 * (xs.max() - xs.min() + 1))
+            centre = np.array([x0 + xs.mean(), y0 + ys.mean() + 1.1 * hand_r])
+            r = obj.radius * hand_r
+        if r is None:
+            r = obj.rest_radius_px
+        cv2.ellipse(frame, (int(round(centre[0])), int(round(centre[1]))), (int(round(r)), int(round(0.8 * r))),
+                    0, 0, 360, tuple(int(c) for c in obj.colour), -1, lineType=cv2.LINE_AA)
 
 
 def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,
@@ -243,4 +283,6 @@ def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: 
                         "hair": list(p.hair), "height_m": round(p.height_m, 3)}
                        for k, p in enumerate(scene.appearances)]}
     (out / "scene.json").write_text(json.dumps(meta, indent=2) + "\n")
+    if scene.events is not None:
+        scene.events.to_csv(out / "events.csv", index=False, lineterminator="\n")
     return out

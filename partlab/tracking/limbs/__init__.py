@@ -18,4 +18,9 @@ def build(params, rngs, context):
         tracker = LimbTracker(p, rngs["limbs"], init=context.init)
     except ValueError as exc:
         raise UserError(f"bad init table: {exc}") from None
-    return SingleView(tracker, p)
+    view = SingleView(tracker, p)
+    if "activities" in params:  # carried objects and activities over the hands it tracks
+        from partlab.tracking.activities import with_activities
+
+        return with_activities(view, params["activities"])
+    return view

@@ -16,7 +16,7 @@ def exported(tmp_path_factory, truth, clip):
 
 
 def test_pycocotools_reads_images_categories_and_boxes(exported, truth):
-    coco = COCO(str(exported / "annotations.json"))
+    coco = COCO(str(exported / "annotations" / "instances_default.json"))
     assert len(coco.getImgIds()) == 20 and len(coco.getAnnIds()) == len(truth)
     head = coco.getCatIds(catNms=["head"])
     assert len(coco.getAnnIds(catIds=head)) == (truth.part == "head").sum() == 36
@@ -37,7 +37,7 @@ def test_round_trip_with_our_importer(exported, truth):
 def test_every_thins_the_images(tmp_path, truth, clip):
     path, info = clip
     out = export_dataset(truth, "coco", tmp_path / "c", info, video_path=path, every=5)
-    doc = json.loads((out / "annotations.json").read_text())
+    doc = json.loads((out / "annotations" / "instances_default.json").read_text())
     assert [im["frame_id"] for im in doc["images"]] == [0, 5, 10, 15]
     assert sorted(p.name for p in (out / "images").iterdir()) == [
         "frame_000000.jpg", "frame_000005.jpg", "frame_000010.jpg", "frame_000015.jpg"]

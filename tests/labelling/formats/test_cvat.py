@@ -30,10 +30,10 @@ def test_datumaro_reads_tracks_with_outside_and_occluded(exported, truth):
     assert len(inside) == len(truth)
     # person 3 leaves at frame 8 (a box per part marks it outside) and comes back at 12
     assert sorted({f for f, _ in outside}) == [8] and len(outside) == 4
-    assert {a.group for _, a in outside} == {3 + 1}
+    assert {int(a.attributes["person"]) for _, a in outside} == {3} and {a.group for _, a in outside} == {0}
     occluded = sorted(f for f, a in inside if a.attributes["occluded"])
     assert occluded == [5, 6, 7]
-    f, head = next((f, a) for f, a in inside if f == 10 and labels[a.label] == "head" and a.group == 1)
+    f, head = next((f, a) for f, a in inside if f == 10 and labels[a.label] == "head" and a.attributes["person"] == 0)
     t = truth[(truth.frame == 10) & (truth.track_id == 0) & (truth.part == "head")].iloc[0]
     assert head.get_bbox() == pytest.approx([t.x, t.y, t.w, t.h])
 

@@ -7,7 +7,6 @@ import pytest
 
 from partlab.labelling.evaluation import iou_distance
 from partlab.labelling.formats import FormatError, export_dataset, import_dataset
-from partlab.labelling.formats.mot import mot_id
 from partlab.tracking.parts import BOX_PARTS
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "occluded"]
@@ -25,21 +24,24 @@ def test_layout_states_the_clip(exported, clip):
     seq.read(exported / "seqinfo.ini")
     assert dict(seq["Sequence"]) == {"name": "clip", "imdir": "img1", "framerate": "10", "seqlength": "20",
                                      "imwidth": "160", "imheight": "120", "imext": ".jpg"}
-    assert (exported / "gt" / "labels.txt").read_text().split() == list(BOX_PARTS)
+    assert (exported / "gt" / "labels.txt").read_text().split() == ["person"]
+    assert sorted(p.name for p in (exported / "gt").iterdir()) == ["gt.txt", "head.txt", "hipleg.txt", "labels.txt",
+                                                                  "torso.txt"]
     images = sorted(p.name for p in (exported / "img1").iterdir())
     assert images[0] == "000001.jpg" and images[-1] == "000020.jpg" and len(images) == 20
 
 
 def test_motmetrics_reads_the_boxes_flags_and_classes(exported, truth):
     gt = mm.io.loadtxt(str(exported / "gt" / "gt.txt"), fmt="mot15-2D")
-    assert len(gt) == len(truth)
-    # motmetrics undoes MOT's 1-based pixels and frames: our decoder frame 7, track 0, torso
-    row = gt.loc[(8, int(mot_id(0, BOX_PARTS.index("torso"))))]
+    assert len(gt) == (truth.part == "person").sum() == 36 and set(gt["ClassId"]) == {1}  # MOT17 pedestrian
+    torso = mm.io.loadtxt(str(exported / "gt" / "torso.txt"), fmt="mot15-2D")
+    # motmetrics undoes MOT's 1-based pixels and frames: our decoder frame 7, track 0 (MOT id 1), torso
+    row = torso.loc[(8, 1)]
     t = truth[(truth.frame == 7) & (truth.track_id == 0) & (truth.part == "torso")].iloc[0]
     assert (row.X, row.Y, row.Width, row.Height) == pytest.approx((t.x, t.y, t.w, t.h))
     assert row.Visibility == pytest.approx(0.75)  # occluded 0.25
-    assert row.ClassId == BOX_PARTS.index("torso") + 1
-    assert gt.index.is_unique  # one MOT id per (person, part)
+    assert sorted(torso.index.get_level_values(1).unique()) == [1, 4]  # track_id + 1, as in gt.txt
+    assert gt.index.is_unique and torso.index.is_unique
 
 
 def test_truth_against_itself_with_motmetrics_gives_mota_one(exported, monkeypatch):
@@ -70,7 +72,7 @@ def test_every_thins_frames_and_names_them_by_decoder_index(tmp_path, truth, cli
     assert sorted(p.name for p in (out / "img1").iterdir()) == ["000001.jpg", "000006.jpg", "000011.jpg", "000016.jpg"]
     back = import_dataset(out, "mot")
     assert sorted(back["frame"].unique()) == [0, 5, 10, 15]
-    assert len(back) == 4 + 4 + 4 + 4 + 4 * 3  # person 1 is away at frame 10
+    assert len(back) == 4 + 4 + 4 + 4 + 4 * 3  # person 3 is away at frame 10
 
 
 def test_foreign_mot17_gt_and_mapping(tmp_path):
@@ -139,9 +141,11 @@ def test_datumaro_reads_our_mot_and_we_read_datumaros(exported, truth, tmp_path)
     ds = Dataset.import_from(str(exported), "mot_seq")
     names = [c.name for c in ds.categories()[list(ds.categories())[0]]]
     anns = [a for item in ds for a in item.annotations]
-    assert len(anns) == len(truth) and sorted({names[a.label] for a in anns}) == ["head", "hipleg", "person", "torso"]
+    people = truth[truth.part == "person"]
+    assert len(anns) == len(people) == 36 and {names[a.label] for a in anns} == {"person"}
     ds.export(str(tmp_path / "dm"), "mot_seq_gt")  # a MOT sequence written by another tool
     back = import_dataset(tmp_path / "dm", "mot")
-    assert len(back) == len(truth) and (back["part"].value_counts() == 36).all()
+    assert len(back) == 36 and set(back["part"]) == {"person"}
     # Datumaro keeps MOT's 1-based pixels as they are on both sides, so the boxes come back exactly
-    assert np.allclose(np.sort(back["x"]), np.sort(truth["x"]))
+    assert np.allclose(np.sort(back["x"]), np.sort(people["x"]))
+    assert sorted(back["frame"].unique()) == list(range(20))

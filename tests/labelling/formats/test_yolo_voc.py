@@ -17,7 +17,8 @@ def test_yolo_read_by_datumaro(tmp_path, truth, clip):
     out = export_dataset(truth, "yolo", tmp_path / "y", info, video_path=path)
     data = yaml.safe_load((out / "data.yaml").read_text())
     assert data["names"] == dict(enumerate(BOX_PARTS)) and data["nc"] == 6
-    ds = Dataset.import_from(str(out), "yolo")
+    assert (out / "train" / "classes.txt").read_text().split() == list(BOX_PARTS)
+    ds = Dataset.import_from(str(out))  # detected by itself (as roboflow_yolo, the layout it reads)
     names = [c.name for c in ds.categories()[list(ds.categories())[0]]]
     assert len(ds) == 20 and sum(len(i.annotations) for i in ds) == len(truth)
     item = next(i for i in ds if i.id == "frame_000018")

@@ -1,0 +1,103 @@
+"""Events (activities with a start and an end frame): the events CSV and their evaluation.
+
+The events CSV is what ``partlab track --events`` writes and ``partlab eval --events`` reads:
+``start_frame,end_frame,kind`` first, then ``track_id_a,part_a,track_id_b,part_b`` (the tracks and
+parts involved; ``track_id_b = 0`` for one-hand activities), ``ended_by``, ``object_colour``
+(``#rrggbb``) and ``confidence``. Synthetic scenes write their truth as ``events.csv`` with
+``kind,start_frame,end_frame,...,colour``; both are read here.
+
+Evaluation follows the usual temporal-detection protocol: a predicted event is a true positive
+when it has the kind of a truth event not matched yet and their temporal IoU (frames in common over
+frames in either, ends included) is at least ``iou`` (0.5); matching is greedy by IoU.
+"""
+
+from __future__ import annotations
+
+import math
+from os import PathLike
+from pathlib import Path
+
+import pandas as pd
+
+from partlab.errors import UserError
+
+KINDS: tuple[str, ...] = ("clap", "handshake", "exchange", "pick", "place", "hand_head")
+REQUIRED: tuple[str, ...] = ("start_frame", "end_frame", "kind")
+
+
+class EventsError(UserError):
+    """An events file that cannot be used; the message names the file, line and column."""
+
+
+def read_events(path: str | PathLike) -> pd.DataFrame:
+    """An events CSV (ours or a synthetic scene's truth), checked: frames are whole numbers with
+    ``start <= end``, kinds are known."""
+    p = Path(path)
+    if not p.is_file():
+        raise EventsError(f"{p}: no such events file")
+    try:
+        df = pd.read_csv(p, dtype={"kind": str}, keep_default_na=False)
+    except (UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+        raise EventsError(f"{p}: not an events CSV ({' '.join(str(exc).split())})") from None
+    missing = [c for c in REQUIRED if c not in df.columns]
+    if missing:
+        raise EventsError(f"{p} line 1: missing column(s) {', '.join(missing)}")
+    for i, row in enumerate(df.itertuples(index=False), start=2):
+        for col in ("start_frame", "end_frame"):
+            v = getattr(row, col)
+            try:
+                f = float(v)
+            except (TypeError, ValueError):
+                raise EventsError(f"{p} line {i}, column '{col}': {v!r} is not a frame number") from None
+            if not math.isfinite(f) or f < 0 or not f.is_integer():
+                raise EventsError(f"{p} line {i}, column '{col}': {v!r} is not a frame number")
+        if int(float(row.start_frame)) > int(float(row.end_frame)):
+            raise EventsError(f"{p} line {i}: start_frame {row.start_frame} is after end_frame {row.end_frame}")
+        if row.kind not in KINDS:
+            raise EventsError(f"{p} line {i}, column 'kind': unknown kind {row.kind!r}; expected one of "
+                              f"{', '.join(KINDS)}")
+    df["start_frame"] = df["start_frame"].astype(float).astype("int64")
+    df["end_frame"] = df["end_frame"].astype(float).astype("int64")
+    return df
+
+
+def temporal_iou(a: tuple[int, int], b: tuple[int, int]) -> float:
+    """Frames in common over frames in either (both ends included)."""
+    inter = min(a[1], b[1]) - max(a[0], b[0]) + 1
+    if inter <= 0:
+        return 0.0
+    return inter / (max(a[1], b[1]) - min(a[0], b[0]) + 1)
+
+
+def match_events(truth: pd.DataFrame, predicted: pd.DataFrame, iou: float = 0.5) -> list[tuple[int, int, float]]:
+    """Greedy one-to-one matches ``(truth row, predicted row, iou)`` of the same kind with IoU >= ``iou``."""
+    pairs = []
+    for i, t in enumerate(truth.itertuples(index=False)):
+        for j, p in enumerate(predicted.itertuples(index=False)):
+            if t.kind == p.kind:
+                v = temporal_iou((t.start_frame, t.end_frame), (p.start_frame, p.end_frame))
+                if v >= iou:
+                    pairs.append((v, i, j))
+    used_t, used_p, out = set(), set(), []
+    for v, i, j in sorted(pairs, reverse=True):
+        if i not in used_t and j not in used_p:
+            used_t.add(i)
+            used_p.add(j)
+            out.append((i, j, v))
+    return out
+
+
+def evaluate_events(truth: pd.DataFrame, predicted: pd.DataFrame, iou: float = 0.5) -> pd.DataFrame:
+    """Per kind: truth and predicted counts, true positives, precision and recall at temporal ``iou``;
+    a last row ``all``. Precision of a kind nobody predicted and recall of a kind not in the truth
+    are NaN (undefined, not 0 or 1)."""
+    matches = match_events(truth, predicted, iou)
+    kinds = [k for k in KINDS if k in set(truth["kind"]) | set(predicted["kind"])]
+    rows = []
+    for k in kinds + ["all"]:
+        nt = int((truth["kind"] == k).sum()) if k != "all" else len(truth)
+        npred = int((predicted["kind"] == k).sum()) if k != "all" else len(predicted)
+        tp = sum(1 for i, _, _ in matches if k == "all" or truth.iloc[i]["kind"] == k)
+        rows.append(dict(kind=k, truth=nt, predicted=npred, matched=tp,
+                         precision=tp / npred if npred else float("nan"), recall=tp / nt if nt else float("nan")))
+    return pd.DataFrame(rows).set_index("kind")

@@ -1,0 +1,103 @@
+"""Every tunable number of the carried-object analysis and the activity table, grouped by what it
+tunes (*3D tracking of the hands and head of interacting people from several cameras*, sec. 7).
+Stored by model bundles under the key ``"activities"``.
+
+- ``region``: the circle around each hand whose pixels are analysed (sec. 7.2.1);
+- ``modes``: the hue histogram, its kernel density and the connectivity test (sec. 7.2.2);
+- ``reliability``: eq. 28;
+- ``decision``: the two decision points and the table (sec. 7.3.1, Table 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from partlab.tracking.core.params import FRACTION, POSITIVE, POSITIVE_COUNT, Parameters, group_field, number
+
+
+@dataclass(frozen=True)
+class Region:
+    """The circle around a hand (sec. 7.2.1): its radius in hand radii (half the larger side of
+    the hand's box). 2.6 reaches an object held in the hand without reaching the other hand's."""
+
+    radius: float = number(2.6, POSITIVE)
+    # pixels whose hue is undefined (grey, dark) say nothing about colour: OpenCV S and V (0-255)
+    min_saturation: float = number(60.0)
+    min_value: float = number(40.0)
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Hue modes (sec. 7.2.2). The paper's delta is about 3 degrees and its n 10 pixels."""
+
+    # kernel density over the 180 two-degree hue bins: Gaussian of this std (degrees)
+    kde_sigma: float = number(4.0, POSITIVE)
+    # a mode is kept when a connected region of at least ``min_pixels`` pixels has hue within
+    # +- ``delta`` degrees of it (the paper: n = 10, delta ~ 3)
+    delta: float = number(3.0, POSITIVE)
+    min_pixels: int = number(10, POSITIVE_COUNT)
+    # a mode within this many degrees of the hand's own skin hue is skin, not an object
+    skin_margin: float = number(14.0)
+    # a colour covering at least this share of the region below the person's head (their clothes,
+    # averaged over the run) is not taken for an object
+    clothes_share: float = number(0.04, FRACTION)
+
+
+@dataclass(frozen=True)
+class Reliability:
+    """Eq. 28: rho = (share of the circle's boundary outside the silhouette) + rho_min."""
+
+    rho_min: float = number(0.1, POSITIVE)
+
+
+@dataclass(frozen=True)
+class Decision:
+    """The decision points (sec. 7.3.1) and what makes a colour 'held'."""
+
+    # frames fused (eq. 29) at each decision point
+    window: int = number(8, POSITIVE_COUNT)
+    # frames between the join (or the still moment) and each window: the paper's "a few frames"
+    # for the hands to be apart again
+    gap: int = number(3, POSITIVE_COUNT)
+    # a colour is held at a decision point when its share of the fused distribution is at least this
+    min_mass: float = number(0.12, FRACTION)
+    # ... and not held when it is below this, or below ``absent_ratio`` of its share at the other
+    # decision point (the object already near the hand before it is picked up); between: no decision
+    max_mass_absent: float = number(0.04, FRACTION)
+    absent_ratio: float = number(0.25, FRACTION)
+    # two modes within this many degrees are the same colour (an object seen before and after)
+    same_colour: float = number(10.0, POSITIVE)
+    # the decision points of a two-hand activity are where the hands are this many hand sides apart
+    # (the paper: "separated by a minimum pre-defined distance"), searched up to ``apart_search``
+    # frames before the join and after the separation
+    apart_size: float = number(3.0, POSITIVE)
+    apart_search: int = number(40, POSITIVE_COUNT)
+    # two hands touch when their centres are at most this many hand sides apart: what the state
+    # machine's combined state means (its ``combine_size`` is 1.3), read from the tracks themselves so
+    # that a touch the state machine saw as one hand lost still counts
+    contact_size: float = number(1.5, POSITIVE)
+    # joins of the same two hands this close in time are one activity (three claps, a shake with
+    # a few contacts): frames between one separation and the next join
+    merge_gap: int = number(30, POSITIVE_COUNT)
+    # activities less sure than this are not reported (a hand unseen at a decision point: Table 1
+    # needs both; colour around both hands that keeps a two-hand touch from being read)
+    min_confidence: float = number(0.4, FRACTION)
+    # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
+    # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
+    still_speed: float = number(0.05, POSITIVE)
+    still_frames: int = number(8, POSITIVE_COUNT)
+
+
+@dataclass(frozen=True)
+class ActivityParams(Parameters):
+    """Parameters of carried-object detection and activity recognition, by what they tune."""
+
+    KEY: ClassVar[str] = "activities"
+
+    region: Region = group_field(Region)
+    modes: Modes = group_field(Modes)
+    reliability: Reliability = group_field(Reliability)
+    decision: Decision = group_field(Decision)
+
+    FLAT: ClassVar[dict[str, str | None]] = {}

@@ -1,0 +1,278 @@
+"""Activities of tracked hands (sec. 7 of *3D tracking of the hands and head of interacting people
+from several cameras*): clap, handshake, exchange, pick up, place.
+
+:class:`ActivityTracker` wraps a tracker that reports hands (``limbs``, ``all``, ``limbs3d``): every
+frame it looks at the colour around each reported hand in each view (:mod:`.objects`); when the
+run ends it takes the tracker's join/separation events (sec. 5.2, the climax points of two-hand
+activities) and the hands' still moments (the climax points of picks and places, the paper's
+"ballistic movements"), fuses the colour around each hand over a window before and after the
+climax (eq. 29) and reads the activity from Table 1 (:mod:`.table`). The tracks are unchanged.
+
+Events carry :data:`ACTIVITY_COLUMNS`: start and end frame, kind, the two tracks and parts
+(``track_id_b = 0`` and ``part_b`` empty for one-hand activities), how the join ended, the
+object's colour (``#rrggbb``) and a confidence in [0, 1].
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from typing import Mapping
+
+import numpy as np
+import pandas as pd
+
+from partlab.tracking.activities.objects import (
+    DEGREES_PER_BIN,
+    HUE_BINS,
+    HandColour,
+    body_colours,
+    colour_masses,
+    fuse,
+    hand_colour,
+    hue_to_hex,
+)
+from partlab.tracking.activities.params import ActivityParams
+from partlab.tracking.activities.table import one_hand, two_hands
+from partlab.tracking.frame import FrameSet
+from partlab.tracking.tracks import TrackRecord
+
+HAND_PARTS = ("left_hand", "right_hand")
+ACTIVITY_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b",
+                                     "part_b", "ended_by", "object_colour", "confidence")
+KINDS = ("clap", "handshake", "exchange", "pick", "place", "hand_head")
+
+Key = tuple[int, str]  # (track_id, part)
+
+
+class ActivityTracker:
+    """A tracker plus activity recognition over the hands it reports."""
+
+    def __init__(self, inner, params: ActivityParams):
+        self.inner = inner
+        self.activity_params = params
+        self.params = getattr(inner, "params", None)
+        self._colours: dict[Key, dict[int, list[HandColour]]] = defaultdict(lambda: defaultdict(list))
+        self._centres: dict[Key, dict[int, tuple[float, float, float]]] = defaultdict(dict)
+        self._clothes: dict[int, np.ndarray] = defaultdict(lambda: np.zeros(HUE_BINS))
+        self._clothes_n: dict[int, int] = defaultdict(int)
+        self.events: pd.DataFrame | None = None
+
+    def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
+        rows = self.inner.step(frames, foreground)
+        for r in rows:
+            if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0:
+                continue
+            stream = r.camera or next(iter(frames.views))
+            view = frames.views.get(stream)
+            if view is None or view.color is None:
+                continue
+            if r.part == "head":
+                self._clothes[r.track_id] += body_colours(view.color, foreground.get(stream), r.box,
+                                                          self.activity_params)
+                self._clothes_n[r.track_id] += 1
+                continue
+            key = (r.track_id, r.part)
+            self._colours[key][r.frame].append(
+                hand_colour(view.color, foreground.get(stream), r.box, self.activity_params))
+            if stream == next(iter(frames.views)):  # still moments are measured in the first view
+                self._centres[key][r.frame] = (r.box.x + r.box.w / 2, r.box.y + r.box.h / 2, max(r.box.w, r.box.h))
+        return rows
+
+    def table(self, records: list[TrackRecord]) -> pd.DataFrame:
+        out = self.inner.table(records)
+        joins = getattr(self.inner, "events", None)
+        found = contacts(out, self.activity_params)
+        joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
+        clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
+                   for t, n in self._clothes_n.items()}
+        self.events = recognise(joins, self._colours, self._centres, self.activity_params, clothes)
+        return out
+
+
+def clothes_hues(shares: np.ndarray, params: ActivityParams) -> np.ndarray:
+    """Hue bins a person's clothes cover (their mean share below the head is at least ``clothes_share``),
+    widened by ``same_colour`` degrees."""
+    reach = int(round(params.decision.same_colour / DEGREES_PER_BIN))
+    smooth = np.convolve(np.concatenate([shares[-reach:], shares, shares[:reach]]), np.ones(2 * reach + 1), "valid")
+    return np.flatnonzero(smooth >= params.modes.clothes_share)
+
+
+def _without(held: dict[int, float] | None, hues: np.ndarray) -> dict[int, float] | None:
+    if held is None or not len(hues):
+        return held
+    return {h: m for h, m in held.items() if h not in set(hues.tolist())}
+
+
+def _held(colours: dict[int, list[HandColour]], lo: int, hi: int, params: ActivityParams) -> dict[int, float] | None:
+    """The colours a hand holds over frames ``lo..hi`` (eq. 29), or None when it was not seen there."""
+    obs = [o for f in range(lo, hi + 1) for o in colours.get(f, ())]
+    if len(obs) < max(2, params.decision.window // 3):
+        return None
+    return colour_masses(fuse(obs), params)
+
+
+def _windows(start: int, end: int, params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
+    d = params.decision
+    return (start - d.gap - d.window, start - d.gap), (end + d.gap, end + d.gap + d.window)
+
+
+def still_moments(centres: dict[int, tuple[float, float, float]], params: ActivityParams) -> list[tuple[int, int]]:
+    """Stretches of at least ``still_frames`` frames in which the hand moves less than
+    ``still_speed`` hand sizes per frame (centres smoothed over three frames)."""
+    if len(centres) < 3:
+        return []
+    frames = np.array(sorted(centres))
+    xyz = np.array([centres[f] for f in frames], dtype=float)
+    k = np.ones(3) / 3
+    sx = np.convolve(np.pad(xyz[:, 0], 1, mode="edge"), k, "valid")
+    sy = np.convolve(np.pad(xyz[:, 1], 1, mode="edge"), k, "valid")
+    gaps = np.diff(frames)
+    step = np.hypot(np.diff(sx), np.diff(sy)) / np.maximum(gaps, 1) / np.maximum(xyz[1:, 2], 1.0)
+    ok = np.concatenate([[False], (step < params.decision.still_speed) & (gaps == 1), [False]]).astype(np.int8)
+    edges = np.diff(ok)
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # a run of k steps spans k + 1 frames
+    runs: list[list[int]] = []
+    for a, b in zip(starts, stops):  # stops a jittering hand makes are merged, as joins are
+        if runs and frames[a] - runs[-1][1] <= params.decision.still_frames // 2:
+            runs[-1][1] = int(frames[b])
+        else:
+            runs.append([int(frames[a]), int(frames[b])])
+    return [(a, b) for a, b in runs if b - a + 1 >= params.decision.still_frames]
+
+
+def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
+    """Frames where two hands touch (centres within ``contact_size`` hand sides, in the first view),
+    as join rows: one per run of touching frames of a pair."""
+    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
+    hands = tracks[tracks["part"].isin(HAND_PARTS)]
+    if "camera" in hands.columns and (hands["camera"] != "").any():
+        hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
+    if hands.empty:
+        return pd.DataFrame(columns=cols)
+    cx = (hands["x"] + hands["w"] / 2).to_numpy()
+    cy = (hands["y"] + hands["h"] / 2).to_numpy()
+    side = np.maximum(hands["w"], hands["h"]).to_numpy()
+    frame, tid, part = hands["frame"].to_numpy(), hands["track_id"].to_numpy(), hands["part"].to_numpy()
+    touching: dict[tuple, list[int]] = defaultdict(list)
+    order = np.argsort(frame, kind="stable")
+    bounds = np.flatnonzero(np.diff(frame[order])) + 1
+    for idx in np.split(order, bounds):
+        for i in range(len(idx)):
+            for j in range(i + 1, len(idx)):
+                p, q = idx[i], idx[j]
+                if np.hypot(cx[p] - cx[q], cy[p] - cy[q]) <= params.decision.contact_size * 0.5 * (side[p] + side[q]):
+                    key = tuple(sorted(((int(tid[p]), str(part[p])), (int(tid[q]), str(part[q])))))
+                    touching[key].append(int(frame[p]))
+    rows = []
+    for (a, b), fs in touching.items():
+        fs = sorted(set(fs))
+        start = prev = fs[0]
+        for f in fs[1:] + [None]:
+            if f is not None and f - prev <= 2:
+                prev = f
+                continue
+            rows.append((start, prev, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact"))
+            if f is not None:
+                start = prev = f
+    return pd.DataFrame(rows, columns=cols)
+
+
+def merged_joins(joins: pd.DataFrame | None, params: ActivityParams) -> list[dict]:
+    """The joins of each pair of targets, those less than ``merge_gap`` frames apart merged into one
+    (claps come in bursts, a handshake touches a few times): ``start_frame`` of the first,
+    ``end_frame`` of the last."""
+    if joins is None or not len(joins):
+        return []
+    groups: dict[tuple, list] = defaultdict(list)
+    for j in joins.itertuples(index=False):
+        a, b = (int(j.track_id_a), str(j.part_a)), (int(j.track_id_b), str(j.part_b))
+        groups[tuple(sorted((a, b)))].append((int(j.start_frame), int(j.end_frame), str(j.kind), str(j.ended_by)))
+    out = []
+    for (a, b), items in groups.items():
+        items.sort()
+        cur = None
+        for start, end, kind, ended in items:
+            if cur is not None and start - cur["end_frame"] <= params.decision.merge_gap:
+                cur.update(end_frame=max(cur["end_frame"], end), ended_by=ended)
+                continue
+            cur = dict(start_frame=start, end_frame=end, kind=kind, a=a, b=b, ended_by=ended)
+            out.append(cur)
+    return out
+
+
+def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, end: int,
+                  params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
+    """The two decision windows of a join: ending at the last frame before ``start`` and starting at
+    the first frame after ``end`` where the hands are ``apart_size`` hand sides apart (the gap
+    windows of :func:`_windows` where they never are). The activity lasts from the first to the
+    second decision point."""
+    d = params.decision
+
+    def apart(f: int) -> bool:
+        if f not in ca or f not in cb:
+            return False
+        (xa, ya, sa), (xb, yb, sb) = ca[f], cb[f]
+        return np.hypot(xa - xb, ya - yb) >= d.apart_size * 0.5 * (sa + sb)
+
+    (b0, b1), (a0, a1) = _windows(start, end, params)
+    before = next((f for f in range(start - 1, start - d.apart_search, -1) if apart(f)), None)
+    after = next((f for f in range(end + 1, end + d.apart_search) if apart(f)), None)
+    if before is not None:
+        b0, b1 = before - d.window, before
+    if after is not None:
+        a0, a1 = after, after + d.window
+    return (b0, b1), (a0, a1)
+
+
+def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityParams,
+               clothes: Mapping[int, np.ndarray]) -> tuple[list[dict], dict[Key, list]]:
+    rows, busy = [], defaultdict(list)
+    for j in merged_joins(joins, params):
+        a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
+        busy[a].append((start, end))
+        busy[b].append((start, end))
+        base = dict(start_frame=start, end_frame=end, kind=j["kind"], track_id_a=a[0], part_a=a[1],
+                    track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
+        if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
+            (b0, b1), (a0, a1) = apart_windows(centres.get(a, {}), centres.get(b, {}), start, end, params)
+            base.update(start_frame=min(start, b1 + 1), end_frame=max(end, a0 - 1))
+            worn = np.union1d(clothes.get(a[0], np.zeros(0, int)), clothes.get(b[0], np.zeros(0, int)))
+            seen = [_without(_held(colours.get(k, {}), lo, hi, params), worn)
+                    for k in (a, b) for lo, hi in ((b0, b1), (a0, a1))]
+            if all(s is not None for s in seen):
+                ab, aa, bb, ba = seen
+                v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
+                base.update(kind=v.kind, confidence=round(v.margin, 3),
+                            object_colour="" if v.colour is None else hue_to_hex(v.colour))
+            else:  # a hand unseen at a decision point: the state machine's guess, less sure
+                base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
+        rows.append(base)
+    return rows, busy
+
+
+def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, list[HandColour]]],
+              centres: Mapping[Key, Mapping[int, tuple[float, float, float]]], params: ActivityParams,
+              clothes: Mapping[int, np.ndarray] | None = None) -> pd.DataFrame:
+    """The activities table (:data:`ACTIVITY_COLUMNS`) from the join events and what each hand held;
+    ``clothes``: per track, the hue bins the person wears (never taken for objects)."""
+    clothes = clothes or {}
+    rows, busy = _join_rows(joins, colours, centres, params, clothes)
+    d = params.decision
+    for key, cs in centres.items():
+        for s0, s1 in still_moments(cs, params):
+            if any(s0 <= e + d.gap + d.window and s1 >= b - d.gap - d.window for b, e in busy.get(key, ())):
+                continue  # part of a two-hand activity
+            (b0, b1), (a0, a1) = _windows(s0, s1, params)
+            worn = clothes.get(key[0], np.zeros(0, int))
+            before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
+                             for lo, hi in ((b0, b1), (a0, a1)))
+            if before is None or after is None:
+                continue
+            v = one_hand(before, after, params)
+            if v is not None:
+                rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
+                                 track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
+                                 confidence=round(v.margin, 3)))
+    out = pd.DataFrame(rows, columns=list(ACTIVITY_COLUMNS))
+    out = out[(out["confidence"] >= params.decision.min_confidence) | (out["kind"] == "hand_head")]
+    return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)

@@ -1,0 +1,72 @@
+"""The tables partlab 0.2.0 created (``Base.metadata.create_all`` in store.py at commit 2c99e66),
+frozen here as plain SQLAlchemy Core so the migration tests do not depend on the code they test."""
+
+from sqlalchemy import (Boolean, Column, DateTime, Float, ForeignKey, Integer, MetaData, String, Table, Text,
+                        UniqueConstraint)
+
+LEGACY = MetaData()
+
+Table("projects", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("name", String(200), unique=True, nullable=False),
+      Column("default_bundle_id", Integer, nullable=True),
+      Column("created", DateTime(timezone=True), nullable=False))
+Table("clips", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("project_id", ForeignKey("projects.id"), index=True, nullable=False),
+      Column("name", String(300), nullable=False),
+      Column("path", Text, nullable=False),
+      Column("sha256", String(64), index=True, nullable=False),
+      Column("fps", Float, nullable=False),
+      Column("width", Integer, nullable=False),
+      Column("height", Integer, nullable=False),
+      Column("frame_count", Integer, nullable=False),
+      Column("exported", Boolean, nullable=False),
+      Column("created", DateTime(timezone=True), nullable=False),
+      UniqueConstraint("project_id", "sha256"))
+Table("tracker_runs", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("clip_id", ForeignKey("clips.id"), index=True, nullable=False),
+      Column("tracker", String(20), nullable=False),
+      Column("bundle", Text, nullable=False),
+      Column("seed", Integer, nullable=False),
+      Column("start_frame", Integer, nullable=False),
+      Column("created", DateTime(timezone=True), nullable=False))
+Table("tracker_boxes", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("clip_id", ForeignKey("clips.id"), index=True, nullable=False),
+      Column("run_id", ForeignKey("tracker_runs.id"), nullable=False),
+      Column("frame", Integer, index=True, nullable=False),
+      Column("track_id", Integer, nullable=False),
+      Column("part", String(20), nullable=False),
+      *(Column(c, Float, nullable=False) for c in "xywh"),
+      Column("score", Float, nullable=True),
+      Column("failure", Boolean, nullable=False),
+      Column("occluded", Float, nullable=False),
+      Column("state", String(40), nullable=False))
+Table("edits", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("clip_id", ForeignKey("clips.id"), index=True, nullable=False),
+      Column("frame", Integer, index=True, nullable=False),
+      Column("track_id", Integer, nullable=False),
+      Column("part", String(20), nullable=False),
+      Column("revision", Integer, nullable=False),
+      *(Column(c, Float, nullable=False) for c in "xywh"),
+      Column("failure", Boolean, nullable=False),
+      Column("occluded", Float, nullable=False),
+      Column("deleted", Boolean, nullable=False),
+      Column("author", String(100), nullable=False),
+      Column("created", DateTime(timezone=True), nullable=False),
+      UniqueConstraint("clip_id", "frame", "track_id", "part", "revision"))
+Table("occluders", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("clip_id", ForeignKey("clips.id"), index=True, nullable=False),
+      *(Column(c, Float, nullable=False) for c in "xywh"))
+Table("bundles", LEGACY,
+      Column("id", Integer, primary_key=True),
+      Column("project_id", ForeignKey("projects.id"), index=True, nullable=False),
+      Column("name", String(200), nullable=False),
+      Column("path", Text, nullable=False),
+      Column("summary", Text, nullable=False),
+      Column("created", DateTime(timezone=True), nullable=False),
+      UniqueConstraint("project_id", "name"))

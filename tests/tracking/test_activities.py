@@ -1,0 +1,117 @@
+"""Carried objects and activities: the colour around a hand, Table 1 read per colour, and the
+activities found on rendered scenes."""
+
+import cv2
+import numpy as np
+import pandas as pd
+import pytest
+
+from partlab.labelling.events import evaluate_events, temporal_iou
+from partlab.labelling.synth import make_scene
+from partlab.tracking.activities.objects import HUE_BINS, colour_masses, fuse, hand_colour
+from partlab.tracking.activities.params import ActivityParams
+from partlab.tracking.activities.recognise import contacts, merged_joins, still_moments
+from partlab.tracking.activities.table import one_hand, two_hands
+from partlab.tracking.core.background import BackgroundModel
+from partlab.tracking.core.box import Box
+from partlab.tracking.frame import FrameSet
+from partlab.tracking.protocol import TrackContext
+from partlab.tracking.run import build_tracker, model_params, run_frames
+
+P = ActivityParams()
+SKIN = (120, 150, 200)  # BGR of a light skin tone (inside the default skin rule)
+GREEN = (40, 180, 40)
+
+
+def _frame(with_object: bool, sleeve=(200, 200, 200)):
+    img = np.full((80, 80, 3), 90, np.uint8)
+    cv2.rectangle(img, (0, 30), (34, 42), sleeve, -1)  # the forearm's sleeve, grey: no hue
+    cv2.circle(img, (40, 36), 6, SKIN, -1)  # the hand
+    if with_object:
+        cv2.ellipse(img, (40, 45), (8, 6), 0, 0, 360, GREEN, -1)
+    return img
+
+
+def test_an_object_in_the_hand_is_its_hue_and_skin_is_not_an_object():
+    hand = Box(34, 30, 12, 12)
+    held = hand_colour(_frame(True), None, hand, P)
+    empty = hand_colour(_frame(False), None, hand, P)
+    green_bin = int(cv2.cvtColor(np.uint8([[GREEN]]), cv2.COLOR_BGR2HSV)[0, 0, 0])
+    masses = colour_masses(fuse([held] * 3), P)
+    assert len(masses) == 1 and abs(next(iter(masses)) - green_bin) <= 2
+    assert next(iter(masses.values())) > 0.15
+    assert colour_masses(fuse([empty] * 3), P) == {}  # grey sleeve and skin only: nothing held
+
+
+def test_the_connectivity_test_drops_scattered_pixels():
+    img = _frame(False)
+    rng = np.random.default_rng(0)
+    ys, xs = rng.integers(22, 50, 40), rng.integers(26, 54, 40)
+    img[ys, xs] = GREEN  # 40 isolated green pixels around the hand: noise, not an object
+    assert colour_masses(fuse([hand_colour(img, None, Box(34, 30, 12, 12), P)]), P) == {}
+
+
+def test_reliability_is_higher_for_a_hand_held_away_from_the_body():
+    img = _frame(True)
+    body = np.zeros((80, 80), np.uint8)
+    body[:, :] = 255  # the hand inside the silhouette
+    inside = hand_colour(img, body, Box(34, 30, 12, 12), P)
+    body[:, 50:] = 0
+    body[:26, :] = 0
+    body[48:, :] = 0
+    out = hand_colour(img, body, Box(34, 30, 12, 12), P)
+    assert out.rho > inside.rho + 0.3 and inside.rho == pytest.approx(P.reliability.rho_min)
+
+
+def test_table_one_read_per_colour():
+    green, blue, shirt = 40, 110, 150
+    assert two_hands({green: 0.3}, {}, {}, {green: 0.3}, False, P).kind == "exchange"
+    assert two_hands({}, {green: 0.3}, {green: 0.25}, {}, True, P).kind == "exchange"
+    # a colour both hands show before and after (a sleeve) decides nothing: still a handshake
+    v = two_hands({shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, False, P)
+    assert v.kind == "handshake" and v.colour is None
+    assert two_hands({}, {}, {}, {}, True, P).kind == "clap"
+    assert one_hand({}, {blue: 0.4}, P).kind == "pick"
+    assert one_hand({blue: 0.4, shirt: 0.2}, {shirt: 0.2}, P).kind == "place"
+    assert one_hand({shirt: 0.2}, {shirt: 0.2}, P) is None
+    assert one_hand({blue: 0.02}, {blue: 0.4}, P).kind == "pick"  # already near the hand: a small share
+
+
+def test_still_moments_and_contacts_from_tracks():
+    centres = {f: (100.0 + (0 if 10 <= f <= 30 else 4 * (f - 10)), 50.0, 10.0) for f in range(10, 60)}
+    (s0, s1), = still_moments(centres, P)
+    assert 10 <= s0 <= 13 and 28 <= s1 <= 31
+    rows = [(f, 1, "left_hand", 100 + (0 if 20 <= f <= 25 else 30), 50) for f in range(40)]
+    rows += [(f, 1, "right_hand", 110, 50) for f in range(40)]
+    tracks = pd.DataFrame([dict(frame=f, track_id=t, part=p, x=x, y=y, w=10, h=10, camera="")
+                           for f, t, p, x, y in rows])
+    found = contacts(tracks, P)
+    assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[20, 25, "clap"]]
+    twice = pd.concat([found, found.assign(start_frame=40, end_frame=45)])
+    assert [(j["start_frame"], j["end_frame"]) for j in merged_joins(twice, P)] == [(20, 45)]
+
+
+def test_temporal_matching():
+    assert temporal_iou((10, 19), (15, 24)) == pytest.approx(5 / 15)
+    truth = pd.DataFrame(dict(kind=["pick", "place"], start_frame=[10, 50], end_frame=[20, 60]))
+    found = pd.DataFrame(dict(kind=["pick", "pick"], start_frame=[12, 50], end_frame=[21, 60]))
+    table = evaluate_events(truth, found)
+    assert table.loc["pick", "precision"] == 0.5 and table.loc["place", "recall"] == 0.0
+    assert table.loc["all", "matched"] == 1
+
+
+def _activities(name: str, seed: int) -> tuple[pd.DataFrame, pd.DataFrame]:
+    scene = make_scene(name, seed=seed, n_frames=150)
+    tracker = build_tracker("limbs", seed=seed, context=TrackContext(init=scene.init, fps=scene.fps))
+    body = model_params(None, "body")
+    run_frames(tracker, (FrameSet.single(i, f) for i, f in enumerate(scene.frames)), lambda s: BackgroundModel(body))
+    return scene.events, tracker.events
+
+
+def test_an_object_passed_between_people_is_an_exchange_and_a_bare_handshake_is_not():
+    truth, found = _activities("exchange", 1)
+    table = evaluate_events(truth, found)
+    assert table.loc["exchange", "matched"] == 1
+    truth, found = _activities("handshake", 1)
+    assert "exchange" not in set(found["kind"])
+    assert evaluate_events(truth, found).loc["handshake", "matched"] == 1
