@@ -223,6 +223,7 @@ class BodyDetection:
     lost_frames: int = number(10, POSITIVE_COUNT)
     support_min: float = number(0.1, FRACTION)
     leave_fraction: float = number(0.5, FRACTION)
+    # (Automatically started tracks end at once; the rest of this applies to --init tracks.)
     # Tracks started from --init are judged by the same foreground support once the background
     # model has learnt the scene (after ``background.warmup`` frames). A person without support
     # for ``lost_frames`` frames is *lost*: all parts coast on the person's recent velocity (an
