@@ -219,7 +219,9 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
         inside = person[(person["x"] >= 2) & (person["y"] >= 2) & (person["x"] + person["w"] <= width - 2)
                         & (person["y"] + person["h"] <= height - 2)]
         start = inside.groupby("track_id")["frame"].min()
-        first = truth["track_id"].map(start).fillna(first)
+        # never wholly in view: start at the frame it shows most of itself
+        largest = person.assign(a=person["w"] * person["h"]).sort_values("a").groupby("track_id")["frame"].last()
+        first = truth["track_id"].map(start).fillna(truth["track_id"].map(largest)).fillna(first)
     init = truth[truth["frame"] == first].reset_index(drop=True)
     events = None
     if script.events:
