@@ -33,7 +33,7 @@ import math
 import re
 import zipfile
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from importlib import resources
 from os import PathLike
 from pathlib import Path
@@ -139,7 +139,7 @@ def save_bundle(bundle: Bundle, path: str | PathLike) -> Path:
     manifest = _json_safe({
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
-        "created": bundle.created or datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created": bundle.created or datetime.now(UTC).isoformat(timespec="seconds"),
         "params": {key: p.to_dict() for key, p in bundle.params.items()},
         "detector": detector,
         "summary": bundle.summary,

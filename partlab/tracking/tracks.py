@@ -140,18 +140,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     Every malformed cell is reported as ``FILE line L, column 'C': problem`` (lines
     counted from 1, the header being line 1), so a user can open the file there.
     """
-    if isinstance(source, (str, PathLike)):
-        path = Path(source)
-        label = name or str(path)
-        try:
-            text = path.read_text(encoding="utf-8-sig")
-        except FileNotFoundError:
-            raise TracksCSVError(f"{label}: no such file") from None
-        except UnicodeDecodeError:
-            raise TracksCSVError(f"{label}: not a text CSV file (not UTF-8)") from None
-    else:
-        label = name or "tracks CSV"
-        text = source.read()
+    label, text = _read_text(source, name)
     reader = _rows(csv.reader(io.StringIO(text, newline="")), label)
     try:
         header = next(reader)
@@ -159,13 +148,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
         raise TracksCSVError(f"{label}: the file is empty; expected a header row "
                              f"starting with {','.join(REQUIRED_COLUMNS)}") from None
     header = [h.strip() for h in header]
-    if tuple(header[: len(REQUIRED_COLUMNS)]) != REQUIRED_COLUMNS:
-        missing = [c for c in REQUIRED_COLUMNS if c not in header]
-        if missing:
-            raise TracksCSVError(f"{label} line 1: missing column(s) {', '.join(repr(m) for m in missing)}; "
-                                 f"the header must start with {','.join(REQUIRED_COLUMNS)}")
-        raise TracksCSVError(f"{label} line 1: the header must start with {','.join(REQUIRED_COLUMNS)} "
-                             f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
+    _check_header(header, label)
     index = {c: i for i, c in enumerate(header) if c in COLUMNS}
     cols: dict[str, list] = {c: [] for c in index}
     coord_limit, row_limit = max_coord(), max_csv_rows()
@@ -180,53 +163,92 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                                  f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
         for col, i in index.items():
             cell = row[i].strip() if i < len(row) else ""
-            where = f"{label} line {lineno}, column '{col}'"
-            if col in ("frame", "track_id"):
-                try:
-                    value = int(cell)
-                except ValueError:
-                    try:
-                        f = float(cell)
-                    except ValueError:
-                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
-                    if not f.is_integer():
-                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
-                    value = int(f)
-                if value < 0:
-                    raise TracksCSVError(f"{where}: {value} is negative")
-                if value > MAX_ID:
-                    raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
-            elif col == "part":
-                if cell not in PART_NAMES:
-                    raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
-                value = cell
-            elif col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
-                if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
-                    value = DEFAULTS[col]
-                else:
-                    try:
-                        value = float(cell)
-                    except ValueError:
-                        raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
-                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and not math.isfinite(value):
-                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
-                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and abs(value) > coord_limit:
-                        raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
-                                             "(set PARTLAB_MAX_COORD to change it)")
-                    if col == "score" and math.isinf(value):
-                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
-                    if col == "occluded" and not 0.0 <= value <= 1.0:
-                        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
-                    if col in ("w", "h") and value < 0:
-                        raise TracksCSVError(f"{where}: negative size {value:g}")
-            elif col == "failure":
-                value = _parse_bool(cell)
-                if value is None:
-                    raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
-            else:  # state, source, camera
-                value = cell if cell else DEFAULTS[col]
-            cols[col].append(value)
+            cols[col].append(_parse_cell(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
     return normalise_tracks(pd.DataFrame(cols))
+
+
+def _read_text(source: str | PathLike | io.TextIOBase, name: str | None) -> tuple[str, str]:
+    """``(label for messages, the CSV's text)`` of a path or an open text stream."""
+    if not isinstance(source, (str, PathLike)):
+        return name or "tracks CSV", source.read()
+    path = Path(source)
+    label = name or str(path)
+    try:
+        return label, path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise TracksCSVError(f"{label}: no such file") from None
+    except UnicodeDecodeError:
+        raise TracksCSVError(f"{label}: not a text CSV file (not UTF-8)") from None
+
+
+def _check_header(header: list[str], label: str) -> None:
+    if tuple(header[: len(REQUIRED_COLUMNS)]) == REQUIRED_COLUMNS:
+        return
+    missing = [c for c in REQUIRED_COLUMNS if c not in header]
+    if missing:
+        raise TracksCSVError(f"{label} line 1: missing column(s) {', '.join(repr(m) for m in missing)}; "
+                             f"the header must start with {','.join(REQUIRED_COLUMNS)}")
+    raise TracksCSVError(f"{label} line 1: the header must start with {','.join(REQUIRED_COLUMNS)} "
+                         f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
+
+
+def _parse_int(cell: str, where: str) -> int:
+    """A non-negative id or frame (``3`` or ``3.0``) within :data:`MAX_ID`."""
+    try:
+        value = int(cell)
+    except ValueError:
+        try:
+            f = float(cell)
+        except ValueError:
+            raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        if not f.is_integer():
+            raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        value = int(f)
+    if value < 0:
+        raise TracksCSVError(f"{where}: {value} is negative")
+    if value > MAX_ID:
+        raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
+    return value
+
+
+def _parse_number(col: str, cell: str, where: str, coord_limit: float) -> float:
+    if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
+        return DEFAULTS[col]
+    try:
+        value = float(cell)
+    except ValueError:
+        raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
+    if col in ("x", "y", "w", "h", "X", "Y", "Z"):
+        if not math.isfinite(value):
+            raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+        if abs(value) > coord_limit:
+            raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
+                                 "(set PARTLAB_MAX_COORD to change it)")
+    if col == "score" and math.isinf(value):
+        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+    if col == "occluded" and not 0.0 <= value <= 1.0:
+        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
+    if col in ("w", "h") and value < 0:
+        raise TracksCSVError(f"{where}: negative size {value:g}")
+    return value
+
+
+def _parse_cell(col: str, cell: str, where: str, coord_limit: float):
+    """One cell of column ``col``, checked; ``where`` names it in the error."""
+    if col in ("frame", "track_id"):
+        return _parse_int(cell, where)
+    if col == "part":
+        if cell not in PART_NAMES:
+            raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
+        return cell
+    if col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
+        return _parse_number(col, cell, where, coord_limit)
+    if col == "failure":
+        value = _parse_bool(cell)
+        if value is None:
+            raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
+        return value
+    return cell if cell else DEFAULTS[col]  # state, source, camera
 
 
 def normalise_tracks(df: pd.DataFrame) -> pd.DataFrame:
