@@ -86,6 +86,9 @@ class SingleView:
         return self.tracker.step(frames.index, view.color, foreground.get(view.stream))
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
+        finish = getattr(self.tracker, "finish", None)  # e.g. rows of lost tracks withdrawn
+        if finish is not None:
+            records = finish(records)
         return records_to_frame(records) if records else empty_tracks()
 
 
