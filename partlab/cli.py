@@ -48,14 +48,22 @@ def _module(name: str):
     return importlib.import_module(f"partlab.commands.{name.replace('-', '_')}")
 
 
+class _Version(argparse.Action):
+    """``--version``, reading the version only when asked."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        import partlab
+
+        print(f"partlab {partlab.__version__}")
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="partlab",
         description="Label human body parts in video: track, correct, learn, export.",
     )
-    from partlab import __version__
-
-    parser.add_argument("--version", action="version", version=f"partlab {__version__}")
+    parser.add_argument("--version", action=_Version, nargs=0, help="print partlab's version and exit")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback of an unexpected error instead of one line")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from partlab.cli import CommandError, main
-from partlab.commands.calibrate import calibrate_clips
 from partlab.labelling.calibration import read_calibration
+from partlab.labelling.chessboard import calibrate_clips
 from partlab.labelling.synth.multiview import look_at, render_chessboard
 from partlab.labelling.video import write_video
 
