@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from partlab.cli import CommandError, main
+from partlab.cli import main
+from partlab.errors import UserError
 from partlab.labelling.calibration import read_calibration
 from partlab.labelling.chessboard import calibrate_clips
 from partlab.labelling.synth.multiview import look_at, render_chessboard
@@ -27,7 +28,7 @@ def test_chessboards_recover_the_cameras(tmp_path):
 def test_no_board_is_refused_with_the_clip_named(tmp_path, capsys):
     clip = tmp_path / "camX.avi"
     write_video(clip, [np.full((120, 160, 3), 128, np.uint8)] * 4, 25)
-    with pytest.raises(CommandError, match=r"camX.avi: chessboard 9x6 .* found in 0 frame"):
+    with pytest.raises(UserError, match=r"camX.avi: chessboard 9x6 .* found in 0 frame"):
         calibrate_clips([clip], (9, 6), 100.0)
     assert main(["calibrate", str(clip), "-o", str(tmp_path / "c.json")]) == 2
     assert "found in 0 frame(s)" in capsys.readouterr().err
