@@ -134,6 +134,129 @@ def _rows(reader, label: str):
             raise TracksCSVError(f"{label} line {reader.line_num}: not a CSV row ({exc})") from None
 
 
+INT_COLUMNS = ("frame", "track_id")
+FLOAT_COLUMNS = ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z")
+#: columns whose values must be finite and within ``PARTLAB_MAX_COORD``
+COORD_COLUMNS = ("x", "y", "w", "h", "X", "Y", "Z")
+
+
+def check_value(col: str, value, where: str, coord_limit: float | None = None, text_numbers: bool = True):
+    """The one rule set for a cell of a tracks table, shared by the CSV reader, every importer
+    and the store: ``value`` (text as in the CSV, or a number/bool from a JSON or XML file) as the
+    column's type, or a :class:`TracksCSVError` naming ``where`` and the value.
+
+    Frames and ids are whole numbers in 0..2**31-1; ``x, y, w, h, X, Y, Z`` finite and within
+    ``PARTLAB_MAX_COORD`` (``w, h`` not negative); ``score`` not infinite; ``occluded`` in [0, 1];
+    ``failure`` a boolean (``"false"`` is False); booleans, lists and objects are not numbers.
+    With ``text_numbers=False`` (JSON files, whose numbers are numbers) text is refused for the
+    frame and the box.
+    """
+    if coord_limit is None:
+        coord_limit = max_coord()
+    if isinstance(value, str):
+        cell = value.strip()
+        if not text_numbers and col in ("frame", "x", "y", "w", "h"):
+            raise TracksCSVError(f"{where}: {_short(value)} is text, not a number")
+    elif value is None:
+        cell = ""
+    elif isinstance(value, bool):
+        if col == "failure":
+            return value
+        if col in INT_COLUMNS or col in FLOAT_COLUMNS:
+            raise TracksCSVError(f"{where}: {value!r} is a boolean, not a number")
+        cell = str(value).lower()
+    elif isinstance(value, (int, float)) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0):
+        cell = None  # a number already
+    else:
+        raise TracksCSVError(f"{where}: {_short(value)} is not a single value")
+    if col in INT_COLUMNS:
+        if cell is not None:
+            try:
+                number = int(cell)
+            except ValueError:
+                try:
+                    number = float(cell)
+                except ValueError:
+                    raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        else:
+            number = value
+        if isinstance(number, float) or not isinstance(number, int):
+            number = float(number)
+            if not number.is_integer():
+                raise TracksCSVError(f"{where}: {_short(value)} is not an integer")
+            if abs(number) > 2.0 ** 63:
+                raise TracksCSVError(f"{where}: {_short(value)} is larger than the limit of {MAX_ID}")
+            number = int(number)
+        if number < 0:
+            raise TracksCSVError(f"{where}: {number} is negative")
+        if number > MAX_ID:
+            raise TracksCSVError(f"{where}: {number} is larger than the limit of {MAX_ID}")
+        return number
+    if col == "part":
+        part = cell if cell is not None else str(value)
+        if part not in PART_NAMES:
+            raise TracksCSVError(f"{where}: unknown part {part!r}; expected one of {', '.join(PART_NAMES)}")
+        return part
+    if col in FLOAT_COLUMNS:
+        if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
+            return DEFAULTS[col]
+        if cell is not None:
+            try:
+                number = float(cell)
+            except ValueError:
+                raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
+        else:
+            try:
+                number = float(value)
+            except OverflowError:
+                raise TracksCSVError(f"{where}: {_short(value)} is not a finite number") from None
+        shown = cell if cell is not None else _short(value)
+        if col in COORD_COLUMNS:
+            if math.isnan(number) and col in ("X", "Y", "Z"):
+                return number  # an unknown 3D position
+            if not math.isfinite(number):
+                raise TracksCSVError(f"{where}: {shown!r} is not a finite number")
+            if abs(number) > coord_limit:
+                raise TracksCSVError(f"{where}: {shown!r} is beyond the limit of {coord_limit:g} "
+                                     "(set PARTLAB_MAX_COORD to change it)")
+        if col == "score" and math.isinf(number):
+            raise TracksCSVError(f"{where}: {shown!r} is not a finite number")
+        if col == "occluded" and not 0.0 <= number <= 1.0:
+            raise TracksCSVError(f"{where}: {shown!r} is not a fraction between 0 and 1")
+        if col in ("w", "h") and number < 0:
+            raise TracksCSVError(f"{where}: negative size {number:g}")
+        return number
+    if col == "failure":
+        if cell is None:
+            if value in (0, 1):
+                return bool(value)
+            raise TracksCSVError(f"{where}: {_short(value)} is not a boolean (0/1/true/false)")
+        flag = _parse_bool(cell)
+        if flag is None:
+            raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
+        return flag
+    # state, source, camera
+    text = cell if cell is not None else str(value)
+    return text if text else DEFAULTS[col]
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def check_rows(rows: list[dict], label: str, text_numbers: bool = True) -> list[dict]:
+    """``rows`` (dicts of tracks columns, an optional ``_where`` naming each one's place in its
+    file) checked and converted by :func:`check_value`; errors read ``LABEL WHERE, column 'C': ...``."""
+    coord_limit = max_coord()
+    out = []
+    for i, row in enumerate(rows):
+        place = row.get("_where", f"box {i + 1}")
+        out.append({col: check_value(col, v, f"{label} {place}, column '{col}'", coord_limit, text_numbers)
+                    for col, v in row.items() if col in COLUMNS})
+    return out
+
+
 def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
     """Read and validate a tracks CSV.
 
@@ -180,52 +303,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                                  f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
         for col, i in index.items():
             cell = row[i].strip() if i < len(row) else ""
-            where = f"{label} line {lineno}, column '{col}'"
-            if col in ("frame", "track_id"):
-                try:
-                    value = int(cell)
-                except ValueError:
-                    try:
-                        f = float(cell)
-                    except ValueError:
-                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
-                    if not f.is_integer():
-                        raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
-                    value = int(f)
-                if value < 0:
-                    raise TracksCSVError(f"{where}: {value} is negative")
-                if value > MAX_ID:
-                    raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
-            elif col == "part":
-                if cell not in PART_NAMES:
-                    raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
-                value = cell
-            elif col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
-                if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
-                    value = DEFAULTS[col]
-                else:
-                    try:
-                        value = float(cell)
-                    except ValueError:
-                        raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
-                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and not math.isfinite(value):
-                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
-                    if col in ("x", "y", "w", "h", "X", "Y", "Z") and abs(value) > coord_limit:
-                        raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
-                                             "(set PARTLAB_MAX_COORD to change it)")
-                    if col == "score" and math.isinf(value):
-                        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
-                    if col == "occluded" and not 0.0 <= value <= 1.0:
-                        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
-                    if col in ("w", "h") and value < 0:
-                        raise TracksCSVError(f"{where}: negative size {value:g}")
-            elif col == "failure":
-                value = _parse_bool(cell)
-                if value is None:
-                    raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
-            else:  # state, source, camera
-                value = cell if cell else DEFAULTS[col]
-            cols[col].append(value)
+            cols[col].append(check_value(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
     return normalise_tracks(pd.DataFrame(cols))
 
 
