@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from partlab.labelling.store import StaleEditError, Store, StoreError
+from partlab.tracking.tracks import TracksCSVError, check_value
 from partlab.tracking.core.box import Box
 
 
@@ -47,8 +48,21 @@ class ApplyResult:
 
 
 def _box(values) -> Box:
-    x, y, w, h = (float(v) for v in values)
-    return Box(x, y, max(w, 0.0), max(h, 0.0))
+    """The box of an editor event, by the tracks CSV's rules (finite, in range, no negative size)."""
+    if not isinstance(values, (list, tuple)) or len(values) != 4:
+        raise StoreError(f"a box is [x, y, w, h], got {str(values)[:60]}")
+    try:
+        x, y, w, h = (check_value(c, v, f"box {c}") for c, v in zip("xywh", values))
+    except TracksCSVError as exc:
+        raise StoreError(f"Not a usable box: {exc}") from None
+    return Box(x, y, w, h)
+
+
+def _flag(value) -> bool:
+    try:
+        return check_value("failure", value, "failure")
+    except TracksCSVError as exc:
+        raise StoreError(str(exc)) from None
 
 
 def _current(store: Store, clip_id: int, frame: int, track_id: int, part: str) -> dict | None:
@@ -81,8 +95,8 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                     expected = store.revision(clip_id, frame, tid, part)
                 box = _box(ev["box"]) if kind == "edit" else None
                 rev = store.edit_box(clip_id, frame, tid, part, box,
-                                     failure=bool(ev.get("failure")) if kind == "edit" else None,
-                                     occluded=float(ev.get("occluded") or 0.0) if kind == "edit" else None,
+                                     failure=_flag(ev.get("failure")) if kind == "edit" else None,
+                                     occluded=ev.get("occluded") or 0.0 if kind == "edit" else None,
                                      expected_revision=int(expected), author=author)
                 history.undo.append(EditRef(frame, tid, part, rev))
                 history.redo.clear()

@@ -34,7 +34,7 @@ from partlab.labelling.config import data_dir, database_url
 from partlab.labelling.video import VideoError, probe, store_by_hash
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import check_part
-from partlab.tracking.tracks import COLUMNS, normalise_tracks
+from partlab.tracking.tracks import COLUMNS, TracksCSVError, check_table, check_value, normalise_tracks
 
 
 class StoreError(ValueError):
@@ -325,6 +325,26 @@ def _engine(url: str):
         return eng
 
 
+def _check_edit(frame, track_id, part, box, failure, occluded, xyz) -> None:
+    """An edit by the tracks CSV's rules (finite, in range, int32, no negative sizes), refused with a
+    StoreError naming the box and the value before any revision is compared (a NaN is not "stale")."""
+    where = f"edit of {part} #{track_id} at frame {frame}"
+    values = {"frame": frame, "track_id": track_id}
+    if box is not None:
+        values.update(x=box.x, y=box.y, w=box.w, h=box.h)
+    if occluded is not None:
+        values["occluded"] = occluded
+    if failure is not None:
+        values["failure"] = failure
+    if xyz is not None and len(xyz) == 3:
+        values.update(X=xyz[0], Y=xyz[1], Z=xyz[2])
+    try:
+        for col, v in values.items():
+            check_value(col, v, f"{where}, {col}")
+    except TracksCSVError as exc:
+        raise StoreError(f"Not a usable box: {exc}") from None
+
+
 def _point(before: dict | None, camera: str | None, xyz) -> dict:
     """camera and X, Y, Z of an edit: the given ones, else the box's current ones."""
     out = dict(camera=str(camera) if camera is not None else (before or {}).get("camera") or "")
@@ -424,6 +444,10 @@ class Store:
         ``[start_frame, stop_frame)``; human edits are never touched."""
         self.clip(clip_id)
         df = normalise_tracks(tracks)
+        try:  # the tracks CSV's rules: nothing is stored that partlab's own reader would refuse
+            check_table(df, f"tracker run of clip {clip_id}")
+        except TracksCSVError as exc:
+            raise StoreError(str(exc)) from None
         with self._session() as s:
             run = RunRow(clip_id=clip_id, tracker=tracker, bundle=str(bundle), seed=seed, start_frame=start_frame)
             s.add(run)
@@ -518,6 +542,7 @@ class Store:
         :class:`StaleEditError` when the newest revision is not ``expected_revision``.
         """
         check_part(part)
+        _check_edit(frame, track_id, part, box, failure, occluded, xyz)
         clip = self.clip(clip_id)
         if not 0 <= frame < clip.frame_count:
             raise StoreError(f"frame {frame} is outside clip {clip.name!r} (0..{clip.frame_count - 1})")

@@ -257,6 +257,30 @@ def check_rows(rows: list[dict], label: str, text_numbers: bool = True) -> list[
     return out
 
 
+def check_table(df: pd.DataFrame, label: str) -> None:
+    """:func:`check_value`'s rules over a normalised tracks table at once (what the store and the
+    writers take); raises :class:`TracksCSVError` naming the first bad row (counted from 1) and value."""
+    import numpy as np
+
+    limit = max_coord()
+    tests = {
+        "frame": lambda v: (v >= 0) & (v <= MAX_ID), "track_id": lambda v: (v >= 0) & (v <= MAX_ID),
+        "x": lambda v: np.isfinite(v) & (np.abs(v) <= limit), "y": lambda v: np.isfinite(v) & (np.abs(v) <= limit),
+        "w": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit), "h": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
+        "score": lambda v: ~np.isinf(v), "occluded": lambda v: (v >= 0) & (v <= 1),
+        **{c: (lambda v: np.isnan(v) | (np.abs(v) <= limit)) for c in ("X", "Y", "Z")},
+    }
+    for col, test in tests.items():
+        if col not in df.columns:
+            continue
+        values = df[col].to_numpy(dtype=float)
+        bad = ~test(values)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            check_value(col, values[i].item(), f"{label} row {i + 1}, column '{col}'", limit)
+            raise TracksCSVError(f"{label} row {i + 1}, column '{col}': {values[i]!r} is out of range")
+
+
 def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
     """Read and validate a tracks CSV.
 
