@@ -1,5 +1,6 @@
 # partlab: `make run` starts the app on a demo clip, `make test` runs the tests.
 # Both create (or reuse) a virtual environment in .venv and install what they need.
+# `make test` lints first (ruff, configured in pyproject.toml: a complexity limit of 15 per function).
 
 PYTHON ?= python3
 VENV ?= .venv
@@ -50,6 +51,7 @@ run: $(VENV)/.installed
 	$(PY) -m partlab app --host $(HOST) --port $(PORT)
 
 test: $(VENV)/.installed-test peers
+	$(PY) -m ruff check .
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 clean:

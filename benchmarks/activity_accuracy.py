@@ -66,8 +66,8 @@ def main() -> int:
             if name == "handshake":
                 swaps += int((pred["kind"] == "exchange").sum())
             kinds = ", ".join(f"{r.kind} {r.start_frame}-{r.end_frame}" for r in pred.itertuples()) or "none"
-            print(f"{name:10s} seed {seed}: truth {', '.join(f'{r.kind} {r.start_frame}-{r.end_frame}' for r in truth.itertuples())}"
-                  f" | found {kinds}", flush=True)
+            said = ", ".join(f"{r.kind} {r.start_frame}-{r.end_frame}" for r in truth.itertuples())
+            print(f"{name:10s} seed {seed}: truth {said} | found {kinds}", flush=True)
             truths.append(truth)
             preds.append(pred)
     # evaluate per clip (frames of different clips never match), then sum the counts

@@ -26,24 +26,22 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from partlab.labelling.evaluation import mot_metrics  # noqa: E402
-from partlab.tracking.core.background import BackgroundModel  # noqa: E402
 from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
 from partlab.tracking.params import BodyParams  # noqa: E402
-from partlab.tracking.tracks import records_to_frame  # noqa: E402
+from partlab.tracking.run import run_single_view  # noqa: E402
 
 SCENES = ("single", "pair_cross", "crowd", "distractors", "bend", "pillar")
-PETS = ROOT.parent / "shared" / "data" / "pets09_s2l1_vtest"
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"  # ../shared/data beside the repository
+PETS = DATA / "pets09_s2l1_vtest"
 
 
-def track_auto(frames, occluders=(), seed: int = 0, fps: float = 25.0, params: BodyParams | None = None) -> pd.DataFrame:
+def track_auto(frames, occluders=(), seed: int = 0, fps: float = 25.0,
+               params: BodyParams | None = None) -> pd.DataFrame:
     """Person boxes of the body tracker started automatically (no init)."""
     params = params or BodyParams()
-    bg = BackgroundModel(params)
     tracker = BodyTracker(params, np.random.default_rng(seed), occluders=occluders, fps=fps)
-    records = []
-    for i, frame in enumerate(frames):
-        records.extend(tracker.step(i, frame, bg.apply(frame)))
-    tracks = records_to_frame(records) if records else pd.DataFrame(columns=["frame", "track_id", "part"])
+    tracks = run_single_view(tracker, frames, BackgroundModel(params))
     return tracks[tracks.part == "person"]
 
 

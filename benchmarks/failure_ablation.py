@@ -8,7 +8,8 @@ body tracker runs from the truth's first boxes
 
 * ``none``     : the default bundle's parameters, no failure detector (no adjustment);
 * ``default``  : the default bundle's parameters and failure detector (adjustment);
-* ``retrained``: a bundle trained here, starting from the shipped one (``partlab train``'s default; ``--from-builtin``: from the built-in parameters), on the truth of *other* clips (other seeds, all
+* ``retrained``: a bundle trained here, starting from the shipped one (``partlab train``'s default;
+  ``--from-builtin``: from the built-in parameters), on the truth of *other* clips (other seeds, all
   walking scenarios including ``distractors`` and ``bend``, which the default bundle
   never saw), parameters and detector.
 
@@ -40,17 +41,17 @@ PARTS = ("head", "torso", "hipleg")
 
 
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame, at: int = AT) -> dict[str, tuple[int, int, float]]:
-    """Per part ``(right at at, people with truth at at, mean rate over offsets 1..at)``,
-    offsets counted from each truth track's first frame."""
-    from partlab.models.selection import right_after_start
+    """Per part ``(right at at, people with truth at at, averaged rate over offsets 1..at)``,
+    offsets counted from each truth track's first frame (:mod:`partlab.tracking.measures`)."""
+    from partlab.tracking import measures
 
     out = {}
     for part in PARTS:
-        m = right_after_start(tracks, truth, part)
-        m = m[m.frame <= m.f0 + at]
-        last = (m.frame == m.f0 + at).to_numpy()
-        ok = m.right.to_numpy()
-        out[part] = (int(ok[last].sum()), int(last.sum()), float(ok.mean()) if len(ok) else float("nan"))
+        judged = measures.with_offsets(measures.judge(truth[truth.part == part], tracks[tracks.part == part]),
+                                       truth)
+        judged = judged[judged.offset <= at]
+        last = judged[judged.offset == at]
+        out[part] = (int(last.right.sum()), len(last), measures.averaged_rate(measures.rate_curve(judged)))
     return out
 
 
@@ -66,12 +67,13 @@ def main(argv=None) -> int:
                     help="retrain from the built-in parameters (partlab train --from none), not the shipped bundle")
     args = ap.parse_args(argv)
 
+    from track_accuracy_limbs import through_codec
+    from train_default_bundle import scene_clips
+
     from partlab.labelling.synth import make_scene
     from partlab.models.bundle import default_bundle
     from partlab.models.runner import body_tracker_runner, run_body_tracker
     from partlab.models.training import first_boxes, train_bundle
-    from train_default_bundle import scene_clips
-    from track_accuracy_limbs import through_codec
 
     t0 = time.time()
     default = default_bundle()
@@ -100,7 +102,7 @@ def main(argv=None) -> int:
             scene = make_scene(name, seed=seed)
             init = first_boxes(scene.truth)
             shown = through_codec(scene.frames, scene.fps) if args.video else scene.frames
-            frames = lambda: ((i, shown[i]) for i in range(len(shown)))  # noqa: E731
+            frames = lambda shown=shown: ((i, shown[i]) for i in range(len(shown)))  # noqa: E731
             for cond, (params, detector) in conditions.items():
                 t1 = time.time()
                 try:

@@ -1,7 +1,7 @@
 """Export PETS09-S2L1 truth in every format, read it back with the peers' parsers and ours,
 and check the evaluation on real data (motmetrics' TUD sequences with published numbers).
 
-    PYTHONPATH=. python benchmarks/formats_real_data.py [--data /work/shared/data] [--every 10]
+    PYTHONPATH=. python benchmarks/formats_real_data.py [--data ../shared/data] [--every 10]
 
 Prints counts, round-trip errors and timings; writes into a temporary directory only.
 """
@@ -19,7 +19,8 @@ import pandas as pd
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--data", default="/work/shared/data")
+    ap.add_argument("--data", default=str(Path(__file__).resolve().parents[1].parent / "shared" / "data"),
+                    help="the shared data folder (default: ../shared/data beside the repository)")
     ap.add_argument("--every", type=int, default=10, help="frame thinning for the image formats")
     args = ap.parse_args()
 

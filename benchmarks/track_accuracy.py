@@ -1,8 +1,8 @@
 """Tracking rates of the body tracker (seed 002 sec. 5.3's measure), printed as tables.
 
-A box is correct when at least half of it lies on the true box and its centre is inside
-the true box. The rate at frame i counts the people tracked correctly i frames after
-their initialisation; the mean rate averages over every (person, frame) pair.
+The measures are :mod:`partlab.tracking.measures`: a box is right when at least half of it lies
+on the true box and its centre is inside it; the rate at frame i counts the people tracked right
+i frames after their initialisation; the mean rate averages that curve over frames 1 on.
 
     python benchmarks/track_accuracy.py                       # synthetic suite + PETS09-S2L1
     python benchmarks/track_accuracy.py --skip-pets --scenarios single,pillar
@@ -33,70 +33,43 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from partlab.tracking.core.background import BackgroundModel  # noqa: E402
+from partlab.tracking import measures  # noqa: E402
 from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
 from partlab.tracking.params import BodyParams  # noqa: E402
-from partlab.tracking.tracks import records_to_frame  # noqa: E402
+from partlab.tracking.run import run_single_view  # noqa: E402
 
-DATA = ROOT.parent.parent / "shared" / "data"
-if not DATA.exists():
-    DATA = Path("/work/shared/data")
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"  # ../shared/data beside the repository
 PETS = DATA / "pets09_s2l1_vtest"
 SUITE = ("single", "pillar", "distractors", "pair_cross", "crowd", "bend", "desk")
 AT = 105
 
 
-def correct(boxes: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """Row-wise: box ``(N, 4)`` correct for truth ``(N, 4)`` (x, y, w, h)?"""
-    b = np.asarray(boxes, float)
-    t = np.asarray(truth, float)
-    ix = np.clip(np.minimum(b[:, 0] + b[:, 2], t[:, 0] + t[:, 2]) - np.maximum(b[:, 0], t[:, 0]), 0, None)
-    iy = np.clip(np.minimum(b[:, 1] + b[:, 3], t[:, 1] + t[:, 3]) - np.maximum(b[:, 1], t[:, 1]), 0, None)
-    area = b[:, 2] * b[:, 3]
-    cx, cy = b[:, 0] + b[:, 2] / 2, b[:, 1] + b[:, 3] / 2
-    inside = (cx >= t[:, 0]) & (cx <= t[:, 0] + t[:, 2]) & (cy >= t[:, 1]) & (cy <= t[:, 1] + t[:, 3])
-    return (area > 0) & (ix * iy >= 0.5 * area) & inside
-
-
-def rates(tracks: pd.DataFrame, truth: pd.DataFrame, starts: pd.Series, part: str, at: int = AT):
-    """(rate at ``at`` frames after start, mean rate, people at ``at``) for one part; a truth
-    box without a tracked box counts as a miss."""
-    t = truth[truth.part == part][["frame", "track_id", "x", "y", "w", "h"]]
-    k = tracks[tracks.part == part][["frame", "track_id", "x", "y", "w", "h"]]
-    m = t.merge(k, on=["frame", "track_id"], how="left", suffixes=("_t", ""))
-    ok = correct(m[["x", "y", "w", "h"]].fillna(0).to_numpy(), m[["x_t", "y_t", "w_t", "h_t"]].to_numpy())
-    age = m["frame"].to_numpy() - m["track_id"].map(starts).to_numpy()
-    valid = age >= 0
-    at_mask = age == at
-    r_at = ok[at_mask].mean() if at_mask.any() else float("nan")
-    return r_at, ok[valid].mean(), int(at_mask.sum())
+def rates(tracks: pd.DataFrame, truth: pd.DataFrame, part: str, at: int = AT):
+    """(rate at ``at`` frames after start, averaged rate, people at ``at``) for one part
+    (:mod:`partlab.tracking.measures`; a truth box without a tracked box counts as a miss)."""
+    judged = measures.with_offsets(measures.judge(truth[truth.part == part], tracks[tracks.part == part]), truth)
+    curve = measures.rate_curve(judged)
+    return measures.rate_at(curve, at), measures.averaged_rate(curve), int((judged.offset == at).sum())
 
 
 def run_tracker(frames, init, whole=False, occluders=(), seed=0, params=None, fps=25.0):
+    """The body tracker through the one run loop: (tracks, seconds per frame)."""
     params = params or BodyParams()
     tracker = BodyTracker(params, np.random.default_rng(seed), init=init, occluders=occluders, whole=whole, fps=fps)
-    bg = BackgroundModel(params)
-    records = []
     t0 = time.perf_counter()
-    n = 0
-    for index, frame in frames:
-        records.extend(tracker.step(index, frame, bg.apply(frame)))
-        n += 1
-    return records_to_frame(records), (time.perf_counter() - t0) / max(n, 1)
+    tracks = run_single_view(tracker, frames, BackgroundModel(params))
+    return tracks, (time.perf_counter() - t0) / max(len(frames), 1)
 
 
 def synth_suite(names, seed, n_frames):
-    try:
-        from partlab.labelling.synth import make_scene
-    except ImportError:
-        print("partlab.labelling.synth is not available: synthetic suite skipped")
-        return
+    from partlab.labelling.synth import make_scene
+
     rows = []
     for name in names:
         scene = make_scene(name, seed=seed, n_frames=n_frames, width=720, height=480)
         truth = scene.truth
         init = scene.init
-        starts = init.groupby("track_id")["frame"].min()
         frames = list(enumerate(scene.frames))
         for mode in ("body", "whole"):
             tracks, spf = run_tracker(frames, init, whole=mode == "whole", occluders=scene.occluders, seed=seed,
@@ -104,7 +77,7 @@ def synth_suite(names, seed, n_frames):
             row = {"scene": name, "tracker": mode, "ms/frame": 1000 * spf}
             parts = ("person",) if mode == "whole" else ("head", "torso", "hipleg", "person")
             for part in parts:
-                r_at, r_mean, n = rates(tracks, truth, starts, part)
+                r_at, r_mean, n = rates(tracks, truth, part)
                 row[f"{part}@{AT}"] = r_at
                 row[f"{part} mean"] = r_mean
             row["people"] = n
@@ -130,7 +103,6 @@ def pets(video: Path, truth_csv: Path, stop: int | None):
         gt = gt[gt.frame < stop]
     gt = gt.assign(part="person")
     first = gt.sort_values("frame").groupby("track_id").head(1)
-    starts = first.set_index("track_id")["frame"]
     init = first[["frame", "track_id", "part", "x", "y", "w", "h"]]
     clip = VideoClip(video)
     frames = list(clip.frames(0, stop))
@@ -138,21 +110,18 @@ def pets(video: Path, truth_csv: Path, stop: int | None):
     rows = []
     for mode, occluders in (("body", ()), ("whole", ()), ("body", PETS_OCCLUDERS)):
         tracks, spf = run_tracker(frames, init, whole=mode == "whole", occluders=occluders, fps=clip.fps)
-        r_at, r_mean, n = rates(tracks, gt, starts, "person")
+        r_at, r_mean, n = rates(tracks, gt, "person")
         start = "first truth box" + (", sign post as occluder" if occluders else "")
         rows.append({"tracker": mode, "start": start, f"person@{AT}": r_at, "person mean": r_mean,
                      f"people@{AT}": n, "ms/frame": 1000 * spf})
     tracks, spf = run_tracker(frames, None, fps=clip.fps)
     found, precise = detection_rates(tracks[tracks.part == "person"], gt)
-    try:  # the project's evaluation (labelling/evaluation.py): MOT metrics of the person boxes
-        from partlab.labelling.evaluation import evaluate
+    from partlab.labelling.evaluation import evaluate  # MOT metrics of the person boxes
 
-        rep = evaluate(gt, tracks[tracks.part == "person"], hota=False)
-        mot = rep.mot.loc["person"]
-        print("automatic detection, MOT metrics of person boxes (partlab.labelling.evaluation): "
-              + ", ".join(f"{k} {mot[k]:.3f}" for k in mot.index if k in ("mota", "motp", "idf1", "num_switches")))
-    except ImportError:
-        pass
+    rep = evaluate(gt, tracks[tracks.part == "person"], hota=False)
+    mot = rep.mot.loc["person"]
+    print("automatic detection, MOT metrics of person boxes (partlab.labelling.evaluation): "
+          + ", ".join(f"{k} {mot[k]:.3f}" for k in mot.index if k in ("mota", "motp", "idf1", "num_switches")))
     rows.append({"tracker": "body", "start": "automatic", f"person@{AT}": float("nan"), "person mean": found,
                  f"people@{AT}": 0, "ms/frame": 1000 * spf})
     print(pd.DataFrame(rows).to_string(index=False, float_format=lambda v: f"{v:.2f}"))
@@ -172,7 +141,7 @@ def detection_rates(tracks: pd.DataFrame, gt: pd.DataFrame) -> tuple[float, floa
         kb = k[["x", "y", "w", "h"]].to_numpy()
         ok = np.zeros((len(kb), len(tb)), bool)
         for j in range(len(tb)):
-            ok[:, j] = correct(kb, np.repeat(tb[j:j + 1], len(kb), axis=0))
+            ok[:, j] = measures.right_box(kb, np.repeat(tb[j:j + 1], len(kb), axis=0))
         found += int(ok.any(axis=0).sum())
         good += int(ok.any(axis=1).sum())
     return found / max(len(gt), 1), good / max(len(tracks), 1)

@@ -5,9 +5,9 @@ For each scenario and seed: render the scene (``partlab.labelling.synth.make_sce
 report per part (head, left hand, right hand)
 
 - the tracking rate at frame ``--at`` (105 by default): the fraction of (seed, person)
-  whose box is right there; a box is right when at least half of it lies on the true
-  box and its centre is inside the true box (seed 002 sec. 5.3, DESIGN.md);
-- the mean rate over all frames;
+  whose box is right there (:mod:`partlab.tracking.measures`: at least half of it on the true
+  box and its centre inside it, Zhao & Lee sec. 5.2-5.3);
+- the averaged rate (the rate curve's mean over frames 1 on);
 - the number of identity swaps of the hands after the clap (in the left_hand row): a
   swap starts at a frame where each hand's box is nearer the other hand's true centre
   than its own.
@@ -28,39 +28,12 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from partlab.tracking import measures
+from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.limbs.tracker import LimbTracker
 from partlab.tracking.params import LimbParams
 from partlab.tracking.parts import LIMB_PARTS
-from partlab.tracking.tracks import records_to_frame
-
-
-def box_correct(pred: np.ndarray, true: np.ndarray) -> np.ndarray:
-    """``(N,) bool``: at least half of each predicted box ``(N, 4) x, y, w, h`` lies on its true
-    box and its centre is inside it."""
-    pred = np.asarray(pred, float).reshape(-1, 4)
-    true = np.asarray(true, float).reshape(-1, 4)
-    iw = np.minimum(pred[:, 0] + pred[:, 2], true[:, 0] + true[:, 2]) - np.maximum(pred[:, 0], true[:, 0])
-    ih = np.minimum(pred[:, 1] + pred[:, 3], true[:, 1] + true[:, 3]) - np.maximum(pred[:, 1], true[:, 1])
-    inter = np.clip(iw, 0, None) * np.clip(ih, 0, None)
-    area = pred[:, 2] * pred[:, 3]
-    cx, cy = pred[:, 0] + pred[:, 2] / 2, pred[:, 1] + pred[:, 3] / 2
-    inside = (cx >= true[:, 0]) & (cx <= true[:, 0] + true[:, 2]) & (cy >= true[:, 1]) & (cy <= true[:, 1] + true[:, 3])
-    return (area > 0) & (inter >= 0.5 * area) & inside
-
-
-def foreground_model():
-    """The shared background model if it has landed, else OpenCV's MOG2 with its defaults."""
-    try:
-        from partlab.tracking.core.background import BackgroundModel
-        return BackgroundModel()
-    except ImportError:
-        import cv2
-        mog = cv2.createBackgroundSubtractorMOG2(detectShadows=False)
-
-        class _Mog:
-            def apply(self, frame):
-                return mog.apply(frame)
-        return _Mog()
+from partlab.tracking.run import run_single_view
 
 
 class PlateForeground:
@@ -101,21 +74,19 @@ def run_scene(scene, params: LimbParams, seed: int, fg: str = "model",
               video: bool = False) -> tuple[pd.DataFrame, pd.DataFrame]:
     init = scene.init[scene.init["part"].isin(LIMB_PARTS)]
     tracker = LimbTracker(params, np.random.default_rng(seed), init=init)
-    bg = PlateForeground(scene.background) if fg == "plate" else foreground_model()
-    recs = []
+    bg = PlateForeground(scene.background) if fg == "plate" else BackgroundModel()
     frames = through_codec(scene.frames, scene.fps) if video else scene.frames
-    for i, frame in enumerate(frames):
-        recs += tracker.step(i, frame, bg.apply(frame))
-    return records_to_frame(recs), tracker.events
+    return run_single_view(tracker, frames, bg), tracker.events
 
 
 def score(out: pd.DataFrame, truth: pd.DataFrame) -> pd.DataFrame:
-    """Truth rows of the limb parts with a ``correct`` column (missing predictions are wrong)."""
+    """Truth rows of the limb parts with ``correct`` (:func:`partlab.tracking.measures.judge`; missing
+    predictions are wrong) and ``offset``; the tracked box in ``x, y, w, h`` and the truth in ``x_t ...``."""
     t = truth[truth["part"].isin(LIMB_PARTS)][["frame", "track_id", "part", "x", "y", "w", "h"]]
-    m = t.merge(out[["frame", "track_id", "part", "x", "y", "w", "h", "state"]],
-                on=["frame", "track_id", "part"], how="left", suffixes=("_t", ""))
-    ok = box_correct(m[["x", "y", "w", "h"]].fillna(0).to_numpy(), m[["x_t", "y_t", "w_t", "h_t"]].to_numpy())
-    return m.assign(correct=ok & m["x"].notna().to_numpy())
+    m = measures.with_offsets(measures.judge(t, out), truth).merge(
+        out[["frame", "track_id", "part", "state"]], on=["frame", "track_id", "part"], how="left")
+    m = m.rename(columns={"x": "x_t", "y": "y_t", "w": "w_t", "h": "h_t"})
+    return m.rename(columns={"x_k": "x", "y_k": "y", "w_k": "w", "h_k": "h", "right": "correct"})
 
 
 def hand_swaps(m: pd.DataFrame, after: int) -> int:
@@ -142,7 +113,7 @@ def hand_swaps(m: pd.DataFrame, after: int) -> int:
 def clap_end(truth: pd.DataFrame, gap: float) -> int:
     """Last frame at which some person's true hand centres are closer than ``gap`` (the clap)."""
     frames = []
-    for (f, tid), g in truth[truth.part.isin(["left_hand", "right_hand"])].groupby(["frame", "track_id"]):
+    for (f, _tid), g in truth[truth.part.isin(["left_hand", "right_hand"])].groupby(["frame", "track_id"]):
         if len(g) == 2:
             c = g[["x", "y"]].to_numpy() + g[["w", "h"]].to_numpy() / 2
             if np.hypot(*(c[0] - c[1])) < gap:
@@ -169,16 +140,16 @@ def limbs_table(scenarios=("desk", "single"), seeds=(0, 1, 2), n_frames: int = 1
             end = clap_end(scene.truth, gap)
             for part in LIMB_PARTS:
                 mp = m[m.part == part]
-                at_rows = mp[mp.frame == at]
+                curve = measures.rate_curve(mp.rename(columns={"correct": "right"}))
                 rows.append({"scenario": name, "seed": seed, "part": part,
-                             f"rate@{at}": at_rows.correct.mean() if len(at_rows) else np.nan,
-                             "rate_all": mp.correct.mean() if len(mp) else np.nan,
+                             f"rate@{at}": measures.rate_at(curve, at),
+                             "rate_mean": measures.averaged_rate(curve),
                              "swaps_after_clap": hand_swaps(m, end) if end >= 0 and part == "left_hand" else 0,
                              "clap_end": end, "events": len(events),
                              "lost_frames": int((mp.state == "lost").sum())})
     df = pd.DataFrame(rows)
     summary = df.groupby(["scenario", "part"]).agg(
-        **{f"rate@{at}": (f"rate@{at}", "mean"), "rate_all": ("rate_all", "mean"),
+        **{f"rate@{at}": (f"rate@{at}", "mean"), "rate_mean": ("rate_mean", "mean"),
            "swaps": ("swaps_after_clap", "sum")})
     return df, summary
 

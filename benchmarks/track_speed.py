@@ -2,7 +2,7 @@
 
 For a 720x480 synthetic clip with 1, 4 and 8 walkers (500 particles per part, the
 entropy adaptation pinned) and for PETS09-S2L1 (768x576), prints per frame:
-decode-only ms, background-model ms, body-tracker ms (``BodyTracker.step`` only),
+decode-only ms, background-model ms, body-tracker ms (the run loop without the background model),
 their ratio to decode, and OpenCV's ``TrackerMIL`` on the same person boxes (ms per
 frame for all people, measured on the first ``--mil-frames`` frames).
 
@@ -32,14 +32,26 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from partlab.labelling.video import VideoClip, write_video  # noqa: E402
-from partlab.tracking.core.background import BackgroundModel  # noqa: E402
 from partlab.tracking.body.tracker import BodyTracker  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
 from partlab.tracking.params import BodyParams  # noqa: E402
+from partlab.tracking.run import run_single_view  # noqa: E402
 
-PETS = Path("/work/shared/data/pets09_s2l1_vtest")
-_alt = ROOT.parent.parent / "shared" / "data" / "pets09_s2l1_vtest"
-if _alt.exists():
-    PETS = _alt
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"  # ../shared/data beside the repository
+PETS = DATA / "pets09_s2l1_vtest"
+
+
+class _Timed:
+    """A background model that adds the time of every ``apply`` to ``seconds``."""
+
+    def __init__(self, model):
+        self.model, self.seconds = model, 0.0
+
+    def apply(self, frame):
+        t0 = time.perf_counter()
+        mask = self.model.apply(frame)
+        self.seconds += time.perf_counter() - t0
+        return mask
 
 
 def walkers_scene(n: int, n_frames: int, seed: int = 0):
@@ -77,23 +89,21 @@ def decode_ms(path: Path, stop: int | None = None) -> float:
 def body_ms(frames, init: pd.DataFrame, particles: int, whole: bool = False) -> tuple[float, float, int]:
     """(background ms/frame, tracker ms/frame, mean tracked people), timed on a second run over
     the clip: the first loads every compiled kernel (numba) it uses."""
-    params = BodyParams().updated({"particles.initial": particles, "particles.min": particles, "particles.max": particles})
+    params = BodyParams().updated({"particles.initial": particles, "particles.min": particles,
+                                   "particles.max": particles})
     for _ in range(2):
         tracker = BodyTracker(params, np.random.default_rng(0), init=init, whole=whole)
-        bg = BackgroundModel(params)
-        t_bg = t_tr = 0.0
-        people = 0
-        for i, frame in enumerate(frames):
-            t0 = time.perf_counter()
-            mask = bg.apply(frame)
-            t1 = time.perf_counter()
-            tracker.step(i, frame, mask)
-            t2 = time.perf_counter()
-            t_bg += t1 - t0
-            t_tr += t2 - t1
-            people += len(tracker.people)
+        bg = _Timed(BackgroundModel(params))
+        people = []
+
+        def count(_done, _total, tracker=tracker, people=people):
+            people.append(len(tracker.people))
+
+        t0 = time.perf_counter()
+        run_single_view(tracker, frames, bg, progress=count)  # the one run loop
+        t_all = time.perf_counter() - t0
     n = len(frames)
-    return 1000 * t_bg / n, 1000 * t_tr / n, people / n
+    return 1000 * bg.seconds / n, 1000 * (t_all - bg.seconds) / n, sum(people) / n
 
 
 def repeated(n: int, decode, body) -> tuple[float, float, float, float]:
@@ -155,8 +165,8 @@ def main() -> None:
             path = write_video(Path(tmp) / f"walkers{n}.mp4", scene.frames, scene.fps)
             frames = [f for _, f in VideoClip(path).frames()]
             init = scene.init[scene.init.part.isin(["person", "head", "torso", "hipleg"])]
-            dec, bg, tr, people = repeated(a.repeat, lambda: decode_ms(path),
-                                           lambda: body_ms(frames, init, a.particles))
+            dec, bg, tr, people = repeated(a.repeat, lambda path=path: decode_ms(path),
+                                           lambda frames=frames, init=init: body_ms(frames, init, a.particles))
             mil = mil_ms(frames, init, a.mil_frames)
             rows.append(row(f"synthetic, {n} walker(s)", "720x480", people, dec, bg, tr, mil))
     if not a.skip_pets and a.pets_video.exists():

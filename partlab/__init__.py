@@ -11,7 +11,8 @@ per tracker), :mod:`partlab.models` (failure SVMs, variance parameters, bundles)
 :mod:`partlab.app` (the Streamlit pages). Importing ``partlab`` loads none of them.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("partlab")

@@ -56,13 +56,13 @@ def main(argv=None) -> int:
 
     import dataclasses
 
+    import pandas as pd
     from tqdm import tqdm
 
     from partlab.models.bundle import save_bundle
     from partlab.models.failure_svm import SVMReport, report_table
     from partlab.models.training import train_bundle, training_steps
     from partlab.models.variance import comparison_table
-    import pandas as pd
 
     runner = None
     if not args.no_tracker:

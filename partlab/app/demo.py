@@ -8,7 +8,6 @@ scene generator (``partlab.labelling.synth``) is not installed.
 
 from __future__ import annotations
 
-import importlib
 import threading
 from pathlib import Path
 
@@ -32,10 +31,7 @@ def demo_files(clip_name: str) -> dict[str, Path]:
 
 def ensure_demo(store=None) -> bool:
     """Create the demo project with its clips if missing; True when it exists afterwards."""
-    try:
-        synth = importlib.import_module("partlab.labelling.synth")
-    except ImportError:  # the generator has not landed yet
-        return False
+    from partlab.labelling import synth
     from partlab.labelling.store import Store, StoreError
 
     with _LOCK:

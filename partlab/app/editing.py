@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from partlab.labelling.store import StaleEditError, Store, StoreError
-from partlab.tracking.tracks import TracksCSVError, check_value
 from partlab.tracking.core.box import Box
+from partlab.tracking.tracks import TracksCSVError, check_value
 
 
 @dataclass(frozen=True)

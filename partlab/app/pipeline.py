@@ -3,8 +3,8 @@ run loop, :func:`partlab.tracking.run.track`. Kept as the app's and the command 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from os import PathLike
-from typing import Callable
 
 import pandas as pd
 

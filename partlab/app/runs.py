@@ -1,14 +1,13 @@
 """Start the app's long work as background jobs: tracking, re-tracking, training.
 
 This is glue only: the algorithms are ``partlab.app.pipeline.track_video`` (trackers),
-``partlab.models.training.train_bundle`` (SVMs and variances) and the store. Modules that
-have not landed yet are looked up lazily, so a page can say "not available yet"
-instead of failing to import.
+``partlab.models.training.train_bundle`` (SVMs and variances) and the store. They are imported
+when a job starts (the pages stay quick to load); an import that breaks fails the job or the page,
+it is never hidden.
 """
 
 from __future__ import annotations
 
-import importlib
 import re
 from pathlib import Path
 
@@ -22,26 +21,12 @@ from partlab.labelling.video import VideoClip
 TRACKERS: tuple[str, ...] = ("body", "limbs", "all")
 
 
-def optional(module: str):
-    """The module, or None when it is not there yet (or fails to import)."""
-    try:
-        return importlib.import_module(module)
-    except ImportError:
-        return None
-
-
-def missing(*modules: str) -> list[str]:
-    """Which of ``modules`` cannot be imported."""
-    return [m for m in modules if optional(m) is None]
-
-
 def _load_model(bundle_path: str | Path | None):
     if not bundle_path:
         return None
-    bundle = optional("partlab.models.bundle")
-    if bundle is None:
-        raise RuntimeError("model bundles are not available yet (partlab.models.bundle has not landed)")
-    return bundle.load_bundle(bundle_path)
+    from partlab.models.bundle import load_bundle
+
+    return load_bundle(bundle_path)
 
 
 BUILTIN = "built-in parameters"
@@ -58,9 +43,10 @@ def bundle_choices(store: Store, project) -> dict[str, str | None]:
     if default is not None:
         out[f"{default.name} (project default)"] = str(default.path)
     out[BUILTIN] = None
-    bundle_mod = optional("partlab.models.bundle")
-    if bundle_mod is not None and (bundle_mod.default_bundle_path() / bundle_mod.MANIFEST).is_file():
-        out[SHIPPED] = str(bundle_mod.default_bundle_path())
+    from partlab.models.bundle import MANIFEST, default_bundle_path
+
+    if (default_bundle_path() / MANIFEST).is_file():
+        out[SHIPPED] = str(default_bundle_path())
     for b in bundles:
         if b is not default:
             out[b.name] = str(b.path)
@@ -85,9 +71,8 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     ``start`` instead of detecting people; ``init`` gives such boxes directly (e.g. a
     synthetic scene's init.csv).
     """
-    pipeline = optional("partlab.app.pipeline")
-    if pipeline is None:
-        raise RuntimeError("tracking is not available yet (partlab.app.pipeline has not landed)")
+    from partlab.app import pipeline
+
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
     stop = None
@@ -151,10 +136,10 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     """Train a bundle from corrected clips in the background, save it and register it.
     ``start_path``: the bundle to improve on (its detector stays unless the new one does no
     worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
-    training = optional("partlab.models.training")
-    bundle_mod = optional("partlab.models.bundle")
-    if training is None or bundle_mod is None:
-        raise RuntimeError("training is not available yet (partlab.models.training / partlab.models.bundle have not landed)")
+    from partlab.models import bundle as bundle_mod
+    from partlab.models import training
+    from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
+
     if not clip_ids:
         raise ValueError("pick at least one corrected clip")
     folder = safe_name(name)
@@ -170,13 +155,11 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
-    runner_mod = optional("partlab.models.runner")  # the tracker's own failures are the paper's training samples
-    runner = getattr(runner_mod, "body_tracker_runner", None)
     names = [store.clip(cid).name for cid in clip_ids]
     start = _load_model(start_path)
 
     def work(progress):
-        total = training.training_steps(len(clips), with_tracker=runner is not None)
+        total = training.training_steps(len(clips), with_tracker=True)
         steps = iter(range(1, 10**6))
 
         def step(_message: str) -> None:  # train_bundle reports named steps; the bar counts them
@@ -205,9 +188,7 @@ def start_comparison_run(clip: Clip, tracker: str, bundle_name: str, bundle_path
                          seed: int = 0, init: pd.DataFrame | None = None) -> jobs.Job:
     """Track a clip with one bundle without storing the result (Evaluate page), from
     ``init`` boxes when given; the job's result is the tracks DataFrame."""
-    pipeline = optional("partlab.app.pipeline")
-    if pipeline is None:
-        raise RuntimeError("tracking is not available yet (partlab.app.pipeline has not landed)")
+    from partlab.app import pipeline
 
     def work(progress):
         start = int(init.frame.min()) if init is not None and len(init) else 0

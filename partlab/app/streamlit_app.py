@@ -31,6 +31,7 @@ PAGES = [
     st.Page("views/train.py", title="Train", icon=":material/model_training:", url_path="train"),
     st.Page("views/evaluate.py", title="Evaluate and compare", icon=":material/insights:", url_path="evaluate"),
     st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
+    st.Page("views/depth.py", title="Depth", icon=":material/layers:", url_path="depth"),
 ]
 
 

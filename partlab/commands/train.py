@@ -39,6 +39,7 @@ def _tracker_runner():
 
 
 def run(args) -> int:
+    import pandas as pd
     from tqdm import tqdm
 
     from partlab.labelling.video import VideoClip, VideoError
@@ -47,7 +48,6 @@ def run(args) -> int:
     from partlab.models.training import train_bundle, training_steps
     from partlab.models.variance import comparison_table
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
-    import pandas as pd
 
     if len(args.clip) != len(args.truth):
         raise CommandError(f"{len(args.clip)} --clip but {len(args.truth)} --truth; give one --truth per --clip")

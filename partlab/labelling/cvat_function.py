@@ -19,11 +19,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import cv2
+import cvat_sdk.auto_annotation as cvataa
 import numpy as np
 import pandas as pd
 import PIL.Image
-
-import cvat_sdk.auto_annotation as cvataa
 
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.frame import DEFAULT_STREAM, Frame, FrameSet

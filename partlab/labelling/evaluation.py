@@ -1,17 +1,14 @@
-"""Compare tracks with truth: seed 002's tracking rate per part, the person MBR rate, mean
+"""Compare tracks with truth: Zhao & Lee's tracking rate per part, the person MBR rate, mean
 IoU, and MOT metrics per part (py-motmetrics; HOTA through TrackEval when importable).
 
-Tracking rate (seed 002, sec. 5.2-5.3): a tracked box is *correct* when at least half of
-it lies on the true box and its centre is inside the true box. The rate at frame offset
-``i`` is the fraction of (person, part) pairs, among truth tracks that have that part
-``i`` frames after their initialisation (their first truth frame), whose tracked box is
-correct; the denominator varies with ``i`` because people stay in view for different
-times. The averaged rate is the mean of that curve over offsets. The person MBR rate
-compares the minimum bounding rectangle of the tracked head, torso and hip-leg with
-that of the true ones (seed 002 Fig. 4 (d)), where at least two of the three are
-present in the truth; tracks without body parts (a whole-body tracker) are judged by
-their ``person`` boxes, as in that figure. (For rectangles "half on the true box" already implies the centre lies
-in it, closed; the centre test is kept because the definition names it.)
+The right box, the person box and the tracking rate are defined once, in
+:mod:`partlab.tracking.measures` (Zhao & Lee sec. 5.2-5.3): the rate at frame offset ``i`` is
+the fraction of (person, part) pairs, among truth tracks that have that part ``i`` frames after
+their initialisation (their first truth frame), whose tracked box is right; the averaged rate is
+the mean of that curve over the offsets tracked (1 on). The person MBR rate compares the minimum
+bounding rectangle of the tracked head, torso and hip-leg with that of the true ones (Fig. 4 (d)),
+where at least two of the three are present in the truth; tracks without body parts (a
+whole-body tracker) are judged by their ``person`` boxes, as in that figure.
 
 Tracks are matched to truth by ``track_id`` when the ids agree (runs from ``--init``
 keep them): every truth track has a tracker track of the same id whose boxes overlap it
@@ -29,7 +26,6 @@ from __future__ import annotations
 
 import contextlib
 import io
-
 import json
 import math
 from dataclasses import dataclass, field
@@ -38,12 +34,13 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
+from partlab.tracking import measures
 from partlab.tracking.core.box import iou_xywh
 from partlab.tracking.parts import BODY_PARTS, PART_NAMES
 from partlab.tracking.tracks import normalise_tracks
 
 DEFAULT_AT = 105  # seed 002 reports its rates at the 105th frame after initialisation
-MIN_COVER = 0.5  # seed 002: a box is wrong when half of it or more covers other things
+MIN_COVER = measures.MIN_COVER
 MOT_IOU = 0.5  # the usual MOTChallenge threshold for a match
 ID_AGREE_IOU = 0.5  # same-id boxes overlapping this much at their first common frame: ids agree
 MOT_METRICS: tuple[str, ...] = ("mota", "motp", "idf1", "num_switches", "num_false_positives", "num_misses",
@@ -107,25 +104,9 @@ class EvaluationReport:
 
 
 def box_correct(tracked: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """Row-wise seed 002 correctness of ``tracked (N, 4)`` against ``truth (N, 4)`` xywh boxes.
-
-    Correct: intersection / tracked area >= 0.5 and the tracked centre inside the true box.
-    NaN tracked rows (no box) are wrong.
-    """
-    tracked = np.asarray(tracked, float).reshape(-1, 4)
-    truth = np.asarray(truth, float).reshape(-1, 4)
-    ix = np.minimum(tracked[:, 0] + tracked[:, 2], truth[:, 0] + truth[:, 2]) - np.maximum(tracked[:, 0], truth[:, 0])
-    iy = np.minimum(tracked[:, 1] + tracked[:, 3], truth[:, 1] + truth[:, 3]) - np.maximum(tracked[:, 1], truth[:, 1])
-    inter = np.clip(ix, 0, None) * np.clip(iy, 0, None)
-    area = tracked[:, 2] * tracked[:, 3]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cover = np.where(area > 0, inter / area, 0.0)
-    cx = tracked[:, 0] + tracked[:, 2] / 2
-    cy = tracked[:, 1] + tracked[:, 3] / 2
-    inside = ((truth[:, 0] <= cx) & (cx <= truth[:, 0] + truth[:, 2])
-              & (truth[:, 1] <= cy) & (cy <= truth[:, 1] + truth[:, 3]))
-    ok = (cover >= MIN_COVER) & inside
-    return ok & ~np.isnan(tracked).any(axis=1)
+    """Row-wise :func:`partlab.tracking.measures.right_box` of ``tracked (N, 4)`` against
+    ``truth (N, 4)`` xywh boxes (NaN tracked rows, no box, are wrong)."""
+    return measures.right_box(np.asarray(tracked, float).reshape(-1, 4), np.asarray(truth, float).reshape(-1, 4))
 
 
 def _rowwise_iou(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -191,20 +172,8 @@ def match_tracks(truth: pd.DataFrame, tracks: pd.DataFrame, how: str = "auto") -
     return "iou", out
 
 
-MIN_MBR_PARTS = 2  # a single body part (e.g. the head of a limb tracker) is no person box
-
-
-def _mbr(df: pd.DataFrame, parts) -> pd.DataFrame:
-    """Minimum bounding rectangle per (frame, track_id) of the rows whose part is in ``parts``
-    (only where at least :data:`MIN_MBR_PARTS` of them are present)."""
-    d = df[df["part"].isin(parts)]
-    g = d.assign(x2=d["x"] + d["w"], y2=d["y"] + d["h"]).groupby(["frame", "track_id"])
-    out = g.agg(x=("x", "min"), y=("y", "min"), x2=("x2", "max"), y2=("y2", "max"),
-                n=("part", "size")).reset_index()
-    out = out[out["n"] >= MIN_MBR_PARTS]
-    out["w"] = out["x2"] - out["x"]
-    out["h"] = out["y2"] - out["y"]
-    return out[["frame", "track_id"] + XYWH]
+MIN_MBR_PARTS = measures.MIN_MBR_PARTS
+_mbr = measures.person_boxes
 
 
 def _person_boxes(df: pd.DataFrame, prefer_person: bool) -> pd.DataFrame:
@@ -219,11 +188,8 @@ def _person_boxes(df: pd.DataFrame, prefer_person: bool) -> pd.DataFrame:
 
 def _judge(truth: pd.DataFrame, matched: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
     """Truth rows with ``correct`` and ``iou`` of the matched tracker box (wrong / 0 when missing)."""
-    m = truth.merge(matched[keys + XYWH], on=keys, how="left", suffixes=("", "_k"))
-    t = m[XYWH].to_numpy(float)
-    k = m[[c + "_k" for c in XYWH]].to_numpy(float)
-    m["correct"] = box_correct(k, t)
-    m["iou"] = _rowwise_iou(t, k)
+    m = measures.judge(truth, matched, keys).rename(columns={"right": "correct"})
+    m["iou"] = _rowwise_iou(m[XYWH].to_numpy(float), m[[c + "_k" for c in XYWH]].to_numpy(float))
     return m
 
 
@@ -243,7 +209,6 @@ def evaluate(truth_df: pd.DataFrame, tracks_df: pd.DataFrame, at: int = DEFAULT_
     how, pairs = match_tracks(truth, tracks, matching)
     rename = dict(zip(pairs["track_id"], pairs["truth_id"]))
     matched = tracks[tracks["track_id"].isin(rename)].assign(track_id=lambda d: d["track_id"].map(rename))
-    init = truth.groupby("track_id")["frame"].min()
 
     judged = _judge(truth, matched, ["frame", "track_id", "part"])
     judged["column"] = judged["part"]
@@ -253,7 +218,7 @@ def evaluate(truth_df: pd.DataFrame, tracks_df: pd.DataFrame, at: int = DEFAULT_
         pj = _judge(truth_person, track_person, ["frame", "track_id"])
         pj["column"] = PERSON_MBR
         judged = pd.concat([judged, pj], ignore_index=True)
-    judged["offset"] = judged["frame"] - judged["track_id"].map(init)
+    judged = measures.with_offsets(judged, truth)
 
     columns = [p for p in PART_NAMES if p in set(truth["part"])] + ([PERSON_MBR] if len(truth_person) else [])
     rates = judged.pivot_table(index="offset", columns="column", values="correct", aggfunc="mean")
@@ -262,8 +227,8 @@ def evaluate(truth_df: pd.DataFrame, tracks_df: pd.DataFrame, at: int = DEFAULT_
     counts = counts.reindex(columns=columns).fillna(0).astype(int)
     rates.columns.name = counts.columns.name = None
     summary = pd.DataFrame({
-        "rate_at": [float(rates[c].get(at, np.nan)) for c in columns],
-        "rate_mean": [float(rates[c].mean()) for c in columns],
+        "rate_at": [measures.rate_at(rates[c], at) for c in columns],
+        "rate_mean": [measures.averaged_rate(rates[c].dropna()) for c in columns],
         "mean_iou": [float(judged.loc[judged["column"] == c, "iou"].mean()) for c in columns],
         "boxes": [int((judged["column"] == c).sum()) for c in columns],
     }, index=pd.Index(columns, name="part"))

@@ -19,19 +19,34 @@ from __future__ import annotations
 import json
 import threading
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from os import PathLike
 from pathlib import Path
 
 import pandas as pd
-from sqlalchemy import (JSON, Boolean, DateTime, Float, ForeignKey, Integer, String, Text, UniqueConstraint,
-                        create_engine, delete, event, func, insert, select)
+from sqlalchemy import (
+    JSON,
+    Boolean,
+    DateTime,
+    Float,
+    ForeignKey,
+    Integer,
+    String,
+    Text,
+    UniqueConstraint,
+    create_engine,
+    delete,
+    event,
+    func,
+    insert,
+    select,
+)
 from sqlalchemy.exc import IntegrityError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column
 
 from partlab.labelling import migrations
 from partlab.labelling.config import data_dir, database_url
-from partlab.labelling.video import VideoError, probe, store_by_hash
+from partlab.labelling.video import probe, store_by_hash
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import check_part
 from partlab.tracking.tracks import COLUMNS, TracksCSVError, check_table, check_value, normalise_tracks
@@ -46,7 +61,7 @@ class StaleEditError(StoreError):
 
 
 def _now() -> datetime:
-    return datetime.now(timezone.utc)
+    return datetime.now(UTC)
 
 
 class Base(DeclarativeBase):

@@ -11,6 +11,11 @@ A take folder (documented in docs/formats.md, "Takes")::
       cam0_depth/         optional depth per stream: 16-bit PNGs in mm (000000.png ...), or
       cam0_depth.npy|npz  a (T, H, W) stack in mm; 0 means unmeasured
 
+A stream's depth may instead come from a calibrated stereo pair (:mod:`partlab.labelling.stereo`):
+``{"name": "cam0", "color": "left.mp4", "stereo": {"left": "left.mp4", "right": "right.mp4",
+"right_camera": "cam0_right"}}`` with both cameras in ``calibration.json`` (``right_camera``
+defaults to ``<name>_right``); the depth is then computed per frame, aligned to the left image.
+
 Without ``take.json`` the streams are the folder's videos in name order (a folder holding only
 ``clip.mp4``, as ``partlab synth`` writes, is a one-stream take), each with ``<stem>_depth``
 beside it when present. Every stream must have the same frame count; the take's fps is the first
@@ -20,16 +25,17 @@ stream's.
 from __future__ import annotations
 
 import json
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
-from typing import Iterator, Mapping
 
 import cv2
 import numpy as np
 
 from partlab.errors import UserError
-from partlab.labelling.calibration import FILE_NAME as CALIBRATION_FILE, read_calibration
+from partlab.labelling.calibration import FILE_NAME as CALIBRATION_FILE
+from partlab.labelling.calibration import read_calibration
 from partlab.labelling.video import VIDEO_EXTENSIONS, VideoClip, is_image_sequence
 from partlab.tracking.camera import Camera
 from partlab.tracking.frame import DEFAULT_STREAM, Frame, FrameSet
@@ -42,12 +48,17 @@ class TakeError(UserError):
 
 
 class DepthSource:
-    """Depth frames of one stream, in millimetres (``float32``, NaN where unmeasured)."""
+    """Depth frames of one stream, in millimetres (``float32``, NaN where unmeasured).
+
+    Refused: 8-bit images or stacks (a byte cannot hold millimetres: it is a picture of depth,
+    not a measurement), anything not 2D per frame, and frames whose size differs from the first's.
+    """
 
     def __init__(self, path: Path):
         self.path = path
         self._stack = None
         self._files: list[Path] = []
+        self._shape: tuple[int, int] | None = None
         if path.is_dir():
             self._files = sorted(f for f in path.iterdir() if f.suffix.lower() == ".png")
             if not self._files:
@@ -65,6 +76,9 @@ class DepthSource:
         if self._stack is not None and (self._stack.ndim != 3 or self._stack.dtype.kind not in "uif"):
             raise TakeError(f"{path}: depth stack must be (frames, height, width) numbers, "
                             f"got shape {self._stack.shape} {self._stack.dtype}")
+        if self._stack is not None and self._stack.dtype.itemsize == 1:
+            raise TakeError(f"{path}: depth stack is 8-bit ({self._stack.dtype}); depth must be millimetres "
+                            f"(16-bit or float)")
 
     def __len__(self) -> int:
         return len(self._files) if self._stack is None else int(self._stack.shape[0])
@@ -80,16 +94,58 @@ class DepthSource:
             if raw.dtype != np.uint16 or raw.ndim != 2:
                 raise TakeError(f"{f}: depth PNGs must be 16-bit single-channel millimetres, "
                                 f"got {raw.dtype} with shape {raw.shape}")
+        if self._shape is None:
+            self._shape = raw.shape
+        elif raw.shape != self._shape:
+            where = self._files[index] if self._stack is None else f"{self.path} frame {index}"
+            raise TakeError(f"{where}: depth frame is {raw.shape[1]}x{raw.shape[0]}, the first was "
+                            f"{self._shape[1]}x{self._shape[0]}")
         depth = raw.astype(np.float32)
         depth[~np.isfinite(depth) | (depth <= 0)] = np.nan  # 0 = unmeasured, not near
         return depth
+
+
+class StereoDepth:
+    """Depth of one stream computed from a rectified stereo pair (:class:`~partlab.labelling.stereo.StereoRig`)."""
+
+    def __init__(self, path: Path, left: Path, right: Path, left_camera: Camera | None,
+                 right_camera: Camera | None, right_name: str):
+        from partlab.labelling.stereo import StereoRig
+
+        self.path = path
+        if left_camera is None or right_camera is None:
+            missing = right_name if right_camera is None and left_camera is not None else "the left camera"
+            raise TakeError(f"{path}: stereo depth needs both cameras calibrated; {missing} is not in "
+                            f"{CALIBRATION_FILE}")
+        self.left, self.right = VideoClip(left), VideoClip(right)
+        if self.left.frame_count != self.right.frame_count:
+            raise TakeError(f"{path}: stereo pair differs in frame count ({left.name} {self.left.frame_count}, "
+                            f"{right.name} {self.right.frame_count})")
+        for clip, cam in ((self.left, left_camera), (self.right, right_camera)):
+            if (clip.width, clip.height) != tuple(cam.size):
+                raise TakeError(f"{path}: {clip.path.name} is {clip.width}x{clip.height} but camera "
+                                f"{cam.name!r} is calibrated for {cam.size[0]}x{cam.size[1]}")
+        try:
+            self.rig = StereoRig(left_camera, right_camera)
+        except ValueError as exc:
+            raise TakeError(f"{path}: {exc}") from None
+
+    def __len__(self) -> int:
+        return self.left.frame_count
+
+    def read(self, index: int) -> np.ndarray:
+        return self.rig.depth(self.left.read(index), self.right.read(index))
+
+    def close(self) -> None:
+        self.left.close()
+        self.right.close()
 
 
 @dataclass
 class Stream:
     name: str
     color: VideoClip | None
-    depth: DepthSource | None = None
+    depth: DepthSource | StereoDepth | None = None
     camera: Camera | None = None
 
     @property
@@ -148,8 +204,10 @@ class Take:
         for s in self.streams_:
             if s.color is not None:
                 s.color.close()
+            if isinstance(s.depth, StereoDepth):
+                s.depth.close()
 
-    def __enter__(self) -> "Take":
+    def __enter__(self) -> Take:
         return self
 
     def __exit__(self, *exc) -> None:
@@ -178,9 +236,17 @@ def _stream_list(folder: Path) -> list[dict]:
         for i, s in enumerate(streams):
             if not isinstance(s, dict) or not isinstance(s.get("name", ""), str):
                 raise TakeError(f"{spec}: streams[{i}] must be an object with a 'name'")
-            if not s.get("color") and not s.get("depth"):
+            stereo = s.get("stereo")
+            if stereo is not None and (not isinstance(stereo, dict) or not stereo.get("left")
+                                       or not stereo.get("right")):
+                raise TakeError(f"{spec}: streams[{i}].stereo must be an object with 'left' and 'right' videos")
+            if stereo is not None and s.get("depth"):
+                raise TakeError(f"{spec}: streams[{i}] has both 'depth' and 'stereo'; give one")
+            if not s.get("color") and not s.get("depth") and stereo is None:
                 raise TakeError(f"{spec}: streams[{i}] has neither 'color' nor 'depth'")
-            out.append({"name": s.get("name") or f"cam{i}", "color": s.get("color"), "depth": s.get("depth")})
+            name = s.get("name") or f"cam{i}"
+            out.append({"name": name, "color": s.get("color") or (stereo or {}).get("left"),
+                        "depth": s.get("depth"), "stereo": stereo})
         return out
     videos = sorted(f for f in folder.iterdir() if f.suffix.lower() in VIDEO_EXTENSIONS and f.is_file())
     if not videos:
@@ -210,6 +276,14 @@ def open_take(path: str | PathLike) -> Take:
     for s in specs:
         color = VideoClip(p / s["color"]) if s["color"] else None
         depth = DepthSource(p / s["depth"]) if s["depth"] else None
+        if s.get("stereo"):
+            st = s["stereo"]
+            right_name = str(st.get("right_camera") or f"{s['name']}_right")
+            for key in ("left", "right"):
+                if not (p / st[key]).is_file():
+                    raise TakeError(f"{p / TAKE_FILE}: stream {s['name']!r} stereo {key} video {st[key]} not found")
+            depth = StereoDepth(p, p / st["left"], p / st["right"], cameras.get(s["name"]),
+                                cameras.get(right_name), right_name)
         streams.append(Stream(s["name"], color, depth, cameras.get(s["name"])))
     take = Take(p, streams, fps=next((s.color.fps for s in streams if s.color is not None), 25.0))
     _check_consistent(take)

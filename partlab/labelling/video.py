@@ -19,10 +19,10 @@ import hashlib
 import re
 import shutil
 import zipfile
+from collections.abc import Iterator
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import Iterator
 
 import cv2
 import numpy as np
@@ -279,7 +279,7 @@ class VideoClip:
         if self._files is not None:
             self._files.close()
 
-    def __enter__(self) -> "VideoClip":
+    def __enter__(self) -> VideoClip:
         return self
 
     def __exit__(self, *exc) -> None:

@@ -33,7 +33,7 @@ import math
 import re
 import zipfile
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from importlib import resources
 from os import PathLike
 from pathlib import Path
@@ -140,7 +140,7 @@ def save_bundle(bundle: Bundle, path: str | PathLike) -> Path:
     manifest = _json_safe({
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
-        "created": bundle.created or datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "created": bundle.created or datetime.now(UTC).isoformat(timespec="seconds"),
         "params": {key: p.to_dict() for key, p in bundle.params.items()},
         "detector": detector,
         "summary": bundle.summary,
@@ -313,7 +313,8 @@ def load_bundle(path: str | PathLike) -> Bundle:
                            for k in ("intercept", "gamma", "threshold")}
                 bad = [k for k, v in numbers.items() if not math.isfinite(v)]
                 if bad:
-                    raise BundleError(f"{root / MANIFEST}: SVM {name!r} {bad[0]} is {meta[bad[0]]!r}, not a finite number")
+                    raise BundleError(f"{root / MANIFEST}: SVM {name!r} {bad[0]} is {meta[bad[0]]!r}, "
+                                      "not a finite number")
                 arrays = _load_arrays(root / meta["file"])
                 models[name] = SVMModel(
                     kernel=str(meta["kernel"]), intercept=float(meta["intercept"]),

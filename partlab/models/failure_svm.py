@@ -33,8 +33,8 @@ evaluated in numpy, so a model bundle never has to unpickle anything.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Callable
 
 import numpy as np
 
@@ -87,7 +87,7 @@ class SVMModel:
                              f"{self.support_vectors.shape}, {self.dual_coef.shape}")
 
     @classmethod
-    def from_pipeline(cls, pipeline, threshold: float = 0.0) -> "SVMModel":
+    def from_pipeline(cls, pipeline, threshold: float = 0.0) -> SVMModel:
         """Arrays of a fitted ``Pipeline([("scale", StandardScaler), ("svc", SVC)])``."""
         scaler, svc = pipeline.named_steps["scale"], pipeline.named_steps["svc"]
         # sklearn's binary dual_coef_/intercept_ are signed so that positive = classes_[1].
@@ -149,7 +149,7 @@ class SVMReport:
         return d
 
     @classmethod
-    def from_dict(cls, d: dict) -> "SVMReport":
+    def from_dict(cls, d: dict) -> SVMReport:
         d = dict(d)
         d["confusion"] = tuple(tuple(int(v) for v in r) for r in d.get("confusion", ((0, 0), (0, 0))))
         return cls(**d)

@@ -4,10 +4,9 @@ Seed 002 sec. 4.2: "The state vectors not covering the target body part are labe
 as negative, while those falling inside are labeled as positive. The samples not
 satisfying these two criteria are eliminated". Here a tracked box is
 
-* **on** its part (label 1) when at least ``on_part`` (0.5) of its area lies inside the
-  corrected box and its centre is inside it: seed 002 sec. 5.2 counts a box as right
-  when less than half of it covers other things, and the evaluation also asks for
-  the centre (DESIGN.md);
+* **on** its part (label 1) when it is right by :func:`partlab.tracking.measures.right_box`
+  with ``on_part`` (0.5) as the cover: at least half of its area inside the corrected box and
+  its centre inside it (Zhao & Lee sec. 5.2, the same rule the evaluation uses);
 * **off** (label 0) when less than ``off_part`` (0.2) of it lies inside the corrected
   box: it clearly covers something else;
 * in between: dropped (label -1), so the two classes stay separable.
@@ -24,6 +23,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.models.features import BODY_PARTS
+from partlab.tracking import measures
 
 POSITIVE, NEGATIVE, DROPPED = 1, 0, -1
 #: Names of the four SVMs: one per part (tracked or not) and single vs multi-part failure.
@@ -42,31 +42,23 @@ class LabelRule:
             raise ValueError(f"need 0 <= off_part < on_part <= 1, got {self.off_part}, {self.on_part}")
 
 
+def _xywh(centred: np.ndarray) -> np.ndarray:
+    """``[cx, cy, w, h]`` -> ``[x, y, w, h]`` (the failure features' states are centred)."""
+    b = np.asarray(centred, dtype=np.float64)
+    return np.concatenate([b[..., :2] - b[..., 2:4] / 2, b[..., 2:4]], axis=-1)
+
+
 def inside_fraction(boxes: np.ndarray, truth: np.ndarray) -> np.ndarray:
     """Fraction of each ``[cx, cy, w, h]`` box's area inside the matching truth box
-    (``(..., 4)`` each; a box of zero area counts as 0)."""
-    b = np.asarray(boxes, dtype=np.float64)
-    t = np.asarray(truth, dtype=np.float64)
-    bx0, by0 = b[..., 0] - b[..., 2] / 2, b[..., 1] - b[..., 3] / 2
-    tx0, ty0 = t[..., 0] - t[..., 2] / 2, t[..., 1] - t[..., 3] / 2
-    iw = np.clip(np.minimum(bx0 + b[..., 2], tx0 + t[..., 2]) - np.maximum(bx0, tx0), 0, None)
-    ih = np.clip(np.minimum(by0 + b[..., 3], ty0 + t[..., 3]) - np.maximum(by0, ty0), 0, None)
-    area = b[..., 2] * b[..., 3]
-    return np.where(area > 0, iw * ih / np.where(area > 0, area, 1.0), 0.0)
-
-
-def centre_inside(boxes: np.ndarray, truth: np.ndarray) -> np.ndarray:
-    """Whether each box's centre lies inside the matching truth box (edges included)."""
-    b = np.asarray(boxes, dtype=np.float64)
-    t = np.asarray(truth, dtype=np.float64)
-    return (np.abs(b[..., 0] - t[..., 0]) <= t[..., 2] / 2) & (np.abs(b[..., 1] - t[..., 1]) <= t[..., 3] / 2)
+    (``(..., 4)`` each; a box of zero area counts as 0): :func:`partlab.tracking.measures.cover_fraction`."""
+    return measures.cover_fraction(_xywh(boxes), _xywh(truth))
 
 
 def label_states(states: np.ndarray, truth: np.ndarray, rule: LabelRule = LabelRule()) -> np.ndarray:
     """Labels (1 on, 0 off, -1 dropped) of ``(..., 4)`` ``[cx, cy, w, h]`` boxes against truth."""
-    frac = inside_fraction(states, truth)
-    on = (frac >= rule.on_part) & centre_inside(states, truth)
-    off = frac < rule.off_part
+    b, t = _xywh(states), _xywh(truth)
+    on = measures.right_box(b, t, min_cover=rule.on_part)
+    off = measures.cover_fraction(b, t) < rule.off_part
     return np.where(on, POSITIVE, np.where(off, NEGATIVE, DROPPED)).astype(np.int8)
 
 

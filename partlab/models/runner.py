@@ -9,7 +9,7 @@ goes straight to the body tracker (training's results predate the registry's see
 
 from __future__ import annotations
 
-from typing import Callable, Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pandas as pd

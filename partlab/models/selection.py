@@ -16,22 +16,22 @@ The detector is kept unless it *lowers* that rate: it changes nothing until it f
 part, so a tie means it raised no false alarm that cost a right box, while the failures
 it exists to repair (a part stuck on a look-alike, a bending person) may simply be absent
 from the training clips (measured: the shipped bundle's clips hardly fail, yet its
-detector raised the head rate on the bending walker it never saw; README). The rate is seed 002
-sec. 5.2's: a box is right when at least half of it lies on the true box and its centre
-is inside it (:func:`partlab.models.labels.label_states`), averaged over every frame after a
-track's first, per clip, then over clips.
+detector raised the head rate on the bending walker it never saw; README). The rate is Zhao &
+Lee's averaged tracking rate (:func:`partlab.tracking.measures.part_rates`: the right box of
+sec. 5.2, the rate curve of sec. 5.3 averaged over the offsets after each track's first frame),
+per clip, then over clips.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 import pandas as pd
 
 from partlab.models.features import BODY_PARTS
-from partlab.models.labels import POSITIVE, label_states
+from partlab.tracking import measures
 from partlab.tracking.params import BodyParams
 
 #: ``run(clip_index, params, detector) -> tracks DataFrame`` of the body tracker on a training clip.
@@ -41,35 +41,10 @@ COMPONENTS: tuple[str, ...] = ("noise", "extent", "detector")
 _FIELDS = {"noise": ("dynamics.noise",), "extent": ("output.extent",)}
 
 
-def _centre_boxes(d: pd.DataFrame, sfx: str) -> np.ndarray:
-    return np.stack([d["x" + sfx] + d["w" + sfx] / 2, d["y" + sfx] + d["h" + sfx] / 2, d["w" + sfx], d["h" + sfx]],
-                    axis=1)
-
-
-def right_after_start(tracks: pd.DataFrame, truth: pd.DataFrame, part: str) -> pd.DataFrame:
-    """The truth rows of ``part`` after each track's first frame (``f0``), each with ``right``:
-    whether the tracker's box there is right (a missing tracked box counts as wrong)."""
-    first = truth.groupby("track_id")["frame"].min().rename("f0")
-    t = truth[truth.part == part].join(first, on="track_id")
-    t = t[t.frame > t.f0]
-    r = tracks[tracks.part == part][["track_id", "frame", "x", "y", "w", "h"]]
-    m = t.merge(r, on=["track_id", "frame"], how="left", suffixes=("_t", ""))
-    have = m["x"].notna().to_numpy()
-    ok = np.zeros(len(m), bool)
-    if have.any():
-        mm = m[have]
-        ok[have] = label_states(_centre_boxes(mm, ""), _centre_boxes(mm, "_t")) == POSITIVE
-    return m.assign(right=ok)
-
-
 def part_rates(tracks: pd.DataFrame, truth: pd.DataFrame) -> dict[str, float]:
-    """Per part, the fraction of truth boxes after each track's first frame that the
-    tracker got right (no truth -> nan)."""
-    out = {}
-    for part in BODY_PARTS:
-        m = right_after_start(tracks, truth, part)
-        out[part] = float(m.right.mean()) if len(m) else float("nan")
-    return out
+    """Per body part, the averaged tracking rate of ``tracks`` against ``truth`` (same track
+    ids; :func:`partlab.tracking.measures.part_rates`; no truth -> nan)."""
+    return measures.part_rates(tracks, truth, BODY_PARTS)
 
 
 def mean_rates(per_clip: list[dict[str, float]]) -> dict[str, float]:
@@ -183,7 +158,7 @@ def selection_table(selection: dict) -> str:
             "start" if name == "builtin" and selection.get("started_from") == "a bundle" else name
         rows.append(dict(condition=label, **{k: round(s[k], 3) for k in (*BODY_PARTS, "mean") if k in s},
                          decision=decision))
-    for comp, k in selection.get("kept", {}).items():
+    for comp in selection.get("kept", {}):
         if f"+{comp}" not in scores:
             rows.append(dict(condition=f"+{comp}", decision="not fitted"))
     return pd.DataFrame(rows).to_string(index=False, na_rep="-") if rows else "(no validation)"

@@ -17,7 +17,7 @@ more than ``max_occluded`` are skipped (their colours are someone else's).
 
 from __future__ import annotations
 
-from typing import Callable, Iterator
+from collections.abc import Callable, Iterator
 
 import numpy as np
 import pandas as pd
@@ -46,9 +46,10 @@ def fit_lam(d2: np.ndarray) -> float:
 
 
 def colour_distances(frames: Callable[[], Iterator[tuple[int, np.ndarray]]], truth: pd.DataFrame,
-                     params: BodyParams = BodyParams(), stride: int = 1,
+                     params: BodyParams | None = None, stride: int = 1,
                      max_occluded: float = 0.2) -> dict[str, np.ndarray]:
     """Squared Bhattacharyya distances of every part's corrected box to its running reference."""
+    params = params or BodyParams()
     from partlab.tracking.core import histogram as H  # the body tracker's observation model
 
     truth = truth[truth["part"].isin(SHARPNESS_PARTS)]

@@ -26,14 +26,14 @@ scores and decisions.
 
 from __future__ import annotations
 
-from dataclasses import replace
-from typing import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 
 from partlab.models.bundle import Bundle
-from partlab.models.failure_svm import SVMFailureDetector, TNR_TARGETS, train_failure_svms
+from partlab.models.failure_svm import TNR_TARGETS, SVMFailureDetector, train_failure_svms
 from partlab.models.features import BODY_PARTS, DEFAULT_DT, features_from_tracks, person_histories
 from partlab.models.labels import NEGATIVE, POSITIVE, SVM_NAMES, label_tracks, labels_for_keys
 from partlab.models.perturb import PerturbConfig, perturbed_samples
@@ -127,27 +127,56 @@ def _apply_lam(body: BodyParams, table: pd.DataFrame,
     return body.updated({"dynamics.noise": noise}), table
 
 
-def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], None] | None = None,
-                 tracker_runner: TrackerRunner | None = None, names: Iterable[str] | None = None,
-                 perturbed_per_person: int = 300, body: BodyParams | None = None,
-                 limb: LimbParams | None = None, dt: float = DEFAULT_DT,
-                 fit_sharpness: bool | None = None, validate: bool = True, start=None) -> Bundle:
+@dataclass(frozen=True)
+class TrainingOptions:
+    """How :func:`train_bundle` trains (everything but the data and where it starts).
+
+    ``seed``: the random stream of perturbation and SVM cross-validation (clip ``i`` is tracked
+    with ``seed + i``); ``perturbed_per_person``: simulated failures per person and clip;
+    ``dt``: the failure features' time step (Zhao & Lee sec. 4.2: 0.5 s); ``fit_sharpness``
+    (None: when available) decodes each clip once more to fit ``lam``; ``validate`` (with a
+    tracker): keep each fitted component only if it does not lower the tracking rate on the
+    training clips (:func:`partlab.models.selection.select_components`; up to three more tracker
+    runs per clip); without it, everything fitted is used."""
+
+    seed: int = 0
+    perturbed_per_person: int = 300
+    dt: float = DEFAULT_DT
+    fit_sharpness: bool | None = None
+    validate: bool = True
+
+
+@dataclass
+class _Samples:
+    """What the clips gave: SVM samples, clean truths, per-clip records, tracker runs, colour distances."""
+
+    xs: list = field(default_factory=list)
+    ys: list = field(default_factory=list)
+    truths: list = field(default_factory=list)
+    clip_info: list = field(default_factory=list)
+    tracked_runs: list = field(default_factory=list)
+    counts: dict = field(default_factory=lambda: {"tracker": 0, "human_flags": 0, "perturbed": 0})
+    d2: dict = field(default_factory=dict)
+
+
+def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
+                 progress: Callable[[str], None] | None = None, tracker_runner: TrackerRunner | None = None,
+                 names: Iterable[str] | None = None, start=None, body: BodyParams | None = None,
+                 limb: LimbParams | None = None, **option_values) -> Bundle:
     """Fit the four failure SVMs and the variance parameters from corrected clips.
 
     ``clips``: ``(frames_factory, fps, truth_df)`` each; ``frames_factory()`` yields
     ``(index, frame)``. Without ``tracker_runner`` (or where it fails on a clip) only
     perturbed-truth and hand-flag samples are used; the summary records how many of
-    each. ``progress`` is called once per step with a short description.
-    ``fit_sharpness`` (default: when available) decodes each clip once more to fit ``lam``.
-    ``validate`` (with ``tracker_runner``): keep each fitted component only if it does not
-    lower the tracking rate on the training clips (:func:`partlab.models.selection.select_components`;
-    up to three more tracker runs per clip); without it, everything fitted is used.
+    each. ``progress`` is called once per step with a short description. ``options``
+    (:class:`TrainingOptions`; its fields may also be given as keywords: ``seed=3``).
     ``start``: the bundle training starts from (e.g. :func:`partlab.models.bundle.default_bundle`):
     its body parameters are the defaults the fits widen, and validation starts from its
     parameters *and* its failure detector, which the new detector replaces only if that does
     not lower the rate, so retraining never scores below ``start`` on the training clips.
-    None: the built-in parameters without a detector.
+    None: the built-in parameters without a detector (or ``body`` / ``limb``).
     """
+    opts = replace(options or TrainingOptions(), **option_values)
     if not clips:
         raise ValueError("no clips to train from")
     start_detector = None
@@ -158,117 +187,146 @@ def train_bundle(clips: list[Clip], seed: int = 0, progress: Callable[[str], Non
     names = list(names) if names is not None else [f"clip{i}" for i in range(len(clips))]
     if len(names) != len(clips):
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
-    rng = np.random.default_rng(seed)
+    if opts.fit_sharpness is None:
+        opts = replace(opts, fit_sharpness=sharpness_available())
     step = progress or (lambda _msg: None)
-    xs, ys, truths, clip_info, tracked_runs = [], [], [], [], []
-    counts = {"tracker": 0, "human_flags": 0, "perturbed": 0}
-    if fit_sharpness is None:
-        fit_sharpness = sharpness_available()
-    d2: dict[str, list[np.ndarray]] = {}
+    rng = np.random.default_rng(opts.seed)
+    got = _Samples()
     for i, ((factory, fps, truth), name) in enumerate(zip(clips, names)):
-        truth_clean, _ = split_human_flags(truth)
-        truths.append(truth_clean)
-        info = {"name": name, "fps": float(fps), "people": int(truth_clean["track_id"].nunique()),
-                "frames": int(truth_clean["frame"].nunique())}
-        if tracker_runner is not None:
-            step(f"tracking {name}")
-            tracked = tracker_runner(factory, fps, first_boxes(truth_clean), seed + i)
-            tracked_runs.append((tracked, truth_clean))
-            x, y = tracker_samples(tracked, truth_clean, fps, dt)
-            xs.append(x), ys.append(y)
-            counts["tracker"] += len(x)
-            info["tracker_samples"] = len(x)
-            info["tracker_failures"] = int(np.sum(np.any(y == NEGATIVE, axis=1)))
-        if fit_sharpness:
-            from partlab.models.sharpness import colour_distances
-            step(f"colours of {name}")
-            for part, values in colour_distances(factory, truth_clean, body or BodyParams()).items():
-                d2.setdefault(part, []).append(values)
-        step(f"samples of {name}")
-        x, y = human_flag_samples(truth, fps, dt)
-        xs.append(x), ys.append(y)
-        counts["human_flags"] += len(x)
-        n_pert = 0
-        true_hist = person_histories(truth_clean)
-        if tracker_runner is not None:
-            # failures simulated on the tracker's own boxes (its geometry), labelled against the truth
-            for tid, (frames, hist) in person_histories(tracked).items():
-                aligned = np.full(hist.shape, np.nan)
-                if tid in true_hist:
-                    tf, th = true_hist[tid]
-                    pos = np.searchsorted(tf, frames)
-                    hit = (pos < len(tf)) & (tf[np.minimum(pos, len(tf) - 1)] == frames)
-                    aligned[hit] = th[pos[hit]]
-                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt,
-                                         truth=aligned)
-                xs.append(x), ys.append(y)
-                n_pert += len(x)
-        else:
-            for _tid, (frames, hist) in true_hist.items():
-                x, y = perturbed_samples(frames, hist, fps, perturbed_per_person, rng, PerturbConfig(), dt=dt)
-                xs.append(x), ys.append(y)
-                n_pert += len(x)
-        counts["perturbed"] += n_pert
-        clip_info.append(info)
-    x_all = np.concatenate(xs, axis=0)
-    y_all = np.concatenate(ys, axis=0)
+        _clip_samples(got, i, factory, fps, truth, name, opts, rng, step, tracker_runner, body)
+    x_all = np.concatenate(got.xs, axis=0)
+    y_all = np.concatenate(got.ys, axis=0)
     if len(x_all) == 0:
         raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
-    models, reports = train_failure_svms(x_all, y_all, seed=seed, progress=lambda n: step(f"SVM {n}"))
-    step("variance parameters")
-    # the tracker's prediction errors are not used for the noise (measured worse, see partlab.models.variance)
-    body_p, limb_p, table = fit_variances(truths, body, limb)
-    if fit_sharpness:
-        body_p, table = _apply_lam(body_p, table, d2)
-    if tracked_runs:
-        from partlab.models.extent import fit_output_extent
-
-        step("output extent")
-        current = (body or BodyParams()).output.extent
-        body_p = body_p.updated({"output.extent": fit_output_extent([t for t, _ in tracked_runs],
-                                                                       [g for _, g in tracked_runs], current)})
-    detector = SVMFailureDetector(models, dt=dt) if models else None
+    models, reports = train_failure_svms(x_all, y_all, seed=opts.seed, progress=lambda n: step(f"SVM {n}"))
+    body_p, limb_p, table = _fit_parameters(got, body, limb, opts, step)
+    detector = SVMFailureDetector(models, dt=opts.dt) if models else None
     selection = None
-    if tracked_runs and validate:
-        from partlab.models.selection import select_components
-
-        base = body or BodyParams()
-        inits = [first_boxes(g) for g in truths]
-
-        def run(i, params, det):
-            return tracker_runner(clips[i][0], clips[i][1], inits[i], seed + i, params=params, failure_detector=det)
-
-        fitted = base.updated({"dynamics.noise": body_p.dynamics.noise, "output.extent": body_p.output.extent})
-        chosen = select_components(run, truths, base, fitted, detector,
-                                   base_tracks=[t for t, _ in tracked_runs] if body is None else None,
-                                   progress=step, base_detector=start_detector)
-        body_p = body_p.updated({"dynamics.noise": chosen.body_params.dynamics.noise,
-                                 "output.extent": chosen.body_params.output.extent})
-        new_detector = detector
-        detector = chosen.failure_detector
-        selection = chosen.to_dict()
-        selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output.extent.items()}
-        selection["started_from"] = "a bundle" if start is not None else "built-in"
-        selection["start_detector"] = start_detector is not None
-        selection["detector"] = ("new" if detector is not None and detector is new_detector else
-                                 "start's" if detector is not None else "none")
-        if not chosen.kept["noise"]:  # the table's "applied" says what the bundle uses
-            body_rows = table["tracker"] == "body"
-            table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]
+    if got.tracked_runs and opts.validate:
+        body_p, detector, table, selection = _validate(clips, got, body, body_p, detector, table, opts, step,
+                                                       tracker_runner, start, start_detector)
     summary = {
-        "seed": seed,
-        "clips": clip_info,
-        "samples": {**counts, "total": int(len(x_all))},
+        "seed": opts.seed,
+        "clips": got.clip_info,
+        "samples": {**got.counts, "total": int(len(x_all))},
         "svms": {n: r.to_dict() for n, r in reports.items()},
         "tnr_targets": dict(TNR_TARGETS),
         "thresholds": {n: r.threshold for n, r in reports.items()},
         "variances": table.to_dict(orient="records"),
         "output_extent": {k: list(v) for k, v in body_p.output.extent.items()},
-        "notes": [] if fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
+        "notes": [] if opts.fit_sharpness else ["lam (colour likelihood sharpness) not fitted: defaults kept"],
     }
     if selection is not None:
         summary["selection"] = selection
     return Bundle(body_p, limb_p, detector, summary)
+
+
+def _clip_samples(got: _Samples, i: int, factory: FramesFactory, fps: float, truth: pd.DataFrame, name: str,
+                  opts: TrainingOptions, rng: np.random.Generator, step, tracker_runner, body) -> None:
+    """One clip's samples: the tracker's own output labelled against the truth, the colour
+    distances for ``lam``, the hand-set flags and perturbed states (see the module docstring)."""
+    truth_clean, _ = split_human_flags(truth)
+    got.truths.append(truth_clean)
+    info = {"name": name, "fps": float(fps), "people": int(truth_clean["track_id"].nunique()),
+            "frames": int(truth_clean["frame"].nunique())}
+    tracked = None
+    if tracker_runner is not None:
+        step(f"tracking {name}")
+        tracked = tracker_runner(factory, fps, first_boxes(truth_clean), opts.seed + i)
+        got.tracked_runs.append((tracked, truth_clean))
+        x, y = tracker_samples(tracked, truth_clean, fps, opts.dt)
+        got.xs.append(x)
+        got.ys.append(y)
+        got.counts["tracker"] += len(x)
+        info["tracker_samples"] = len(x)
+        info["tracker_failures"] = int(np.sum(np.any(y == NEGATIVE, axis=1)))
+    if opts.fit_sharpness:
+        from partlab.models.sharpness import colour_distances
+        step(f"colours of {name}")
+        for part, values in colour_distances(factory, truth_clean, body or BodyParams()).items():
+            got.d2.setdefault(part, []).append(values)
+    step(f"samples of {name}")
+    x, y = human_flag_samples(truth, fps, opts.dt)
+    got.xs.append(x)
+    got.ys.append(y)
+    got.counts["human_flags"] += len(x)
+    n_pert = 0
+    for x, y in _perturbed(truth_clean, tracked, fps, opts, rng):
+        got.xs.append(x)
+        got.ys.append(y)
+        n_pert += len(x)
+    got.counts["perturbed"] += n_pert
+    got.clip_info.append(info)
+
+
+def _perturbed(truth: pd.DataFrame, tracked: pd.DataFrame | None, fps: float, opts: TrainingOptions,
+               rng: np.random.Generator) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    """Simulated failures: on the tracker's own boxes (its geometry) labelled against the truth
+    when it ran, else on the truth."""
+    true_hist = person_histories(truth)
+    if tracked is None:
+        for _tid, (frames, hist) in true_hist.items():
+            yield perturbed_samples(frames, hist, fps, opts.perturbed_per_person, rng, PerturbConfig(), dt=opts.dt)
+        return
+    for tid, (frames, hist) in person_histories(tracked).items():
+        aligned = np.full(hist.shape, np.nan)
+        if tid in true_hist:
+            tf, th = true_hist[tid]
+            pos = np.searchsorted(tf, frames)
+            hit = (pos < len(tf)) & (tf[np.minimum(pos, len(tf) - 1)] == frames)
+            aligned[hit] = th[pos[hit]]
+        yield perturbed_samples(frames, hist, fps, opts.perturbed_per_person, rng, PerturbConfig(), dt=opts.dt,
+                                truth=aligned)
+
+
+def _fit_parameters(got: _Samples, body, limb, opts: TrainingOptions, step):
+    """Variance parameters from the truth, ``lam`` from the frames, the output extent from the
+    tracker's runs: ``(BodyParams, LimbParams, table)``."""
+    step("variance parameters")
+    # the tracker's prediction errors are not used for the noise (measured worse, see partlab.models.variance)
+    body_p, limb_p, table = fit_variances(got.truths, body, limb)
+    if opts.fit_sharpness:
+        body_p, table = _apply_lam(body_p, table, got.d2)
+    if got.tracked_runs:
+        from partlab.models.extent import fit_output_extent
+
+        step("output extent")
+        current = (body or BodyParams()).output.extent
+        body_p = body_p.updated({"output.extent": fit_output_extent([t for t, _ in got.tracked_runs],
+                                                                    [g for _, g in got.tracked_runs], current)})
+    return body_p, limb_p, table
+
+
+def _validate(clips, got: _Samples, body, body_p: BodyParams, detector, table: pd.DataFrame, opts: TrainingOptions,
+              step, tracker_runner, start, start_detector):
+    """Keep each fitted component only where it does not lower the rate on the training clips
+    (:mod:`partlab.models.selection`): ``(body params, detector, table, selection record)``."""
+    from partlab.models.selection import select_components
+
+    base = body or BodyParams()
+    inits = [first_boxes(g) for g in got.truths]
+
+    def run(i, params, det):
+        return tracker_runner(clips[i][0], clips[i][1], inits[i], opts.seed + i, params=params, failure_detector=det)
+
+    fitted = base.updated({"dynamics.noise": body_p.dynamics.noise, "output.extent": body_p.output.extent})
+    chosen = select_components(run, got.truths, base, fitted, detector,
+                               base_tracks=[t for t, _ in got.tracked_runs] if body is None else None,
+                               progress=step, base_detector=start_detector)
+    body_p = body_p.updated({"dynamics.noise": chosen.body_params.dynamics.noise,
+                             "output.extent": chosen.body_params.output.extent})
+    new_detector = detector
+    detector = chosen.failure_detector
+    selection = chosen.to_dict()
+    selection["fitted_output_extent"] = {k: list(v) for k, v in fitted.output.extent.items()}
+    selection["started_from"] = "a bundle" if start is not None else "built-in"
+    selection["start_detector"] = start_detector is not None
+    selection["detector"] = ("new" if detector is not None and detector is new_detector else
+                             "start's" if detector is not None else "none")
+    if not chosen.kept["noise"]:  # the table's "applied" says what the bundle uses
+        body_rows = table["tracker"] == "body"
+        table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]
+    return body_p, detector, table, selection
 
 
 def iterate_frames(frames: np.ndarray) -> FramesFactory:

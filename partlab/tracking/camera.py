@@ -101,7 +101,7 @@ class Camera:
                 "dist": self.dist.tolist(), "R": self.R.tolist(), "t": self.t.tolist()}
 
     @classmethod
-    def from_dict(cls, data: dict, name: str | None = None) -> "Camera":
+    def from_dict(cls, data: dict, name: str | None = None) -> Camera:
         """From :meth:`to_dict`'s form; ``rvec`` (Rodrigues, 3 numbers) may stand for ``R``."""
         if not isinstance(data, dict):
             raise ValueError(f"camera {name!r}: expected an object, got {type(data).__name__}")

@@ -12,8 +12,9 @@ length), ``NaN`` where the sensor measured nothing (a 16-bit PNG's 0 is *missing
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Iterator, Mapping, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -62,7 +63,7 @@ class FrameSet:
 
     @classmethod
     def single(cls, index: int, color: np.ndarray | None, depth: np.ndarray | None = None,
-               stream: str = DEFAULT_STREAM, camera: Camera | None = None) -> "FrameSet":
+               stream: str = DEFAULT_STREAM, camera: Camera | None = None) -> FrameSet:
         return cls(index, {stream: Frame(index, color, depth, stream, camera)})
 
 

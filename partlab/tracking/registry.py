@@ -104,6 +104,7 @@ def params_class(key: str) -> type:
 register_parameters(ParameterEntry("body", "partlab.tracking.body.params:BodyParams", rng_slot=0))
 register_parameters(ParameterEntry("limbs", "partlab.tracking.limbs.params:LimbParams", rng_slot=1))
 register_parameters(ParameterEntry("activities", "partlab.tracking.activities.params:ActivityParams", rng_slot=9))
+register_parameters(ParameterEntry("depth", "partlab.tracking.depth.params:DepthParams", rng_slot=16))  # 16: the issue number, clear of the other trackers' slots
 
 register(TrackerEntry(
     "body", "head, torso and hip-leg of every person, plus the person box (Zhao & Lee)",
@@ -119,3 +120,8 @@ register(TrackerEntry(
 register(TrackerEntry(
     "whole", "one box per person (Zhao & Lee's whole-body baseline, Fig. 4(d))",
     "partlab.tracking.body:build_whole", ("body",), ("person",)))
+register(TrackerEntry(
+    "limbs-depth", "face and both hands of one person with depth, plus 3D shoulders and elbows (Xu, Deng & Jia)",
+    "partlab.tracking.depth:build", ("depth",),
+    ("head", "left_hand", "right_hand", "torso", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow"),
+    needs=frozenset({"color", "depth"}), foreground=False))

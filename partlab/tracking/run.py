@@ -11,8 +11,9 @@ parameters draws from its own fixed stream of the seed (:mod:`partlab.tracking.r
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable, Mapping
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -21,8 +22,8 @@ from partlab.errors import UserError
 from partlab.tracking import registry
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.frame import FrameSet, TakeSource
-from partlab.tracking.protocol import TrackContext, Tracker
-from partlab.tracking.tracks import TracksCSVError, TrackRecord, empty_tracks, normalise_tracks
+from partlab.tracking.protocol import SingleView, TrackContext, Tracker
+from partlab.tracking.tracks import TrackRecord, TracksCSVError, empty_tracks, normalise_tracks
 
 Progress = Callable[[int, int], None]
 
@@ -69,6 +70,23 @@ def build_tracker(name: str, *, model: Any = None, seed: int = 0, context: Track
     params = {k: model_params(model, k) for k in entry.param_keys}
     rngs = dict(rngs) if rngs is not None else seeded_streams(seed, entry.param_keys)
     return registry.load(entry.factory)(params, rngs, context or TrackContext())
+
+
+def frame_sets(frames: Iterable) -> Iterable[FrameSet]:
+    """One-stream frame sets from in-memory BGR frames (``(H, W, 3) uint8`` arrays, indexed from
+    0, or ``(index, array)`` pairs), for synthetic scenes and benchmarks."""
+    for i, item in enumerate(frames):
+        index, color = item if isinstance(item, tuple) else (i, item)
+        yield FrameSet.single(int(index), color)
+
+
+def run_single_view(tracker: Any, frames: Iterable, background: Any = None,
+                    progress: Progress | None = None) -> pd.DataFrame:
+    """:func:`run_frames` for a single-view tracker (``BodyTracker``, ``LimbTracker``) over
+    in-memory frames (:func:`frame_sets`); ``background``: the model whose ``apply(frame)`` gives
+    the foreground mask (one per run), or None for no mask."""
+    factory = (lambda _stream: background) if background is not None else None
+    return run_frames(SingleView(tracker, tracker.params), frame_sets(frames), factory, progress)
 
 
 def run_frames(tracker: Tracker, frames: Iterable[FrameSet], background: Callable[[str], Any] | None = None,

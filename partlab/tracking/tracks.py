@@ -145,99 +145,37 @@ def check_value(col: str, value, where: str, coord_limit: float | None = None, t
     and the store: ``value`` (text as in the CSV, or a number/bool from a JSON or XML file) as the
     column's type, or a :class:`TracksCSVError` naming ``where`` and the value.
 
-    Frames and ids are whole numbers in 0..2**31-1; ``x, y, w, h, X, Y, Z`` finite and within
-    ``PARTLAB_MAX_COORD`` (``w, h`` not negative); ``score`` not infinite; ``occluded`` in [0, 1];
-    ``failure`` a boolean (``"false"`` is False); booleans, lists and objects are not numbers.
+    Numbers are checked as the CSV reader checks their text (:func:`_parse_cell`: frames and ids
+    whole in 0..2**31-1; ``x, y, w, h, X, Y, Z`` finite within ``PARTLAB_MAX_COORD``, sizes not
+    negative; ``score`` not infinite; ``occluded`` in [0, 1]; ``failure`` a boolean, ``"false"``
+    being False). Booleans, lists and objects are not numbers; a NaN ``X, Y, Z`` is "unknown".
     With ``text_numbers=False`` (JSON files, whose numbers are numbers) text is refused for the
     frame and the box.
     """
     if coord_limit is None:
         coord_limit = max_coord()
+    numeric = col in INT_COLUMNS or col in FLOAT_COLUMNS
     if isinstance(value, str):
-        cell = value.strip()
         if not text_numbers and col in ("frame", "x", "y", "w", "h"):
             raise TracksCSVError(f"{where}: {_short(value)} is text, not a number")
+        cell = value.strip()
     elif value is None:
         cell = ""
     elif isinstance(value, bool):
-        if col == "failure":
-            return value
-        if col in INT_COLUMNS or col in FLOAT_COLUMNS:
+        if numeric:
             raise TracksCSVError(f"{where}: {value!r} is a boolean, not a number")
         cell = str(value).lower()
-    elif isinstance(value, (int, float)) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0):
-        cell = None  # a number already
+    elif isinstance(value, int) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0
+                                    and value.dtype.kind in "iub"):
+        cell = str(int(value))
+    elif isinstance(value, float) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0
+                                      and value.dtype.kind == "f"):
+        if math.isnan(value) and col in ("X", "Y", "Z"):
+            return float("nan")  # an unknown 3D position
+        cell = repr(float(value))
     else:
         raise TracksCSVError(f"{where}: {_short(value)} is not a single value")
-    if col in INT_COLUMNS:
-        if cell is not None:
-            try:
-                number = int(cell)
-            except ValueError:
-                try:
-                    number = float(cell)
-                except ValueError:
-                    raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
-        else:
-            number = value
-        if isinstance(number, float) or not isinstance(number, int):
-            number = float(number)
-            if not number.is_integer():
-                raise TracksCSVError(f"{where}: {_short(value)} is not an integer")
-            if abs(number) > 2.0 ** 63:
-                raise TracksCSVError(f"{where}: {_short(value)} is larger than the limit of {MAX_ID}")
-            number = int(number)
-        if number < 0:
-            raise TracksCSVError(f"{where}: {number} is negative")
-        if number > MAX_ID:
-            raise TracksCSVError(f"{where}: {number} is larger than the limit of {MAX_ID}")
-        return number
-    if col == "part":
-        part = cell if cell is not None else str(value)
-        if part not in PART_NAMES:
-            raise TracksCSVError(f"{where}: unknown part {part!r}; expected one of {', '.join(PART_NAMES)}")
-        return part
-    if col in FLOAT_COLUMNS:
-        if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
-            return DEFAULTS[col]
-        if cell is not None:
-            try:
-                number = float(cell)
-            except ValueError:
-                raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
-        else:
-            try:
-                number = float(value)
-            except OverflowError:
-                raise TracksCSVError(f"{where}: {_short(value)} is not a finite number") from None
-        shown = cell if cell is not None else _short(value)
-        if col in COORD_COLUMNS:
-            if math.isnan(number) and col in ("X", "Y", "Z"):
-                return number  # an unknown 3D position
-            if not math.isfinite(number):
-                raise TracksCSVError(f"{where}: {shown!r} is not a finite number")
-            if abs(number) > coord_limit:
-                raise TracksCSVError(f"{where}: {shown!r} is beyond the limit of {coord_limit:g} "
-                                     "(set PARTLAB_MAX_COORD to change it)")
-        if col == "score" and math.isinf(number):
-            raise TracksCSVError(f"{where}: {shown!r} is not a finite number")
-        if col == "occluded" and not 0.0 <= number <= 1.0:
-            raise TracksCSVError(f"{where}: {shown!r} is not a fraction between 0 and 1")
-        if col in ("w", "h") and number < 0:
-            raise TracksCSVError(f"{where}: negative size {number:g}")
-        return number
-    if col == "failure":
-        if cell is None:
-            if value in (0, 1):
-                return bool(value)
-            raise TracksCSVError(f"{where}: {_short(value)} is not a boolean (0/1/true/false)")
-        flag = _parse_bool(cell)
-        if flag is None:
-            raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
-        return flag
-    # state, source, camera
-    text = cell if cell is not None else str(value)
-    return text if text else DEFAULTS[col]
+    return _parse_cell(col, cell, where, coord_limit)
 
 
 def _short(value) -> str:
@@ -266,7 +204,8 @@ def check_table(df: pd.DataFrame, label: str) -> None:
     tests = {
         "frame": lambda v: (v >= 0) & (v <= MAX_ID), "track_id": lambda v: (v >= 0) & (v <= MAX_ID),
         "x": lambda v: np.isfinite(v) & (np.abs(v) <= limit), "y": lambda v: np.isfinite(v) & (np.abs(v) <= limit),
-        "w": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit), "h": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
+        "w": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
+        "h": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
         "score": lambda v: ~np.isinf(v), "occluded": lambda v: (v >= 0) & (v <= 1),
         **{c: (lambda v: np.isnan(v) | (np.abs(v) <= limit)) for c in ("X", "Y", "Z")},
     }
@@ -287,18 +226,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     Every malformed cell is reported as ``FILE line L, column 'C': problem`` (lines
     counted from 1, the header being line 1), so a user can open the file there.
     """
-    if isinstance(source, (str, PathLike)):
-        path = Path(source)
-        label = name or str(path)
-        try:
-            text = path.read_text(encoding="utf-8-sig")
-        except FileNotFoundError:
-            raise TracksCSVError(f"{label}: no such file") from None
-        except UnicodeDecodeError:
-            raise TracksCSVError(f"{label}: not a text CSV file (not UTF-8)") from None
-    else:
-        label = name or "tracks CSV"
-        text = source.read()
+    label, text = _read_text(source, name)
     reader = _rows(csv.reader(io.StringIO(text, newline="")), label)
     try:
         header = next(reader)
@@ -306,13 +234,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
         raise TracksCSVError(f"{label}: the file is empty; expected a header row "
                              f"starting with {','.join(REQUIRED_COLUMNS)}") from None
     header = [h.strip() for h in header]
-    if tuple(header[: len(REQUIRED_COLUMNS)]) != REQUIRED_COLUMNS:
-        missing = [c for c in REQUIRED_COLUMNS if c not in header]
-        if missing:
-            raise TracksCSVError(f"{label} line 1: missing column(s) {', '.join(repr(m) for m in missing)}; "
-                                 f"the header must start with {','.join(REQUIRED_COLUMNS)}")
-        raise TracksCSVError(f"{label} line 1: the header must start with {','.join(REQUIRED_COLUMNS)} "
-                             f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
+    _check_header(header, label)
     index = {c: i for i, c in enumerate(header) if c in COLUMNS}
     cols: dict[str, list] = {c: [] for c in index}
     coord_limit, row_limit = max_coord(), max_csv_rows()
@@ -327,8 +249,94 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
                                  f"{len(REQUIRED_COLUMNS)} ({','.join(REQUIRED_COLUMNS)})")
         for col, i in index.items():
             cell = row[i].strip() if i < len(row) else ""
-            cols[col].append(check_value(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
+            cols[col].append(_parse_cell(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
     return normalise_tracks(pd.DataFrame(cols))
+
+
+def _read_text(source: str | PathLike | io.TextIOBase, name: str | None) -> tuple[str, str]:
+    """``(label for messages, the CSV's text)`` of a path or an open text stream."""
+    if not isinstance(source, (str, PathLike)):
+        return name or "tracks CSV", source.read()
+    path = Path(source)
+    label = name or str(path)
+    try:
+        return label, path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        raise TracksCSVError(f"{label}: no such file") from None
+    except UnicodeDecodeError:
+        raise TracksCSVError(f"{label}: not a text CSV file (not UTF-8)") from None
+
+
+def _check_header(header: list[str], label: str) -> None:
+    if tuple(header[: len(REQUIRED_COLUMNS)]) == REQUIRED_COLUMNS:
+        return
+    missing = [c for c in REQUIRED_COLUMNS if c not in header]
+    if missing:
+        raise TracksCSVError(f"{label} line 1: missing column(s) {', '.join(repr(m) for m in missing)}; "
+                             f"the header must start with {','.join(REQUIRED_COLUMNS)}")
+    raise TracksCSVError(f"{label} line 1: the header must start with {','.join(REQUIRED_COLUMNS)} "
+                         f"in that order, got {','.join(header[:len(REQUIRED_COLUMNS)])}")
+
+
+def _parse_int(cell: str, where: str) -> int:
+    """A non-negative id or frame (``3`` or ``3.0``) within :data:`MAX_ID`."""
+    try:
+        value = int(cell)
+    except ValueError:
+        try:
+            f = float(cell)
+        except ValueError:
+            raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        if not f.is_integer():
+            raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        if f > MAX_ID:
+            raise TracksCSVError(f"{where}: {cell!r} is larger than the limit of {MAX_ID}") from None
+        value = int(f)
+    if value < 0:
+        raise TracksCSVError(f"{where}: {value} is negative")
+    if value > MAX_ID:
+        raise TracksCSVError(f"{where}: {value} is larger than the limit of {MAX_ID}")
+    return value
+
+
+def _parse_number(col: str, cell: str, where: str, coord_limit: float) -> float:
+    if cell == "" and col in ("score", "occluded", "X", "Y", "Z"):
+        return DEFAULTS[col]
+    try:
+        value = float(cell)
+    except ValueError:
+        raise TracksCSVError(f"{where}: {cell!r} is not a number") from None
+    if col in ("x", "y", "w", "h", "X", "Y", "Z"):
+        if not math.isfinite(value):
+            raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+        if abs(value) > coord_limit:
+            raise TracksCSVError(f"{where}: {cell!r} is beyond the limit of {coord_limit:g} "
+                                 "(set PARTLAB_MAX_COORD to change it)")
+    if col == "score" and math.isinf(value):
+        raise TracksCSVError(f"{where}: {cell!r} is not a finite number")
+    if col == "occluded" and not 0.0 <= value <= 1.0:
+        raise TracksCSVError(f"{where}: {cell!r} is not a fraction between 0 and 1")
+    if col in ("w", "h") and value < 0:
+        raise TracksCSVError(f"{where}: negative size {value:g}")
+    return value
+
+
+def _parse_cell(col: str, cell: str, where: str, coord_limit: float):
+    """One cell of column ``col``, checked; ``where`` names it in the error."""
+    if col in ("frame", "track_id"):
+        return _parse_int(cell, where)
+    if col == "part":
+        if cell not in PART_NAMES:
+            raise TracksCSVError(f"{where}: unknown part {cell!r}; expected one of {', '.join(PART_NAMES)}")
+        return cell
+    if col in ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z"):
+        return _parse_number(col, cell, where, coord_limit)
+    if col == "failure":
+        value = _parse_bool(cell)
+        if value is None:
+            raise TracksCSVError(f"{where}: {cell!r} is not a boolean (0/1/true/false)")
+        return value
+    return cell if cell else DEFAULTS[col]  # state, source, camera
 
 
 def normalise_tracks(df: pd.DataFrame) -> pd.DataFrame:

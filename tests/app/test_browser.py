@@ -17,16 +17,15 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from playwright import sync_api as playwright  # the test extra installs it: a broken import fails
 
 from partlab.commands.app import streamlit_command
-from partlab.app.runs import missing
 
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).resolve().parents[2]
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
         "--disable-component-update", "--disable-sync", "--no-first-run"]
 
-playwright = pytest.importorskip("playwright.sync_api", reason="the playwright package is not installed")
 if not os.path.exists(CHROMIUM):
     pytest.skip("chromium is not installed (apt-get install chromium; .ci/run does it)", allow_module_level=True)
 
@@ -140,20 +139,19 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     project = store.project_by_name("browser")
     [clip] = store.clips(project.id)
 
-    # track: start from the init boxes of frame 0 (or, until the tracker lands, import all boxes)
+    # track: start from the init boxes of frame 0
     page.get_by_role("link", name="Track").click()
     page.get_by_test_id("stExpander").get_by_text("Import boxes from a tracks CSV").click()
-    init = boxes if missing("partlab.app.pipeline") else boxes[boxes.frame == 0]
+    init = boxes[boxes.frame == 0]
     init.to_csv(tmp_path / "init.csv", index=False)
     page.locator("input[type=file]").last.set_input_files(str(tmp_path / "init.csv"))
     page.get_by_role("button", name="Store these boxes as a tracker run").click()
     page.get_by_text(f"Stored {len(init)} boxes as run").wait_for()
-    if not missing("partlab.app.pipeline"):
-        page.get_by_text("the stored boxes of frame 0").click()
-        page.get_by_role("button", name="Track the whole clip").click()
-        page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)
-        assert store.runs(clip.id).tracker.tolist() == ["import", "body"]
-        assert store.tracks(clip.id).frame.max() == 11  # the tracker followed the walker to the end
+    page.get_by_text("the stored boxes of frame 0").click()
+    page.get_by_role("button", name="Track the whole clip").click()
+    page.get_by_text(re.compile(r": done \(|: failed:")).first.wait_for(timeout=120_000)
+    assert store.runs(clip.id).tracker.tolist() == ["import", "body"]
+    assert store.tracks(clip.id).frame.max() == 11  # the tracker followed the walker to the end
     head0 = store.frame_boxes(clip.id, 0).set_index("part").loc["head"]
 
     # correct: drag the head box of frame 0 right and down, then press F

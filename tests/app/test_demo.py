@@ -2,11 +2,7 @@
 
 from __future__ import annotations
 
-import pytest
-
-pytest.importorskip("partlab.labelling.synth", reason="partlab.labelling.synth has not landed")
-
-from partlab.app.demo import DEMO_SCENES, demo_files, ensure_demo  # noqa: E402
+from partlab.app.demo import DEMO_SCENES, demo_files, ensure_demo
 
 
 def test_demo_project_is_made_once_with_its_scenes(store):

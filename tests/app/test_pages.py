@@ -5,12 +5,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import pytest
 from streamlit.testing.v1 import AppTest
 
 from partlab.app import jobs
-from partlab.app.runs import missing
-
 from partlab.tracking.core.box import Box
 
 PAGES = Path(__file__).resolve().parents[2] / "partlab" / "app" / "views"
@@ -69,7 +66,6 @@ def test_track_page_imports_boxes_as_a_run(store, clip_file, boxes):
     assert len(store.tracks(clip.id)) == 24 and store.runs(clip.id).tracker.tolist() == ["import"]
 
 
-@pytest.mark.skipif(bool(missing("partlab.app.pipeline")), reason="partlab.app.pipeline (the tracker pipeline) has not landed yet")
 def test_track_page_runs_the_tracker_in_the_background_and_stores_the_run(store, clip_file):
     project = store.create_project("p")
     clip = store.add_clip(project.id, clip_file)
@@ -103,8 +99,6 @@ def test_evaluate_page_plots_trajectories(store, tracked_clip):
     assert len(charts) >= 1
 
 
-@pytest.mark.skipif(bool(missing("partlab.models.training", "partlab.models.bundle")),
-                    reason="partlab.models.training / partlab.models.bundle (the learning issue) have not landed yet")
 def test_train_page_produces_a_bundle(store, tracked_clip, boxes):
     project, clip = tracked_clip
     for r in boxes.itertuples():  # correct every frame: the truth is the walker's boxes
@@ -127,7 +121,6 @@ def test_train_page_produces_a_bundle(store, tracked_clip, boxes):
     assert len(at.get("plotly_chart")) >= 1
 
 
-@pytest.mark.skipif(bool(missing("partlab.labelling.formats")), reason="partlab.labelling.formats (the datasets issue) has not landed")
 def test_export_page_builds_an_archive_and_marks_clips_exported(store, tracked_clip):
     project, clip = tracked_clip
     at = page("export", project_id=project.id)
@@ -138,7 +131,6 @@ def test_export_page_builds_an_archive_and_marks_clips_exported(store, tracked_c
     assert store.clip(clip.id).exported
 
 
-@pytest.mark.skipif(bool(missing("partlab.app.pipeline")), reason="partlab.app.pipeline (the tracker pipeline) has not landed yet")
 def test_retrack_from_a_fix_stops_at_the_next_corrected_frame(store, tracked_clip, boxes):
     project, clip = tracked_clip
     head = boxes[(boxes.frame == 3) & (boxes.part == "head")].iloc[0]
@@ -166,8 +158,6 @@ def test_retrack_from_a_fix_stops_at_the_next_corrected_frame(store, tracked_cli
     assert store.runs(clip.id).start_frame.tolist() == [0, 3]
 
 
-@pytest.mark.skipif(bool(missing("partlab.app.pipeline", "partlab.labelling.evaluation")),
-                    reason="partlab.app.pipeline / partlab.labelling.evaluation have not landed yet")
 def test_evaluate_page_compares_two_runs_against_the_truth(store, tracked_clip, boxes, tmp_path):
     project, clip = tracked_clip
     at = page("evaluate", project_id=project.id, clip_id=clip.id)

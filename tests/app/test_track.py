@@ -8,13 +8,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from partlab.app.pipeline import track_video
 from partlab.cli import main
 from partlab.errors import UserError
-from partlab.app.pipeline import track_video
 from partlab.labelling.video import write_video
-from tests.tracking.walkers import background, correct, draw_walker
 from partlab.tracking.core.box import Box
 from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
+from tests.tracking.walkers import background, correct, draw_walker
 
 
 @pytest.fixture(scope="module")

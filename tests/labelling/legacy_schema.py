@@ -1,8 +1,19 @@
 """The tables partlab 0.2.0 created (``Base.metadata.create_all`` in store.py at commit 2c99e66),
 frozen here as plain SQLAlchemy Core so the migration tests do not depend on the code they test."""
 
-from sqlalchemy import (Boolean, Column, DateTime, Float, ForeignKey, Integer, MetaData, String, Table, Text,
-                        UniqueConstraint)
+from sqlalchemy import (
+                        Boolean,
+                        Column,
+                        DateTime,
+                        Float,
+                        ForeignKey,
+                        Integer,
+                        MetaData,
+                        String,
+                        Table,
+                        Text,
+                        UniqueConstraint,
+)
 
 LEGACY = MetaData()
 

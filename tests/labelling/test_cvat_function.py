@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
+import cvat_sdk.auto_annotation as cvataa
 import numpy as np
 import PIL.Image
-import cvat_sdk.auto_annotation as cvataa
 
 from partlab.labelling import cvat_function
 from partlab.tracking.core.box import Box

@@ -63,7 +63,8 @@ def _write(name: str, data) -> Path:
 
 
 ANNOTATION = st.fixed_dictionaries(
-    {"id": VALUE, "image_id": st.sampled_from([1, 1, 2, "1", [1]]), "category_id": st.sampled_from([1, 2, 1, "1", None]),
+    {"id": VALUE, "image_id": st.sampled_from([1, 1, 2, "1", [1]]),
+     "category_id": st.sampled_from([1, 2, 1, "1", None]),
      "bbox": st.one_of(st.lists(VALUE, min_size=4, max_size=4), st.lists(VALUE, min_size=4, max_size=4), JSON)},
     optional={"track_id": VALUE, "score": VALUE,
               "attributes": st.fixed_dictionaries({}, optional={

@@ -1,12 +1,13 @@
 """The store's Alembic migrations: a database made by partlab 0.2.0 opens, migrated, with every edit."""
 
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import numpy as np
 import pandas as pd
 import pytest
 from alembic.autogenerate import compare_metadata
 from alembic.migration import MigrationContext
+from legacy_schema import LEGACY
 from sqlalchemy import create_engine, insert, text
 
 from partlab.labelling import migrations
@@ -14,9 +15,7 @@ from partlab.labelling.config import database_url
 from partlab.labelling.store import Base, Store, StoreError
 from partlab.tracking.core.box import Box
 
-from legacy_schema import LEGACY
-
-T0 = datetime(2026, 11, 1, 12, 0, tzinfo=timezone.utc)
+T0 = datetime(2026, 11, 1, 12, 0, tzinfo=UTC)
 
 
 def _schema_diff(url, metadata):

@@ -50,7 +50,8 @@ def _post(url, body):
 
 def _truth_table(truths):
     return pd.DataFrame([dict(frame=t, track_id=0, part=p, x=b.x, y=b.y, w=b.w, h=b.h)
-                         for t, parts in enumerate(truths) for p, b in parts.items() if p in ("person", "head", "torso", "hipleg")])
+                         for t, parts in enumerate(truths) for p, b in parts.items()
+                         if p in ("person", "head", "torso", "hipleg")])
 
 
 def test_predict_fit_predict(server, walk):

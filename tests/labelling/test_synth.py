@@ -6,7 +6,7 @@ import pytest
 
 from partlab.cli import main
 from partlab.labelling.synth import SCENARIOS, make_scene, render_scenario
-from partlab.labelling.synth.figure import colour_table, FACE, HAIR, SHOES, TROUSERS, TROUSERS_FAR
+from partlab.labelling.synth.figure import FACE, HAIR, SHOES, TROUSERS, TROUSERS_FAR, colour_table
 from partlab.tracking.parts import BOX_PARTS
 from partlab.tracking.tracks import read_tracks_csv
 

@@ -75,3 +75,84 @@ def test_depth_of_the_wrong_kind_is_refused(tmp_path):
     np.save(tmp_path / "clip_depth.npy", np.full((2, 48, 64), 1000, np.uint16))
     with pytest.raises(TakeError, match="3 colour frames but 2 depth frames"):
         open_take(tmp_path)
+
+
+# -- depth input: stereo pairs and bad depth ---------------------------------------------------
+
+def _depth_pngs(folder, n, shape=(48, 64), value=1500, dtype=np.uint16, odd=None):
+    folder.mkdir()
+    for i in range(n):
+        size = odd if (odd is not None and i == n - 1) else shape
+        cv2.imwrite(str(folder / f"{i:06d}.png"), np.full(size, value, dtype))
+
+
+def test_depth_of_the_wrong_size_is_refused_naming_the_stream(tmp_path):
+    write_video(tmp_path / "clip.mp4", _frames(3), fps=25)
+    _depth_pngs(tmp_path / "clip_depth", 3, shape=(24, 32))
+    with pytest.raises(TakeError, match=r"stream 'cam0' depth is 32x24 but its colour is 64x48"):
+        open_take(tmp_path)
+
+
+def test_a_depth_frame_of_another_size_is_refused_when_read(tmp_path):
+    write_video(tmp_path / "clip.mp4", _frames(3), fps=25)
+    _depth_pngs(tmp_path / "clip_depth", 3, odd=(40, 64))
+    with open_take(tmp_path) as take:
+        with pytest.raises(TakeError, match=r"000002.png: depth frame is 64x40, the first was 64x48"):
+            list(take.frames())
+
+
+def test_8_bit_depth_stacks_are_refused(tmp_path):
+    write_video(tmp_path / "clip.mp4", _frames(3), fps=25)
+    np.save(tmp_path / "clip_depth.npy", np.full((3, 48, 64), 200, np.uint8))
+    with pytest.raises(TakeError, match=r"clip_depth.npy: depth stack is 8-bit \(uint8\)"):
+        open_take(tmp_path)
+
+
+def test_npz_depth_in_mm_with_zero_missing(tmp_path):
+    write_video(tmp_path / "clip.mp4", _frames(2), fps=25)
+    d = np.full((2, 48, 64), 900.0, np.float32)
+    d[1, 3, 4] = 0.0
+    np.savez(tmp_path / "clip_depth.npz", depth=d)
+    with open_take(tmp_path) as take:
+        f = list(take.frames())[1].first
+        assert np.isnan(f.depth[3, 4]) and f.depth[0, 0] == pytest.approx(900.0)
+
+
+@pytest.fixture(scope="module")
+def stereo_scene():
+    from partlab.labelling.synth.depth_scene import make_depth_scene
+
+    return make_depth_scene("desk_depth", seed=5, n_frames=3)
+
+
+def _stereo_take(folder, scene, right_camera="cam0_right", cameras=None, right_frames=None):
+    write_video(folder / "left.mp4", scene.frames, 25)
+    write_video(folder / "right.mp4", scene.right[:right_frames], 25)
+    write_calibration(cameras if cameras is not None else scene.cameras, folder / "calibration.json")
+    (folder / "take.json").write_text(json.dumps({"streams": [
+        {"name": "cam0", "stereo": {"left": "left.mp4", "right": "right.mp4", "right_camera": right_camera}}]}))
+
+
+def test_a_stereo_pair_gives_depth_aligned_to_the_left_image(tmp_path, stereo_scene):
+    _stereo_take(tmp_path, stereo_scene)
+    with open_take(tmp_path) as take:
+        assert take.has_depth and take.frame_count == 3
+        f = list(take.frames(1, 2))[0].first
+    truth = stereo_scene.depth[1]
+    person = (stereo_scene.labels[1] > 0) & (stereo_scene.labels[1] != 9)
+    err = np.abs(f.depth - truth)[person]
+    assert f.depth.shape == truth.shape and f.color.shape[:2] == truth.shape
+    assert np.isfinite(err).mean() > 0.9  # matched almost everywhere on the person
+    assert np.nanmedian(err) < 40.0  # mm, at 1.1-1.6 m through the mp4 codec
+
+
+def test_stereo_without_the_right_camera_or_with_uneven_videos_is_refused(tmp_path, stereo_scene):
+    _stereo_take(tmp_path, stereo_scene, right_camera="cam9")
+    with pytest.raises(TakeError, match="stereo depth needs both cameras calibrated; cam9 is not in calibration.json"):
+        open_take(tmp_path)
+    _stereo_take(tmp_path, stereo_scene, right_frames=2)
+    with pytest.raises(TakeError, match=r"stereo pair differs in frame count \(left.mp4 3, right.mp4 2\)"):
+        open_take(tmp_path)
+    (tmp_path / "take.json").write_text(json.dumps({"streams": [{"name": "cam0", "stereo": {"left": "left.mp4"}}]}))
+    with pytest.raises(TakeError, match=r"streams\[0\].stereo must be an object with 'left' and 'right'"):
+        open_take(tmp_path)

@@ -5,7 +5,7 @@ import pickle
 import numpy as np
 import pytest
 
-from partlab.models.bundle import Bundle, BundleError, load_bundle, save_bundle, MANIFEST
+from partlab.models.bundle import MANIFEST, Bundle, BundleError, load_bundle, save_bundle
 from partlab.models.failure_svm import SVMFailureDetector
 from partlab.tracking.params import BodyParams, LimbParams, PartNoise
 
@@ -142,7 +142,6 @@ def test_default_bundle_ships_and_keeps_only_what_validation_approved():
 
 def test_a_bundle_applies_what_was_learned_over_the_installed_defaults(tmp_path):
     """Hand-set tunables follow the installed partlab; fitted ones come from the bundle."""
-    from dataclasses import replace
 
     from partlab.models.bundle import Bundle, load_bundle, save_bundle
     from partlab.tracking.params import BodyParams, LimbParams, PartNoise

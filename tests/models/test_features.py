@@ -2,8 +2,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from partlab.models.features import (FEATURE_NAMES, dt_frames, features_from_history, features_from_tracks,
-                             newest_features, person_scale, relative_states)
+from partlab.models.features import (
+    FEATURE_NAMES,
+    dt_frames,
+    features_from_history,
+    features_from_tracks,
+    newest_features,
+    person_scale,
+    relative_states,
+)
 from partlab.tracking.tracks import normalise_tracks
 
 

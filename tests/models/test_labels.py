@@ -1,7 +1,7 @@
 import numpy as np
 import pandas as pd
 
-from partlab.models.labels import inside_fraction, label_states, label_tracks, svm_targets, LabelRule
+from partlab.models.labels import LabelRule, inside_fraction, label_states, label_tracks, svm_targets
 from partlab.tracking.tracks import normalise_tracks
 
 

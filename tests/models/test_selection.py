@@ -2,10 +2,10 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from walkers import walking_truth
 
 from partlab.models.selection import mean_rates, part_rates, select_components, selection_table
 from partlab.tracking.params import BodyParams
-from walkers import walking_truth
 
 DEFAULT = BodyParams()
 
@@ -102,7 +102,8 @@ def test_noise_is_tried_first_and_kept_params_carry_on():
     run, calls = _fake_runner(truths)
     sel = select_components(run, truths, DEFAULT, noisy)
     # the fake tracker ignores the noise: a tie, so the built-in noise stays
-    assert sel.kept["noise"] is False and sel.body_params.dynamics.noise["head"].lam == DEFAULT.dynamics.noise["head"].lam
+    assert sel.kept["noise"] is False
+    assert sel.body_params.dynamics.noise["head"].lam == DEFAULT.dynamics.noise["head"].lam
     assert np.isclose(sel.scores["+noise"]["mean"], 1.0) and "+extent" not in sel.scores
 
 
@@ -142,7 +143,8 @@ def _inner_rect_runner(truths):
             m = t.part == part
             w, h = t.loc[m, "w"], t.loc[m, "h"]
             cx, cy = t.loc[m, "x"] + w / 2 + 0.3 * w + dx * w, t.loc[m, "y"] + h / 2 + dy * h
-            t.loc[m, "x"], t.loc[m, "y"], t.loc[m, "w"], t.loc[m, "h"] = cx - sw * w / 2, cy - sh * h / 2, sw * w, sh * h
+            t.loc[m, "x"], t.loc[m, "y"] = cx - sw * w / 2, cy - sh * h / 2
+            t.loc[m, "w"], t.loc[m, "h"] = sw * w, sh * h
         t["source"] = "tracker"
         return t
     return run

@@ -2,7 +2,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from partlab.models.variance import comparison_figure, comparison_table, fit_body_noise, fit_constant_velocity, fit_limb_sigmas
+from partlab.models.variance import (
+    comparison_figure,
+    comparison_table,
+    fit_body_noise,
+    fit_constant_velocity,
+    fit_limb_sigmas,
+)
 from partlab.tracking.params import BodyParams, LimbParams
 from partlab.tracking.tracks import normalise_tracks
 

@@ -8,7 +8,7 @@ import pytest
 
 from partlab.labelling.events import evaluate_events, temporal_iou
 from partlab.labelling.synth import make_scene
-from partlab.tracking.activities.objects import HUE_BINS, colour_masses, fuse, hand_colour
+from partlab.tracking.activities.objects import colour_masses, fuse, hand_colour
 from partlab.tracking.activities.params import ActivityParams
 from partlab.tracking.activities.recognise import contacts, merged_joins, still_moments
 from partlab.tracking.activities.table import one_hand, two_hands

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.tracking.test_body import _init, _run, _scene
-from tests.tracking.walkers import correct
 from partlab.tracking.body.adjustment import head_from_torso, hipleg_from_torso, torso_from_head_and_hipleg
 from partlab.tracking.body.tracker import BodyTracker
 from partlab.tracking.core.box import Box
-from partlab.tracking.protocol import FailureVerdict
 from partlab.tracking.params import BodyParams
+from partlab.tracking.protocol import FailureVerdict
+from tests.tracking.test_body import _init, _run, _scene
+from tests.tracking.walkers import correct
 
 
 class DisplacingDetector:

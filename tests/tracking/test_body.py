@@ -6,14 +6,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from tests.tracking.walkers import background, correct, draw_walker
+from partlab.tracking.body.decomposition import decompose
+from partlab.tracking.body.tracker import BodyTracker, init_starts
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
-from partlab.tracking.body.tracker import BodyTracker, init_starts
-from partlab.tracking.body.decomposition import decompose
 from partlab.tracking.core.histogram import to_ycc
 from partlab.tracking.params import BodyParams
 from partlab.tracking.tracks import records_to_frame
+from tests.tracking.walkers import background, correct, draw_walker
 
 W, H = 320, 200
 

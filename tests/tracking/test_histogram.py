@@ -47,7 +47,9 @@ def test_equalization_separates_close_colours_better_than_raw_bins():
     close = level_histogram(_patch(rng, (132, 146, 104)))
     eq = equalization_map(target)
     raw = uniform_map()
-    rho = lambda h, m: float(bhattacharyya(binned_histogram(h, m), binned_histogram(target, m)))
+    def rho(h, m):
+        return float(bhattacharyya(binned_histogram(h, m), binned_histogram(target, m)))
+
     assert rho(same, eq) > 0.95
     assert rho(close, raw) > 0.8           # raw bins: hardly distinguishable
     assert rho(close, eq) < 0.8            # equalized: clearly different
@@ -57,8 +59,10 @@ def test_equalization_separates_close_colours_better_than_raw_bins():
 
 
 def test_model_update_is_eq1():
-    a = np.zeros((3, 256)); a[:, 10] = 1
-    b = np.zeros((3, 256)); b[:, 20] = 1
+    a = np.zeros((3, 256))
+    a[:, 10] = 1
+    b = np.zeros((3, 256))
+    b[:, 20] = 1
     u = update_reference(a, b, 0.1)
     assert u[0, 10] == pytest.approx(0.9) and u[0, 20] == pytest.approx(0.1)
     assert u.sum(axis=1) == pytest.approx([1, 1, 1])

@@ -3,8 +3,16 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from partlab.tracking.core.hue_histogram import (back_projection, bhattacharyya_distance, box_histograms, hue_bin_image,
-                                    hue_confidence, integral_histogram, mean_shift, reference_histogram)
+from partlab.tracking.core.hue_histogram import (
+    back_projection,
+    bhattacharyya_distance,
+    box_histograms,
+    hue_bin_image,
+    hue_confidence,
+    integral_histogram,
+    mean_shift,
+    reference_histogram,
+)
 
 
 def _frame():

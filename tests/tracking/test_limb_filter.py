@@ -4,10 +4,20 @@ import cv2
 import numpy as np
 
 from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
-from partlab.tracking.limbs.filter import (Candidates, LimbFilter, blob_likelihood, blob_points, blob_tips, candidate_modes,
-                                  candidate_terms, nearest_per_parent, silhouette_term, tip_candidates)
-from partlab.tracking.params import LimbParams
 from partlab.tracking.core.skin import SkinModel, find_blobs
+from partlab.tracking.limbs.filter import (
+    Candidates,
+    LimbFilter,
+    blob_likelihood,
+    blob_points,
+    blob_tips,
+    candidate_modes,
+    candidate_terms,
+    nearest_per_parent,
+    silhouette_term,
+    tip_candidates,
+)
+from partlab.tracking.params import LimbParams
 
 SKIN = (110, 150, 210)
 BG = (90, 110, 70)
@@ -67,7 +77,8 @@ def test_filter_follows_a_moving_skin_disc_and_refines_onto_it():
         bins = hue_bin_image(hsv, p.appearance.hue_bins, p.appearance.hue_min_saturation, p.appearance.hue_min_value)
         cands = candidate_terms(find_blobs(skin.mask(frame), 1, 1.5, 10), None, skin.probability(frame), p)
         if filt is None:
-            filt = LimbFilter((cx, 30), (14, 14), reference_histogram(bins, (cx - 7, 23, 14, 14), p.appearance.hue_bins), p, rng)
+            ref = reference_histogram(bins, (cx - 7, 23, 14, 14), p.appearance.hue_bins)
+            filt = LimbFilter((cx, 30), (14, 14), ref, p, rng)
             continue
         filt.predict(rng)
         filt.weigh(cands, integral_histogram(bins, p.appearance.hue_bins))

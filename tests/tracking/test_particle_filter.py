@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from partlab.tracking.body.part_filter import PartFilter, box_to_state, state_to_box
 from partlab.tracking.core.box import Box
 from partlab.tracking.core.histogram import to_ycc
 from partlab.tracking.params import BodyParams, PartNoise
-from partlab.tracking.body.part_filter import PartFilter, box_to_state, state_to_box
 
 W, H = 160, 120
 
@@ -70,7 +70,9 @@ def test_entropy_adapts_particle_count_within_bounds():
     empty = to_ycc(np.clip(rng.normal(128, 20, (H, W, 3)), 0, 255).astype(np.uint8))
     for _ in range(8):
         before = pf.n
-        pf.predict(); pf.measure(empty); pf.resample()
+        pf.predict()
+        pf.measure(empty)
+        pf.resample()
         assert pf.n <= round(1.2 * before)
         counts.append(pf.n)
     assert counts[-1] == 1000
@@ -80,7 +82,9 @@ def test_entropy_adapts_particle_count_within_bounds():
                      PartNoise(x=6, y=6, w=0.5, h=0.5, vx=0.5, vy=0.5, lam=200), np.random.default_rng(5))
     for _ in range(8):
         ycc = to_ycc(_frame(rng, 40, 60))
-        pf2.predict(); pf2.measure(ycc); pf2.resample()
+        pf2.predict()
+        pf2.measure(ycc)
+        pf2.resample()
     assert 200 <= pf2.n < 400
 
 

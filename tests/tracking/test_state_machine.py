@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from partlab.tracking.params import LimbParams
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation, assign_by_direction
+from partlab.tracking.params import LimbParams
 
 P = LimbParams().updated({"states.combine_distance": 20.0, "states.split_distance": 30.0,
                          "states.lost_likelihood": 0.15, "states.recover_likelihood": 0.3, "states.lost_frames": 3,

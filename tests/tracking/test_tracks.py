@@ -4,8 +4,16 @@ import pandas as pd
 import pytest
 
 from partlab.tracking.core.box import Box
-from partlab.tracking.tracks import (COLUMNS, TAKE_COLUMNS, TrackRecord, TracksCSVError, frame_to_records, read_tracks_csv,
-                             records_to_frame, write_tracks_csv)
+from partlab.tracking.tracks import (
+    COLUMNS,
+    TAKE_COLUMNS,
+    TrackRecord,
+    TracksCSVError,
+    frame_to_records,
+    read_tracks_csv,
+    records_to_frame,
+    write_tracks_csv,
+)
 
 HEADER = "frame,track_id,part,x,y,w,h"
 

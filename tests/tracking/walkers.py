@@ -6,6 +6,7 @@ import cv2
 import numpy as np
 
 from partlab.tracking.core.box import Box
+from partlab.tracking.measures import right_box_one
 
 SKIN = (90, 140, 200)
 
@@ -41,5 +42,5 @@ def draw_walker(frame: np.ndarray, cx: float, top: float, height: float, shirt, 
 
 
 def correct(box: Box, truth: Box) -> bool:
-    """Seed 002's measure: at least half of ``box`` on the true part and its centre inside it."""
-    return box.area > 0 and box.intersection(truth) >= 0.5 * box.area and truth.contains_point(*box.centre)
+    """The right-box rule (:func:`partlab.tracking.measures.right_box`) for two boxes."""
+    return right_box_one(box, truth)

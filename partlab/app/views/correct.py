@@ -12,8 +12,8 @@ import streamlit as st
 from partlab.app import state
 from partlab.app.box_editor import box_editor, pending_events
 from partlab.app.editing import apply_events
+from partlab.app.runs import next_human_frame, start_tracking
 from partlab.app.views.common import bound_widget, job_panel, pick_clip, require_project
-from partlab.app.runs import missing, next_human_frame, start_tracking
 from partlab.labelling.store import Store
 from partlab.labelling.video import VideoClip, VideoError
 from partlab.tracking.parts import PART_NAMES
@@ -109,9 +109,8 @@ with st.expander("Re-track from this frame", expanded=False):
     st.write(f"Runs the tracker from the boxes of frame {frame} to "
              + (f"frame {stop} (the next corrected frame)." if stop is not None else "the end of the clip.")
              + " Human corrections are never overwritten.")
-    lacking = missing("partlab.app.pipeline")
     tracker = st.radio("Tracker", ("body", "limbs", "all"), horizontal=True, key="retrack_tracker")
-    if st.button("Re-track from here", disabled=bool(lacking)):
+    if st.button("Re-track from here"):
         try:
             job = start_tracking(s, clip, tracker=tracker, start=frame, retrack=True,
                                  bundle_path=next((b.path for b in s.bundles(project.id)
@@ -119,8 +118,6 @@ with st.expander("Re-track from this frame", expanded=False):
             st.success(f"Started: {job.label}")
         except (RuntimeError, ValueError) as exc:
             st.error(str(exc))
-    if lacking:
-        st.caption("Not available yet: the tracker pipeline has not landed.")
     job_panel("track", limit=1, clip_id=clip.id)
 
 with st.expander("Keyboard shortcuts"):

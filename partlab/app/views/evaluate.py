@@ -9,18 +9,15 @@ import streamlit as st
 from partlab.app import jobs, state
 from partlab.app.box_editor import track_colour
 from partlab.app.demo import demo_files
+from partlab.app.runs import bundle_choices, first_boxes, start_comparison_run, training_truth
 from partlab.app.views.common import pick_clip, require_project
-from partlab.app.runs import bundle_choices, first_boxes, missing, optional, start_comparison_run, training_truth
+from partlab.labelling import evaluation
 from partlab.tracking.tracks import read_tracks_csv
 
 s = state.store()
 st.title("Evaluate and compare")
 project = require_project(s)
 clip = pick_clip(s, project.id)
-
-evaluation = optional("partlab.labelling.evaluation")
-if evaluation is None:
-    st.warning("Evaluation is not available yet: partlab.labelling.evaluation has not landed.")
 
 # ---- truth: an uploaded truth CSV, or the clip's corrected frames
 truth_file = st.file_uploader("Truth CSV for this clip (optional; else the corrected frames are the truth)",
@@ -45,13 +42,10 @@ c1, c2, c3 = st.columns(3)
 a = c1.selectbox("Bundle A", list(options), index=0)
 b = c2.selectbox("Bundle B", list(options), index=min(1, len(options) - 1))
 tracker = c3.radio("Tracker", ("body", "limbs", "all"), horizontal=True, key="eval_tracker")
-lacking = missing("partlab.app.pipeline")
-if st.button("Track with both and compare", disabled=bool(lacking) or evaluation is None, type="primary"):
+if st.button("Track with both and compare", type="primary"):
     init = first_boxes(truth) if len(truth) else None  # both start from the truth's first boxes
     for name in dict.fromkeys((a, b)):
         start_comparison_run(clip, tracker, name, options[name], init=init)
-if lacking:
-    st.caption("Comparison runs need the tracker pipeline, which has not landed yet.")
 
 
 @st.fragment(run_every=1 if jobs.active("compare", clip_id=clip.id) else None)
@@ -69,7 +63,7 @@ def comparison():
                 st.progress(job.fraction, text=f"tracking: {job.done}/{job.total or '?'}")
             elif job.status == "failed":
                 st.error(job.error)
-            elif evaluation is not None and len(truth):
+            elif len(truth):
                 report = evaluation.evaluate(truth, job.result, at=105)
                 st.plotly_chart(evaluation.rate_curve_figure(report), key=f"rates:{side}:{name}")
                 if report.note:

@@ -7,16 +7,13 @@ from pathlib import Path
 import streamlit as st
 
 from partlab.app import state
+from partlab.app.runs import safe_name
 from partlab.app.views.common import require_project
-from partlab.app.runs import optional, safe_name
+from partlab.labelling import formats
 
 s = state.store()
 st.title("Export")
 project = require_project(s)
-formats = optional("partlab.labelling.formats")
-if formats is None or not hasattr(formats, "export_clip"):
-    st.warning("Export is not available yet: partlab.labelling.formats has not landed.")
-    st.stop()
 
 clips = {c.id: c for c in s.clips(project.id)}
 with st.form("export"):

@@ -7,9 +7,9 @@ import pandas as pd
 import streamlit as st
 
 from partlab.app import state
-from partlab.app.views.common import require_project
 from partlab.app.runs import clip_state
 from partlab.app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
+from partlab.app.views.common import require_project
 from partlab.labelling.store import StoreError
 from partlab.labelling.video import VideoClip, VideoError
 

@@ -6,9 +6,9 @@ import pandas as pd
 import streamlit as st
 
 from partlab.app import state
-from partlab.app.views.common import job_panel, pick_clip, require_project
 from partlab.app.demo import demo_files
-from partlab.app.runs import TRACKERS, bundle_choices, missing, start_tracking
+from partlab.app.runs import TRACKERS, bundle_choices, start_tracking
+from partlab.app.views.common import job_panel, pick_clip, require_project
 from partlab.labelling.store import Store
 from partlab.tracking.tracks import read_tracks_csv
 
@@ -27,7 +27,6 @@ def first_frame_with_boxes(url: str, clip_id: int, n_runs: int, n_human: int) ->
     return int(tracks.frame.min()) if len(tracks) else None
 
 
-lacking = missing("partlab.app.pipeline")
 with st.form("track"):
     c1, c2, c3 = st.columns(3)
     tracker = c1.radio("Tracker", TRACKERS, horizontal=True,
@@ -40,10 +39,7 @@ with st.form("track"):
         + (["the synthetic scene's init boxes"] if demo_init else [])
     start_from = st.radio("Start from", starts, horizontal=True,
                           help="imported or drawn boxes make the tracker follow exactly those people")
-    go = st.form_submit_button("Track the whole clip", disabled=bool(lacking), type="primary")
-if lacking:
-    st.warning("Tracking is not available yet: the tracker pipeline (partlab.app.pipeline) has not landed. "
-               "You can import boxes from a tracks CSV below meanwhile.")
+    go = st.form_submit_button("Track the whole clip", type="primary")
 if go:
     path = choices[bundle]
     try:

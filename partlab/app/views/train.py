@@ -5,17 +5,14 @@ import plotly.graph_objects as go
 import streamlit as st
 
 from partlab.app import state
+from partlab.app.runs import SHIPPED, bundle_choices, start_training
 from partlab.app.views.common import job_panel, require_project
-from partlab.app.runs import SHIPPED, bundle_choices, missing, start_training
 from partlab.labelling.store import StoreError
 
 s = state.store()
 st.title("Train")
 project = require_project(s)
 
-lacking = missing("partlab.models.training", "partlab.models.bundle")
-if lacking:
-    st.warning(f"Training is not available yet: {', '.join(lacking)} has not landed.")
 
 clips = s.clips(project.id)
 corrected = {c.id: c for c in clips if s.progress(c.id)["corrected_frames"] > 0}
@@ -34,7 +31,7 @@ with st.form("train"):
                                help="The model to improve on: its failure detector stays unless the one trained "
                                     "here does no worse on these clips, and fitted parameters are kept only if "
                                     "they raise the tracking rate on them.")
-    go_train = st.form_submit_button("Train", type="primary", disabled=bool(lacking) or not corrected)
+    go_train = st.form_submit_button("Train", type="primary", disabled=not corrected)
 if not corrected:
     st.info("No clip has corrected frames yet: correct some boxes on the Correct page first.")
 if go_train:

@@ -9,12 +9,11 @@ The registry :data:`FORMATS` maps a format name to its module's ``export`` and
 from __future__ import annotations
 
 import dataclasses
-
 import shutil
 import tempfile
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import pandas as pd
 

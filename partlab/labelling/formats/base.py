@@ -65,7 +65,7 @@ class ExportManifest:
 
     @classmethod
     def for_video(cls, fmt: str, info: VideoInfo, every: int, frames_written: bool,
-                  notes: str = "") -> "ExportManifest":
+                  notes: str = "") -> ExportManifest:
         return cls(fmt, float(info.fps), int(info.width), int(info.height), int(info.frame_count),
                    int(every), bool(frames_written), Path(info.path).name if info.path else "", notes=notes)
 
@@ -78,7 +78,7 @@ class ExportManifest:
         return path
 
     @classmethod
-    def read(cls, directory: Path) -> "ExportManifest | None":
+    def read(cls, directory: Path) -> ExportManifest | None:
         """The manifest in ``directory``, or None when it is not one of our exports."""
         path = Path(directory) / MANIFEST_NAME
         if not path.is_file():

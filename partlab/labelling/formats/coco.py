@@ -10,7 +10,8 @@ Layout (one export opens in each reader without options)::
 One image entry per exported frame (``id = frame + 1``, our decoder index in
 ``frame_id``), one annotation per box with ``track_id``, the part as its category
 (``id = part_index + 1``), a top-level ``score`` (the tracker's, 1.0 for boxes without one, so
-``COCO.loadRes`` and ``COCOeval`` take the file as detections) and our flags in ``attributes`` (``occluded`` as a boolean
+``COCO.loadRes`` and ``COCOeval`` take the file as detections) and our flags in ``attributes``
+(``occluded`` as a boolean
 the way CVAT and Datumaro write it, the exact fraction in ``occlusion``). ``info``
 states the fps and frame count of the clip. Importing a foreign file takes the frame
 from ``frame_id``, else from the digits ending the file name, else from the image's
@@ -27,8 +28,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.formats.frames import frame_name, link_or_copy, link_tree, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES

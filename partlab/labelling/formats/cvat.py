@@ -1,7 +1,8 @@
 """CVAT for video 1.1 XML (``annotations.xml``): the lossless format.
 
 One ``<track>`` per (person, part), labelled with the part name, the person (our ``track_id``) in
-an immutable ``person`` attribute on every box (not ``track_id``: Datumaro sets that one to the CVAT track). The tracks are not grouped: Datumaro (and CVAT's own
+an immutable ``person`` attribute on every box (not ``track_id``: Datumaro sets that one to the CVAT
+track). The tracks are not grouped: Datumaro (and CVAT's own
 COCO export) merge the shapes of a group into one instance, which would turn a person's four parts
 into one box. The frames are ``images/frame_000042.png`` (PNG, where Datumaro looks for a video task's
 frames). Every box we have is a keyframe; a box with ``outside="1"`` closes a track where
@@ -20,15 +21,21 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pandas as pd
 from defusedxml import ElementTree as SafeET
 from defusedxml.common import DefusedXmlException
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.formats.frames import all_frames, frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
@@ -87,7 +94,7 @@ def _meta(root: ET.Element, info: VideoInfo, every: int, attributes: dict) -> No
     size = ET.SubElement(task, "original_size")
     ET.SubElement(size, "width").text = str(info.width)
     ET.SubElement(size, "height").text = str(info.height)
-    ET.SubElement(meta, "dumped").text = datetime.now(timezone.utc).isoformat(timespec="seconds")
+    ET.SubElement(meta, "dumped").text = datetime.now(UTC).isoformat(timespec="seconds")
     ET.SubElement(meta, "source").text = f"partlab, fps={_num(info.fps)}"
 
 
@@ -98,7 +105,8 @@ def _box(track: ET.Element, r, *, outside: bool, take: bool) -> None:
         "occluded": "1" if occluded > 0 else "0",
         "xtl": _num(r.x), "ytl": _num(r.y), "xbr": _num(r.x + r.w), "ybr": _num(r.y + r.h), "z_order": "0",
     })
-    values = {"person": str(int(r.track_id)), "failure": "true" if bool(r.failure) else "false", "source": str(r.source),
+    values = {"person": str(int(r.track_id)), "failure": "true" if bool(r.failure) else "false",
+              "source": str(r.source),
               "occlusion": _num(occluded), "confidence": "" if math.isnan(r.score) else _num(r.score),
               "state": str(r.state)}
     if take:
@@ -115,7 +123,7 @@ def export(df: pd.DataFrame, out_dir: Path, info: VideoInfo, video_path=None, ev
     ET.SubElement(root, "version").text = "1.1"
     take = has_take_columns(df)
     _meta(root, info, every, ATTRIBUTES | TAKE_ATTRIBUTES if take else ATTRIBUTES)
-    for cvat_id, ((track_id, part), rows) in enumerate(
+    for cvat_id, ((_track_id, part), rows) in enumerate(
             df.groupby(["track_id", "part"], sort=False)):
         track = ET.SubElement(root, "track", {"id": str(cvat_id), "label": part, "source": "manual"})
         rows = rows.sort_values("frame")

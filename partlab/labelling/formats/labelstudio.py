@@ -32,8 +32,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                            thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.video import VideoInfo
 from partlab.limits import max_frames
 from partlab.tracking.parts import BOX_PARTS
@@ -225,7 +231,8 @@ def tracks_from_results(regions_: list, size: tuple[int, int] | None, source: st
             if frame < 1:
                 raise FormatError(f"{source}: region {r.get('id')} has frame {frame}; Label Studio frames count "
                                   "from 1")
-            rows.append({"_where": f"region {r.get('id')!r} frame {frame}", "frame": frame - 1, "track_id": track_id, "part": part,
+            rows.append({"_where": f"region {r.get('id')!r} frame {frame}",
+                         "frame": frame - 1, "track_id": track_id, "part": part,
                          "x": x * W / 100.0, "y": y * H / 100.0, "w": w * W / 100.0, "h": h * H / 100.0,
                          "score": float(r["score"]) if isinstance(r.get("score"), (int, float)) else float("nan"),
                          "source": NAME if key else "interpolated"})

@@ -33,8 +33,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from partlab.labelling.formats.base import (ExportManifest, FormatError, finish_import, map_label, parse_mapping,
-                                    thinned_tracks)
+from partlab.labelling.formats.base import (
+    ExportManifest,
+    FormatError,
+    finish_import,
+    map_label,
+    parse_mapping,
+    thinned_tracks,
+)
 from partlab.labelling.formats.frames import all_frames, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.limits import max_coord

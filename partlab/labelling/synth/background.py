@@ -124,7 +124,7 @@ class CameraEffects:
 
     @classmethod
     def make(cls, rng: np.random.Generator, n_frames: int, width: int, height: int, fps: float,
-             flicker: float = 0.012, sigma: float = 3.0, bank: int = 4, margin: int = 16) -> "CameraEffects":
+             flicker: float = 0.012, sigma: float = 3.0, bank: int = 4, margin: int = 16) -> CameraEffects:
         t = np.arange(n_frames) / fps
         walk = np.cumsum(rng.normal(0, 0.0015, n_frames))
         walk -= np.linspace(walk[0], walk[-1], n_frames)  # no drift over the clip

@@ -24,7 +24,7 @@ class Camera:
     cam_height: float = 3.1  # metres above the floor
 
     @classmethod
-    def for_frame(cls, width: int, height: int) -> "Camera":
+    def for_frame(cls, width: int, height: int) -> Camera:
         """The scenes' camera at any frame size (sizes scale with the frame height)."""
         return cls(width, height, f=1.46 * height, horizon=0.14 * height)
 
@@ -49,7 +49,7 @@ class Camera:
         """Depth of the floor seen at image row ``y`` (below the horizon)."""
         return self.f * self.cam_height / (np.asarray(y, float) - self.horizon)
 
-    def local_view(self, x: float, z: float) -> "LocalView":
+    def local_view(self, x: float, z: float) -> LocalView:
         """The projection linearised around the floor point ``(x, z)``."""
         x0, y0 = self.floor_point(x, z)
         return LocalView(float(x0), float(y0), float(self.scale(z)), self.cam_height / z)

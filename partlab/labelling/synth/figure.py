@@ -147,6 +147,91 @@ def _box_corners(u_top, hw_top, hd_top, u_bot, hw_bot, hd_bot) -> np.ndarray:
     return np.array(corners, float)
 
 
+def _leg_joints(pose: FigurePose, H: float) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """``(side, hip, knee, ankle)`` of both legs of a walking (or standing) figure, in body
+    coordinates (left, forward, up) of a figure ``H`` metres tall, before it is lowered."""
+    legs = []
+    swing = pose.gait * LEG_SWING * np.sin(pose.phase)
+    for side, sign in ((1, 1.0), (-1, -1.0)):  # left leg swings with +sin(phase)
+        a = sign * swing
+        # the knee bends most while the leg swings forward
+        flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))
+        hip = np.array([side * HIP_L * H, 0.0, HIP_U * H])
+        knee = hip + THIGH * H * np.array([0.0, np.sin(a), -np.cos(a)])
+        ankle = knee + SHIN * H * np.array([0.0, np.sin(a - flex), -np.cos(a - flex)])
+        legs.append((side, hip, knee, ankle))
+    return legs
+
+
+def _arm_joints(pose: FigurePose, side: int, sh: np.ndarray, H: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(elbow, wrist, hand)`` of the arm from shoulder ``sh`` (side 1: left): reaching for the
+    pose's hand target when it has one, else swinging with the gait (and the right one waving)."""
+    hand_t = None if pose.hands is None else pose.hands[0 if side == 1 else 1]
+    if hand_t is not None and np.all(np.isfinite(hand_t)):
+        elbow, wrist = _ik_elbow(sh, np.asarray(hand_t, float), UPPER_ARM * H, (FOREARM_LEN + HAND_R) * H,
+                                 np.array([side * 0.8, -0.1, -0.6]))
+        hand = wrist
+        wrist = elbow + (hand - elbow) * FOREARM_LEN / (FOREARM_LEN + HAND_R)
+        return elbow, wrist, hand
+    sign = -1.0 if side == 1 else 1.0  # left arm swings against the left leg
+    g = pose.gait * ARM_SWING * np.sin(pose.phase) * sign
+    up = _dir(0.07, g, side)
+    fore = _dir(0.05, g + 0.15 + pose.gait * 0.25 * max(0.0, np.sin(pose.phase) * sign), side)
+    if side == -1 and pose.wave > 0:  # right arm waving: upper arm out, forearm up
+        w = pose.wave
+        up = (1 - w) * up + w * _dir(1.25, 0.25, side)
+        a2 = 0.15 + 0.45 * np.sin(pose.wave_phase)
+        fore_up = np.array([side * np.sin(a2), 0.15, np.cos(a2)])
+        fore = (1 - w) * fore + w * fore_up
+    up /= np.linalg.norm(up)
+    fore /= np.linalg.norm(fore)
+    elbow = sh + UPPER_ARM * H * up
+    wrist = elbow + FOREARM_LEN * H * fore
+    hand = wrist + HAND_R * H * 0.9 * fore
+    return elbow, wrist, hand
+
+
+def _leg_solids(legs, drop: float, project, depth, scale: float, H: float) -> list[_Solid]:
+    """Both legs (thigh to ankle) and shoes of a figure lowered by ``drop``; ``scale`` = pixels
+    per metre times ``H``. The leg stepping towards the camera is in front, the other darker."""
+    out = []
+    leg_depths = [depth(np.stack(leg[1:])) for leg in legs]
+    far = int(np.argmax(leg_depths)) if abs(leg_depths[0] - leg_depths[1]) > 0.02 else -1
+    for i, (_side, hip, knee, ankle) in enumerate(legs):
+        hip, knee, ankle = (p - np.array([0.0, 0.0, drop]) for p in (hip, knee, ankle))
+        pts = project(np.stack([hip, knee, ankle]))
+        r = scale * np.array([THIGH_R, KNEE_R, ANKLE_R])
+        label = TROUSERS_FAR if i == far else TROUSERS
+        out.append(_Solid("limb", (pts, r), label, "hipleg", leg_depths[i] + 0.03))
+        heel = ankle + np.array([0.0, -SHOE_BACK * H, -0.018 * H])
+        toe = ankle + np.array([0.0, SHOE_FRONT * H, -0.018 * H])
+        out.append(_Solid("limb", (project(np.stack([heel, toe])), np.full(2, scale * SHOE_R)),
+                          SHOES, "hipleg", leg_depths[i] + 0.029))
+    return out
+
+
+def _arm_solids(pose: FigurePose, shoulders: np.ndarray, project, depth, scale: float, H: float,
+                short_sleeves: bool) -> list[_Solid]:
+    """Both arms (sleeve, forearm) and hands; the arm farther from the camera is darker."""
+    out: list[_Solid] = []
+    arm_depths = []
+    for side, hand_part, sh in ((1, "left_hand", shoulders[0]), (-1, "right_hand", shoulders[1])):
+        elbow, wrist, hand = _arm_joints(pose, side, sh, H)
+        pts = project(np.stack([sh, elbow, wrist]))
+        d = depth(np.stack([elbow, wrist]))
+        arm_depths.append(d)
+        r = scale * np.array([ARM_R * 1.15, ARM_R, WRIST_R])
+        hand_px = project(hand)[0]
+        out.append(_Solid("arm", (pts, r, short_sleeves), SLEEVE, None, d))
+        hand_label = HAND_LEFT if side == 1 else HAND_RIGHT
+        out.append(_Solid("circle", (hand_px, scale * HAND_R), hand_label, hand_part, d - 0.001))
+    if abs(arm_depths[0] - arm_depths[1]) > 0.03:
+        for s in out:
+            if s.kind == "arm" and s.depth == max(arm_depths):
+                s.label = SLEEVE_FAR
+    return out
+
+
 def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False,
                   long_hair: bool = False) -> list[_Solid]:
     """The solids of the figure in image coordinates, sorted far to near."""
@@ -172,17 +257,8 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
     if pose.seated:
         drop = 0.24 * H  # hips from standing height to a chair seat
     # ---- legs (with the body lowered so that the lower ankle stays on the floor)
-    legs = []
+    legs = [] if pose.seated else _leg_joints(pose, H)
     if not pose.seated:
-        swing = pose.gait * LEG_SWING * np.sin(pose.phase)
-        for side, sign in ((1, 1.0), (-1, -1.0)):  # left leg swings with +sin(phase)
-            a = sign * swing
-            # the knee bends most while the leg swings forward
-            flex = pose.gait * (0.12 + 0.6 * max(0.0, sign * np.cos(pose.phase)))
-            hip = np.array([side * HIP_L * H, 0.0, HIP_U * H])
-            knee = hip + THIGH * H * np.array([0.0, np.sin(a), -np.cos(a)])
-            ankle = knee + SHIN * H * np.array([0.0, np.sin(a - flex), -np.cos(a - flex)])
-            legs.append((side, hip, knee, ankle))
         lowest = min(leg[3][2] for leg in legs)
         drop = lowest - ANKLE_U * H
     pivot_u = HIP_U * H - drop
@@ -203,18 +279,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         pelvis = _box_corners(PELVIS_TOP_U * H - drop, PELVIS_HALF_W * H, PELVIS_HALF_D * H,
                               PELVIS_BOTTOM_U * H - drop, PELVIS_HALF_W * H * 0.95, PELVIS_HALF_D * H)
         solids.append(_Solid("poly", project(pelvis), TROUSERS, "hipleg", depth(pelvis) + 0.035))
-        leg_depths = [depth(np.stack(leg[1:])) for leg in legs]  # the leg stepping towards the camera is in front
-        far = int(np.argmax(leg_depths)) if abs(leg_depths[0] - leg_depths[1]) > 0.02 else -1
-        for i, (side, hip, knee, ankle) in enumerate(legs):
-            hip, knee, ankle = (p - np.array([0.0, 0.0, drop]) for p in (hip, knee, ankle))
-            pts = project(np.stack([hip, knee, ankle]))
-            r = view.s * H * np.array([THIGH_R, KNEE_R, ANKLE_R])
-            label = TROUSERS_FAR if i == far else TROUSERS
-            solids.append(_Solid("limb", (pts, r), label, "hipleg", leg_depths[i] + 0.03))
-            heel = ankle + np.array([0.0, -SHOE_BACK * H, -0.018 * H])
-            toe = ankle + np.array([0.0, SHOE_FRONT * H, -0.018 * H])
-            solids.append(_Solid("limb", (project(np.stack([heel, toe])), np.full(2, view.s * H * SHOE_R)),
-                                 SHOES, "hipleg", leg_depths[i] + 0.029))
+        solids.extend(_leg_solids(legs, drop, project, depth, view.s * H, H))
     # ---- head: hair cap (top and back) under the face (front), turned by head_yaw
     yaw = pose.facing + pose.head_yaw
     Fh = np.array([np.cos(yaw), np.sin(yaw)])
@@ -243,42 +308,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         fc, fax, _ = head_ellipse(0.014, -0.012, HEAD_RL * 0.9, HEAD_RF * 0.86, HEAD_RU * 0.8)
         solids.append(_Solid("ellipse", (fc, fax), FACE, "head", head_depth))
     # ---- arms
-    arm_depths = []
-    for side, hand_part, sh in ((1, "left_hand", shoulders[0]), (-1, "right_hand", shoulders[1])):
-        hand_t = None if pose.hands is None else pose.hands[0 if side == 1 else 1]
-        if hand_t is not None and np.all(np.isfinite(hand_t)):
-            elbow, wrist = _ik_elbow(sh, np.asarray(hand_t, float), UPPER_ARM * H, (FOREARM_LEN + HAND_R) * H,
-                                     np.array([side * 0.8, -0.1, -0.6]))
-            hand = wrist
-            wrist = elbow + (hand - elbow) * FOREARM_LEN / (FOREARM_LEN + HAND_R)
-        else:
-            sign = -1.0 if side == 1 else 1.0  # left arm swings against the left leg
-            g = pose.gait * ARM_SWING * np.sin(pose.phase) * sign
-            up = _dir(0.07, g, side)
-            fore = _dir(0.05, g + 0.15 + pose.gait * 0.25 * max(0.0, np.sin(pose.phase) * sign), side)
-            if side == -1 and pose.wave > 0:  # right arm waving: upper arm out, forearm up
-                w = pose.wave
-                up = (1 - w) * up + w * _dir(1.25, 0.25, side)
-                a2 = 0.15 + 0.45 * np.sin(pose.wave_phase)
-                fore_up = np.array([side * np.sin(a2), 0.15, np.cos(a2)])
-                fore = (1 - w) * fore + w * fore_up
-            up /= np.linalg.norm(up)
-            fore /= np.linalg.norm(fore)
-            elbow = sh + UPPER_ARM * H * up
-            wrist = elbow + FOREARM_LEN * H * fore
-            hand = wrist + HAND_R * H * 0.9 * fore
-        pts = project(np.stack([sh, elbow, wrist]))
-        d = depth(np.stack([elbow, wrist]))
-        arm_depths.append(d)
-        r = view.s * H * np.array([ARM_R * 1.15, ARM_R, WRIST_R])
-        hand_px = project(hand)[0]
-        solids.append(_Solid("arm", (pts, r, short_sleeves), SLEEVE, None, d))
-        hand_label = HAND_LEFT if side == 1 else HAND_RIGHT
-        solids.append(_Solid("circle", (hand_px, view.s * H * HAND_R), hand_label, hand_part, d - 0.001))
-    if abs(arm_depths[0] - arm_depths[1]) > 0.03:
-        for s in solids:
-            if s.kind == "arm" and s.depth == max(arm_depths):
-                s.label = SLEEVE_FAR
+    solids.extend(_arm_solids(pose, shoulders, project, depth, view.s * H, H, short_sleeves))
     solids.sort(key=lambda s: -s.depth)
     return solids
 

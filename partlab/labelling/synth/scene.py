@@ -25,13 +25,23 @@ import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
+from partlab.labelling.synth.activities import BUILDERS as ACTIVITY_BUILDERS
+from partlab.labelling.synth.activities import HANDS
 from partlab.labelling.synth.appearance import Appearance
 from partlab.labelling.synth.background import CameraEffects, draw_props, room, smooth_noise
 from partlab.labelling.synth.camera import Camera
-from partlab.labelling.synth.figure import (FACE, FIGURE_PARTS, FOREARM, HAND_LEFT, HAND_RIGHT, NECK, PART_LABELS, FigurePose,
-                                    colour_table, draw_figure)
-from partlab.labelling.synth.activities import BUILDERS as ACTIVITY_BUILDERS
-from partlab.labelling.synth.activities import HANDS
+from partlab.labelling.synth.figure import (
+    FACE,
+    FIGURE_PARTS,
+    FOREARM,
+    HAND_LEFT,
+    HAND_RIGHT,
+    NECK,
+    PART_LABELS,
+    FigurePose,
+    colour_table,
+    draw_figure,
+)
 from partlab.labelling.synth.scenarios import BUILDERS, Script
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
@@ -115,6 +125,31 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
     frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
 
 
+def _truth_rows(i: int, drawn: list, owner: np.ndarray) -> list[tuple]:
+    """Truth rows of frame ``i``: every drawn person's box and each part's box (its visible
+    pixels, or all of it when hidden), with the occluded fraction from the owner map."""
+    rows = []
+    for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
+        own = owner[cy1:cy2, cx1:cx2]
+        lab = fig.labels[crop]
+        parts = {"person": lab > 0}
+        for p in FIGURE_PARTS:
+            if p in fig.masks:
+                whole = fig.masks[p][crop]
+                shown = whole & np.isin(lab, PART_LABELS[p])
+                parts[p] = shown if shown.any() else whole
+        for part, mask in parts.items():
+            total = int(mask.sum())
+            if total == 0:
+                continue
+            cols = np.flatnonzero(mask.any(axis=0))
+            rws = np.flatnonzero(mask.any(axis=1))
+            visible = int(np.count_nonzero(own[mask] == a + 1))
+            rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
+                         rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+    return rows
+
+
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
                *, clean: bool = False, owners: bool = False, progress: bool = False) -> Scene:
     """Render scenario ``name`` (one of :data:`SCENARIOS`) deterministically from ``seed``.
@@ -176,24 +211,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
             owner[y:y + h, x:x + w] = OCCLUDER_ID
-        for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
-            own = owner[cy1:cy2, cx1:cx2]
-            lab = fig.labels[crop]
-            parts = {"person": lab > 0}
-            for p in FIGURE_PARTS:
-                if p in fig.masks:
-                    whole = fig.masks[p][crop]
-                    shown = whole & np.isin(lab, PART_LABELS[p])
-                    parts[p] = shown if shown.any() else whole
-            for part, mask in parts.items():
-                total = int(mask.sum())
-                if total == 0:
-                    continue
-                cols = np.flatnonzero(mask.any(axis=0))
-                rws = np.flatnonzero(mask.any(axis=1))
-                visible = int(np.count_nonzero(own[mask] == a + 1))
-                rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
-                             rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
+        rows.extend(_truth_rows(i, drawn, owner))
         frames[i] = frame if effects is None else effects.apply(frame, i)
         if owner_maps is not None:
             owner_maps[i] = owner
@@ -207,7 +225,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     events = None
     if script.events:
         events = pd.DataFrame([(e.kind, e.start_frame, e.end_frame, e.track_id_a, e.part_a, e.track_id_b, e.part_b,
-                                "" if e.colour is None else "#%02x%02x%02x" % tuple(reversed(e.colour)))
+                                "" if e.colour is None else "#{:02x}{:02x}{:02x}".format(*reversed(e.colour)))
                                for e in script.events], columns=list(EVENT_TRUTH_COLUMNS))
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
                  tuple(a.appearance for a in script.actors), background, owner_maps, events)

@@ -158,7 +158,8 @@ def body_colours(frame: np.ndarray, foreground: np.ndarray | None, head: Box, pa
     ok &= _skin_model().mask(crop) == 0
     if foreground is not None and (foreground[y0:y1, x0:x1] > 0).mean() >= 0.2:
         ok &= foreground[y0:y1, x0:x1] > 0
-    return np.bincount(hsv[..., 0][ok].ravel(), minlength=HUE_BINS).astype(np.float64) / max(crop.shape[0] * crop.shape[1], 1)
+    counts = np.bincount(hsv[..., 0][ok].ravel(), minlength=HUE_BINS).astype(np.float64)
+    return counts / max(crop.shape[0] * crop.shape[1], 1)
 
 
 def fuse(observations: list[HandColour]) -> np.ndarray:
@@ -189,4 +190,4 @@ def colour_masses(fused: np.ndarray, params: ActivityParams) -> dict[int, float]
 def hue_to_hex(hue_bin: int) -> str:
     """A saturated colour of that hue, as ``#rrggbb`` (for the events table and the app)."""
     bgr = cv2.cvtColor(np.uint8([[[hue_bin % HUE_BINS, 220, 220]]]), cv2.COLOR_HSV2BGR)[0, 0]
-    return "#%02x%02x%02x" % (int(bgr[2]), int(bgr[1]), int(bgr[0]))
+    return f"#{int(bgr[2]):02x}{int(bgr[1]):02x}{int(bgr[0]):02x}"

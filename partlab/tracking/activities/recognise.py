@@ -16,7 +16,7 @@ object's colour (``#rrggbb``) and a confidence in [0, 1].
 from __future__ import annotations
 
 from collections import defaultdict
-from typing import Mapping
+from collections.abc import Mapping
 
 import numpy as np
 import pandas as pd

@@ -27,10 +27,10 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from partlab.tracking.core.box import Box
 from partlab.tracking.body.decomposition import decompose, inner_rectangle, minimum_bounding_rectangle
-from partlab.tracking.protocol import FailureVerdict
 from partlab.tracking.body.part_filter import box_to_state, state_to_box
+from partlab.tracking.core.box import Box
+from partlab.tracking.protocol import FailureVerdict
 
 if TYPE_CHECKING:
     from partlab.tracking.body.tracker import BodyTracker, Person
@@ -110,7 +110,7 @@ def reinitialise_box(predicted: Box, mask: np.ndarray | None, W: int, H: int, gr
     return best
 
 
-def adjust_person(tracker: "BodyTracker", person: "Person", verdict: FailureVerdict,
+def adjust_person(tracker: BodyTracker, person: Person, verdict: FailureVerdict,
                   ycc: np.ndarray, mask: np.ndarray | None) -> None:
     """Repair the parts ``verdict`` flags (seed 002 sec. 4.3); re-seeds their filters."""
     H, W = ycc.shape[:2]

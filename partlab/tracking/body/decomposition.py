@@ -21,6 +21,7 @@ import cv2
 import numpy as np
 
 from partlab.tracking.core.box import Box
+from partlab.tracking.measures import person_box
 from partlab.tracking.params import BodyParams
 
 #: below this share of foreground in the person's box the mask is not trusted (first frames
@@ -102,8 +103,8 @@ def separation_lines(colours: np.ndarray, fg: np.ndarray, top: int, bottom: int,
     step = max(1, height // 50)
 
     def climb(line: int, lo_bound: int, hi_bound: int, upper: int, lower: int, initial: int) -> int:
-        def diff(l: int) -> float:
-            return float(np.linalg.norm(mean(upper, l) - mean(l, lower)))
+        def diff(at: int) -> float:
+            return float(np.linalg.norm(mean(upper, at) - mean(at, lower)))
         best = diff(line)
         while True:
             cands = [c for c in range(line - step, line + step + 1) if c != line and lo_bound < c < hi_bound]
@@ -174,12 +175,5 @@ def shrink_part(ycc: np.ndarray, mask: np.ndarray | None, box: Box, part: str) -
     return rect if rect is not None else box
 
 
-def minimum_bounding_rectangle(boxes) -> Box:
-    """The person box of the three-part tracker: the MBR of its parts' boxes (sec. 5.3)."""
-    boxes = list(boxes)
-    if not boxes:
-        raise ValueError("no boxes to bound")
-    out = boxes[0]
-    for b in boxes[1:]:
-        out = out.union_box(b)
-    return out
+#: The MBR of boxes: the person box of the three-part tracker (sec. 5.3), defined in one place.
+minimum_bounding_rectangle = person_box

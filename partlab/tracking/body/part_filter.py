@@ -26,9 +26,9 @@ from partlab.tracking.core import kernels
 from partlab.tracking.core.box import Box
 from partlab.tracking.core.histogram import (
     _smooth,
-    binned_histogram,
     bhattacharyya,
     bhattacharyya_counts,
+    binned_histogram,
     equalization_map,
     fused_lut,
     level_histogram,
@@ -37,8 +37,8 @@ from partlab.tracking.core.histogram import (
 )
 from partlab.tracking.core.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 from partlab.tracking.core.lazy_ycc import as_array, cover, cover_rects
-from partlab.tracking.params import BodyParams, PartNoise
 from partlab.tracking.core.resampling import adaptive_particle_count, normalise_weights, systematic_resample
+from partlab.tracking.params import BodyParams, PartNoise
 
 
 def box_to_state(box: Box) -> np.ndarray:
@@ -97,7 +97,8 @@ class PartFilter:
             self.mapping, self.target, self.sqrt_target = kernels.equalize(
                 smoothed, self.reference, p.appearance.bins_per_channel, p.appearance.equalization_floor)
             return
-        self.mapping = equalization_map(self.reference, p.appearance.bins_per_channel, p.appearance.equalization_smoothing,
+        self.mapping = equalization_map(self.reference, p.appearance.bins_per_channel,
+                                        p.appearance.equalization_smoothing,
                                         p.appearance.equalization_floor)
         self.lut = fused_lut(self.mapping, p.appearance.bins_per_channel)
         self.target = binned_histogram(self.reference, self.mapping, p.appearance.bins_per_channel)

@@ -32,14 +32,14 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from partlab.tracking.core.box import Box, iou_xywh
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
-from partlab.tracking.protocol import FailureDetector, FailureVerdict
+from partlab.tracking.body.part_filter import PartFilter
+from partlab.tracking.core.box import Box, iou_xywh
 from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
 from partlab.tracking.params import BodyParams
-from partlab.tracking.body.part_filter import PartFilter
 from partlab.tracking.parts import BODY_PARTS
+from partlab.tracking.protocol import FailureDetector, FailureVerdict
 from partlab.tracking.tracks import TrackRecord, normalise_tracks
 
 
@@ -257,7 +257,8 @@ class BodyTracker:
 
     # -- one frame ----------------------------------------------------------------------
     def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None) -> list[TrackRecord]:
-        p = self.params
+        """Predict every part; decide who is hidden; measure the others; detect failures and
+        adjust; update the models and resample; end tracks and look for new people."""
         ycc = self._ycc.load(frame)  # converted to YCrCb only where the filters look
         H, W = ycc.shape[:2]
         self.frame_size = (W, H)
@@ -283,10 +284,21 @@ class BodyTracker:
             self._measure(person, ycc)
         self._resolve_inter_person_occlusion(active)
 
-        # failure detection and adjustment (sec. 4.2-4.3) for persons not in occlusion
+        if not self.whole:
+            self._detect_failures(active, ycc, mask)
+        self._update_models(active)
+
         for person in active:
-            if self.whole:
-                continue
+            if not person.touching and person.occluded_by is None and not person.hidden_parts:
+                person.centres.append((index, *person.box().centre))
+        self._end_tracks(active, mask, W, H)
+        if self.auto and mask is not None:
+            self._detect(index, frame, ycc, mask)
+        return self._records(index, new_ids)
+
+    def _detect_failures(self, active: list[Person], ycc, mask: np.ndarray | None) -> None:
+        """Failure detection and adjustment (sec. 4.2-4.3) for persons not in occlusion."""
+        for person in active:
             # the detector sees the boxes as reported (and as corrected by people), not the
             # inner rectangles, so that what it was trained on and what it judges agree
             reported = [self.report_box(n, person.filters[n].box) for n in BODY_PARTS]
@@ -297,23 +309,17 @@ class BodyTracker:
             if verdict.failed or verdict.multi:
                 self._adjust(person, verdict, ycc, mask)
 
-        # model update (eq. 1) and resampling (eq. 2)
+    def _update_models(self, active: list[Person]) -> None:
+        """Model update (eq. (1)) where the estimate matches well, and resampling (eq. (2))."""
+        least = self.params.appearance.update_min_similarity
         for person in active:
             for name, f in person.filters.items():
                 if person.occluded_by is not None or name in person.hidden_parts:
                     continue
                 q = person.observed.pop(name, None)
-                if q is not None and person.scores[name] >= p.appearance.update_min_similarity and not person.adjusted:
+                if q is not None and person.scores[name] >= least and not person.adjusted:
                     f.update_model(q)
                 f.resample()
-
-        for person in active:
-            if not person.touching and person.occluded_by is None and not person.hidden_parts:
-                person.centres.append((index, *person.box().centre))
-        self._end_tracks(active, mask, W, H)
-        if self.auto and mask is not None:
-            self._detect(index, frame, ycc, mask)
-        return self._records(index, new_ids)
 
     def _update_person_occlusion(self, person: Person) -> None:
         """Sec. 4.3.1: stay occluded while the person in front still overlaps; sec. 4.3.2:
@@ -356,7 +362,8 @@ class BodyTracker:
                     f.particles[:, 0:2] += delta
                     f.particles[:, 4:6] += delta
                 ax, ay = torso[0], torso[1] + person.offsets[name] * torso[3]
-                f.measure(ycc, ax, self.params.dynamics.coherence * torso[2], ay, self.params.dynamics.coherence_y * torso[3])
+                dyn = self.params.dynamics
+                f.measure(ycc, ax, dyn.coherence * torso[2], ay, dyn.coherence_y * torso[3])
             if name == "torso":
                 torso = f.state.copy()
             person.observed[name] = q = f.appearance(ycc)
@@ -494,7 +501,7 @@ class BodyTracker:
                 person.unsupported = person.unsupported + 1 if support < p.detection.support_min else 0
                 if person.unsupported >= p.detection.lost_frames:
                     del self.people[person.track_id]
-        for tid, q in list(self.people.items()):
+        for q in list(self.people.values()):
             if q.occluded_by is not None and q.occluded_by not in self.people:
                 q.occluded_by = None
 
@@ -525,7 +532,7 @@ class BodyTracker:
                                        float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
-            for name, f in person.filters.items():
+            for name in person.filters:
                 hidden = person.occluded_by is not None or name in person.hidden_parts
                 part_state = "occluded" if hidden and state == "tracked" else state
                 out.append(TrackRecord(index, tid, name, boxes[name], person.scores.get(name, 1.0),

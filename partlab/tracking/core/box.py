@@ -39,13 +39,13 @@ class Box:
     def centre(self) -> tuple[float, float]:
         return (self.x + self.w / 2.0, self.y + self.h / 2.0)
 
-    def intersection(self, other: "Box") -> float:
+    def intersection(self, other: Box) -> float:
         """Area of overlap with ``other`` (0 when disjoint)."""
         iw = min(self.x2, other.x2) - max(self.x, other.x)
         ih = min(self.y2, other.y2) - max(self.y, other.y)
         return max(iw, 0.0) * max(ih, 0.0)
 
-    def iou(self, other: "Box") -> float:
+    def iou(self, other: Box) -> float:
         """Intersection over union; 0 for two empty boxes."""
         inter = self.intersection(other)
         union = self.area + other.area - inter
@@ -54,7 +54,7 @@ class Box:
     def contains_point(self, px: float, py: float) -> bool:
         return self.x <= px <= self.x2 and self.y <= py <= self.y2
 
-    def clip(self, width: int, height: int) -> "Box":
+    def clip(self, width: int, height: int) -> Box:
         """The part of the box inside a ``width`` x ``height`` frame (may be empty)."""
         x1 = min(max(self.x, 0.0), width)
         y1 = min(max(self.y, 0.0), height)
@@ -62,13 +62,13 @@ class Box:
         y2 = min(max(self.y2, 0.0), height)
         return Box(x1, y1, x2 - x1, y2 - y1)
 
-    def union_box(self, other: "Box") -> "Box":
+    def union_box(self, other: Box) -> Box:
         """Minimum bounding rectangle of both boxes."""
         x1, y1 = min(self.x, other.x), min(self.y, other.y)
         x2, y2 = max(self.x2, other.x2), max(self.y2, other.y2)
         return Box(x1, y1, x2 - x1, y2 - y1)
 
-    def transformed(self, scale_w: float, scale_h: float, shift_x: float = 0.0, shift_y: float = 0.0) -> "Box":
+    def transformed(self, scale_w: float, scale_h: float, shift_x: float = 0.0, shift_y: float = 0.0) -> Box:
         """The box scaled about its centre and moved by fractions of its own size."""
         cx, cy = self.centre
         cx += shift_x * self.w

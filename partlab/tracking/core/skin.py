@@ -72,14 +72,14 @@ class SkinModel:
         return int(self.table.shape[0])
 
     @classmethod
-    def default(cls, bins: int = 32, blur: int = 5) -> "SkinModel":
+    def default(cls, bins: int = 32, blur: int = 5) -> SkinModel:
         """The rectangular YCrCb rule as a table: 1 inside the ranges, 0 outside."""
         centres = (np.arange(bins) + 0.5) * (256 / bins)
         cr_in = (centres >= DEFAULT_CR[0]) & (centres <= DEFAULT_CR[1] + 1)
         cb_in = (centres >= DEFAULT_CB[0]) & (centres <= DEFAULT_CB[1] + 1)
         return cls((cr_in[:, None] & cb_in[None, :]).astype(np.float32)[None], blur)
 
-    def with_ybins(self, ybins: int) -> "SkinModel":
+    def with_ybins(self, ybins: int) -> SkinModel:
         """The same model over ``ybins`` luma bins (a 1-bin table is repeated)."""
         if ybins == self.ybins:
             return self
@@ -117,7 +117,7 @@ class SkinModel:
                 "table": np.round(self.table, 5).tolist()}
 
     @classmethod
-    def from_dict(cls, data: dict) -> "SkinModel":
+    def from_dict(cls, data: dict) -> SkinModel:
         if data.get("kind") != "skin_ycrcb_table":
             raise ValueError(f"not a skin model (kind={data.get('kind')!r})")
         return cls(np.asarray(data["table"], dtype=np.float32), int(data.get("blur", 5)))
@@ -131,7 +131,7 @@ class SkinModel:
             path.write_text(json.dumps(self.to_dict()))
 
     @classmethod
-    def load(cls, path: str | PathLike) -> "SkinModel":
+    def load(cls, path: str | PathLike) -> SkinModel:
         path = Path(path)
         if path.suffix == ".npz":
             with np.load(path, allow_pickle=False) as z:

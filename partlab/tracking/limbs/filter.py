@@ -25,9 +25,9 @@ import cv2
 import numpy as np
 
 from partlab.tracking.core.hue_histogram import box_histograms, hue_confidence, mean_shift
-from partlab.tracking.params import LimbParams
 from partlab.tracking.core.resampling import systematic_resample
 from partlab.tracking.core.skin import Blobs
+from partlab.tracking.params import LimbParams
 
 
 @dataclass(frozen=True)
@@ -234,8 +234,9 @@ class LimbFilter:
     def predict(self, rng: np.random.Generator, scale: float = 1.0) -> None:
         """Second-order dynamics (seed 003 sec. 3): position += velocity, both with white noise."""
         p, n = self.params, len(self.particles)
-        self.particles[:, 2:] = p.dynamics.velocity_decay * self.particles[:, 2:] + rng.normal(0.0, p.dynamics.noise_v * scale, (n, 2))
-        self.particles[:, :2] += self.particles[:, 2:] + rng.normal(0.0, p.dynamics.noise_xy * scale, (n, 2))
+        d = p.dynamics
+        self.particles[:, 2:] = d.velocity_decay * self.particles[:, 2:] + rng.normal(0.0, d.noise_v * scale, (n, 2))
+        self.particles[:, :2] += self.particles[:, 2:] + rng.normal(0.0, d.noise_xy * scale, (n, 2))
 
     def particle_boxes(self) -> np.ndarray:
         w, h = self.size

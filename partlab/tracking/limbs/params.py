@@ -28,7 +28,6 @@ from partlab.tracking.core.params import (
     POSITIVE,
     POSITIVE_COUNT,
     Parameters,
-    Rule,
     flag,
     group_field,
     number,

@@ -9,10 +9,12 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   for ``start_frames`` frames;
 - unlabelled -> normal: a labelling cue gave the tracker its type;
 - normal -> combined (both trackers): their estimates come closer than
-  ``combine_size`` target sizes (``combine_distance`` pixels when no size is given) while both are confident (likelihood at least
+  ``combine_size`` target sizes (``combine_distance`` pixels when no size is given) while both are
+  confident (likelihood at least
   ``lost_likelihood``); the vector between them before joining is kept;
 - combined -> unlabelled (both): the combined posterior's two strongest modes lie
-  more than ``split_size`` target sizes (or ``split_distance`` pixels) apart; each tracker receives the mode that keeps the
+  more than ``split_size`` target sizes (or ``split_distance`` pixels) apart; each tracker receives
+  the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
 - normal / unlabelled / combined -> lost: the likelihood stays below
   ``lost_likelihood`` for ``lost_frames`` frames (sec. 5.2: "test the posterior
@@ -129,7 +131,8 @@ class LimbStateMachine:
     def add(self, tracker: int, state: LimbState = LimbState.UNINITIALIZED) -> None:
         if tracker in self._status:
             raise ValueError(f"tracker {tracker} already exists")
-        self._status[tracker] = _Status(LimbState(state), history=deque(maxlen=max(self.params.states.history_frames, 1)))
+        history = deque(maxlen=max(self.params.states.history_frames, 1))
+        self._status[tracker] = _Status(LimbState(state), history=history)
 
     def state(self, tracker: int) -> LimbState:
         return self._status[tracker].state
@@ -183,34 +186,14 @@ class LimbStateMachine:
             s.low = s.low + 1 if obs.likelihood < p.states.lost_likelihood else 0
 
         for t, s in list(self._status.items()):
-            obs = observations.get(t, Observation())
             if t in moved:
                 continue
-            if s.state == LimbState.UNINITIALIZED:
-                s.strong = s.strong + 1 if obs.prior >= p.states.start_prior else 0
-                if s.strong >= p.states.start_frames:
-                    move(t, LimbState.UNLABELLED, "strong candidate")
-            elif s.state in (LimbState.NORMAL, LimbState.UNLABELLED):
-                if s.low >= p.states.lost_frames:
-                    move(t, LimbState.LOST, "low likelihood")
-                elif s.state == LimbState.UNLABELLED and obs.labelled:
-                    move(t, LimbState.NORMAL, "labelled")
-            elif s.state == LimbState.LOST:
-                if obs.likelihood >= p.states.recover_likelihood:
-                    move(t, LimbState.NORMAL if obs.labelled else LimbState.UNLABELLED, "recovered")
-            elif s.state == LimbState.COMBINED and self.is_leader(t):
-                b = s.partner
-                modes = np.asarray(obs.modes, float).reshape(-1, 2)
-                if s.low >= p.states.lost_frames:
-                    self._end_join(frame, t, b, "lost")
-                    move(t, LimbState.LOST, "combined target lost", b)
-                    move(b, LimbState.LOST, "combined target lost", t)
-                elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > distance_threshold(
-                        p.states.split_distance, p.states.split_size, obs.size):
-                    pos_a, pos_b = assign_by_direction(s.before, modes[:2])
-                    self._end_join(frame, t, b, "split")
-                    move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
-                    move(b, LimbState.UNLABELLED, "split", t, tuple(map(float, pos_b)))
+            obs = observations.get(t, Observation())
+            if s.state == LimbState.COMBINED:
+                if self.is_leader(t):
+                    self._combined_step(frame, t, s, obs, move)
+            else:
+                self._single_step(t, s, obs, move)
 
         self._combine(frame, observations, move)
         for t, s in self._status.items():
@@ -220,6 +203,39 @@ class LimbStateMachine:
             if obs.size > 0:
                 self._sizes[t] = obs.size
         return out
+
+    def _single_step(self, t: int, s: _Status, obs: Observation, move) -> None:
+        """uninitialized -> unlabelled (a strong candidate), normal/unlabelled -> lost (low
+        likelihood), unlabelled -> normal (labelled), lost -> normal/unlabelled (recovered)."""
+        p = self.params.states
+        if s.state == LimbState.UNINITIALIZED:
+            s.strong = s.strong + 1 if obs.prior >= p.start_prior else 0
+            if s.strong >= p.start_frames:
+                move(t, LimbState.UNLABELLED, "strong candidate")
+        elif s.state in (LimbState.NORMAL, LimbState.UNLABELLED):
+            if s.low >= p.lost_frames:
+                move(t, LimbState.LOST, "low likelihood")
+            elif s.state == LimbState.UNLABELLED and obs.labelled:
+                move(t, LimbState.NORMAL, "labelled")
+        elif s.state == LimbState.LOST and obs.likelihood >= p.recover_likelihood:
+            move(t, LimbState.NORMAL if obs.labelled else LimbState.UNLABELLED, "recovered")
+
+    def _combined_step(self, frame: int, t: int, s: _Status, obs: Observation, move) -> None:
+        """A combined pair (seen by its leader ``t``) is lost together, or splits into two
+        unlabelled trackers once its two modes are ``split_size`` sides apart."""
+        p = self.params.states
+        b = s.partner
+        modes = np.asarray(obs.modes, float).reshape(-1, 2)
+        if s.low >= p.lost_frames:
+            self._end_join(frame, t, b, "lost")
+            move(t, LimbState.LOST, "combined target lost", b)
+            move(b, LimbState.LOST, "combined target lost", t)
+        elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > distance_threshold(
+                p.split_distance, p.split_size, obs.size):
+            pos_a, pos_b = assign_by_direction(s.before, modes[:2])
+            self._end_join(frame, t, b, "split")
+            move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
+            move(b, LimbState.UNLABELLED, "split", t, tuple(map(float, pos_b)))
 
     def _end_join(self, frame: int, a: int, b: int, how: str) -> None:
         sa, sb = self._status[a], self._status[b]
@@ -260,7 +276,8 @@ class LimbStateMachine:
         n = min(len(ha), len(hb))
         pairs = list(zip(ha[len(ha) - n:], hb[len(hb) - n:]))
         for pa, pb in reversed(pairs):
-            if np.hypot(*(pa - pb)) >= distance_threshold(self.params.states.combine_distance, self.params.states.combine_size,
+            states = self.params.states
+            if np.hypot(*(pa - pb)) >= distance_threshold(states.combine_distance, states.combine_size,
                                                        self._sizes.get(a, 0.0)):
                 return pa - pb
         if pairs:

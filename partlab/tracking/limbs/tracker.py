@@ -32,13 +32,27 @@ import pandas as pd
 
 from partlab.tracking.core.box import Box
 from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
-from partlab.tracking.limbs.filter import (Candidates, LimbFilter, blob_points, candidate_modes, candidate_terms,
-                                 nearest_part_candidates, nearest_per_parent, tip_candidates)
+from partlab.tracking.core.skin import Blobs, SkinModel, find_blobs, train_skin_model
+from partlab.tracking.limbs.filter import (
+    Candidates,
+    LimbFilter,
+    blob_points,
+    candidate_modes,
+    candidate_terms,
+    nearest_part_candidates,
+    nearest_per_parent,
+    tip_candidates,
+)
+from partlab.tracking.limbs.state_machine import (
+    JoinEvent,
+    LimbState,
+    LimbStateMachine,
+    Observation,
+    assign_by_direction,
+    distance_threshold,
+)
 from partlab.tracking.params import LimbParams
 from partlab.tracking.parts import LIMB_PARTS
-from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
-from partlab.tracking.limbs.state_machine import (JoinEvent, LimbState, LimbStateMachine, Observation, assign_by_direction,
-                                    distance_threshold)
 from partlab.tracking.tracks import TrackRecord, normalise_tracks
 
 EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a",
@@ -106,6 +120,56 @@ class _Target:
         return self.track_id is not None and self.part is not None
 
 
+def _check_frame(frame: np.ndarray, foreground: np.ndarray | None) -> np.ndarray:
+    frame = np.asarray(frame)
+    if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
+        raise ValueError(f"expected a BGR (H, W, 3) uint8 frame, got shape {frame.shape} dtype {frame.dtype}")
+    if foreground is not None and np.asarray(foreground).shape != frame.shape[:2]:
+        raise ValueError(f"foreground mask shape {np.asarray(foreground).shape} does not match the frame "
+                         f"{frame.shape[:2]}")
+    return frame
+
+
+@dataclass(frozen=True)
+class _View:
+    """One frame's observations: skin ``blobs``, their candidates ``cands``, the hue bin of every
+    skin pixel ``skin_bins (H, W) int16`` (-1 elsewhere) and its integral histogram."""
+
+    blobs: Blobs
+    cands: Candidates
+    skin_bins: np.ndarray
+    integral: np.ndarray
+
+
+class _CandidateSets:
+    """The candidates each target sees this frame: blob centres for heads and small hands, the
+    blobs' ends for hands (one set per hand size, built once), with the targets sitting on each."""
+
+    def __init__(self, tracker: LimbTracker, view: _View, active: list[int]):
+        self.tracker, self.cands, self.blobs, self.active = tracker, view.cands, view.blobs, active
+        self._pixels: list | None = None  # each blob's pixels, read once when a hand needs its ends
+        self._sets: dict = {}
+        owner, within = tracker._owners(view.cands, active)
+        # a head's blob (face and neck) is no hand's: its lower end would look like one
+        self.heads = within & np.array([tracker.targets[o].part == "head" if o >= 0 else False for o in owner], bool)
+
+    def points(self) -> list[np.ndarray]:
+        if self._pixels is None:
+            self._pixels = blob_points(self.blobs)
+        return self._pixels
+
+    def not_heads(self, c: Candidates) -> Candidates:
+        return self.tracker._subset(c, ~self.heads[c.parents]) if c.parents is not None else c
+
+    def by(self, t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
+        side = self.tracker._hand_side(t)
+        if side not in self._sets:
+            c = self.cands if side is None else self.not_heads(
+                tip_candidates(self.cands, self.points(), side, self.tracker.params))
+            self._sets[side] = (c, self.tracker._owners(c, self.active))
+        return self._sets[side]
+
+
 class LimbTracker:
     """Head and hands of several people; implements ``partlab.tracking.protocol.FrameTracker``.
 
@@ -162,17 +226,38 @@ class LimbTracker:
         return pd.DataFrame(rows, columns=list(EVENT_COLUMNS))
 
     def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None = None) -> list[TrackRecord]:
-        p = self.params
-        frame = np.asarray(frame)
-        if frame.ndim != 3 or frame.shape[2] != 3 or frame.dtype != np.uint8:
-            raise ValueError(f"expected a BGR (H, W, 3) uint8 frame, got shape {frame.shape} dtype {frame.dtype}")
-        if foreground is not None and np.asarray(foreground).shape != frame.shape[:2]:
-            raise ValueError(f"foreground mask shape {np.asarray(foreground).shape} does not match the frame "
-                             f"{frame.shape[:2]}")
+        """One frame: observations, the low layer (every filter), the high layer (the state machine)."""
+        frame = _check_frame(frame, foreground)
         self._last_frame = index
-
-        # 1. observations ------------------------------------------------------------------
+        # 1. observations
         starting = self._init.get(index, [])
+        view = self._observe(index, frame, foreground, starting)
+        for track_id, part, box in starting:
+            self._start(box, view.skin_bins, track_id, part)
+        self._fill_references(view.skin_bins)
+        for t, tgt in self.targets.items():  # started before their head was: anchor them now
+            if tgt.anchor is None and tgt.last is not None and tgt.part != "head":
+                tgt.anchor = self._head_of(t)
+        # 2. low layer
+        active = [t for t in self.machine.trackers()
+                  if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
+        seen = _CandidateSets(self, view, active)
+        observations = {t: self._filter_step(t, seen, view) for t in active}
+        self._follow_leaders(observations)
+        if self.auto_start:
+            self._propose(view.cands, observations)
+        self._label(index, frame, observations)
+        self._reacquire_heads(frame, view.skin_bins, observations)
+        # 3. high layer
+        for tr in self.machine.update(index, observations):
+            self._apply(tr, index, view.skin_bins)
+        self._fill_references(view.skin_bins)
+        return self._records(index)
+
+    # -- 1. observations -------------------------------------------------------------------
+    def _observe(self, index: int, frame: np.ndarray, foreground: np.ndarray | None, starting) -> _View:
+        """Skin pixels within the support, their blobs, candidates and the skin hue."""
+        p = self.params
         if starting and p.skin.adapt:
             # the given boxes show these people's skin against this scene: a Bayes skin model
             # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
@@ -193,124 +278,112 @@ class LimbTracker:
         blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blobs.alpha, self._min_area(starting))
         cands = candidate_terms(blobs, fg, skin_prob, p)
         hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
-        bins = hue_bin_image(hsv, p.appearance.hue_bins, p.appearance.hue_min_saturation, p.appearance.hue_min_value)
+        a = p.appearance
+        bins = hue_bin_image(hsv, a.hue_bins, a.hue_min_saturation, a.hue_min_value)
         skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)  # skin_mask is within the support
         # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
         # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
         # The colour likelihood and the mean shift therefore run on the "skin-colour
         # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
-        integral = integral_histogram(skin_bins, p.appearance.hue_bins)
+        integral = integral_histogram(skin_bins, a.hue_bins)
+        return _View(blobs, cands, skin_bins, integral)
 
-        for track_id, part, box in starting:
-            self._start(box, skin_bins, track_id, part)
-        self._fill_references(skin_bins)
-        for t, tgt in self.targets.items():  # started before their head was: anchor them now
-            if tgt.anchor is None and tgt.last is not None and tgt.part != "head":
-                tgt.anchor = self._head_of(t)
+    # -- 2. low layer: one filter ----------------------------------------------------------
+    def _filter_step(self, t: int, seen: _CandidateSets, view: _View) -> Observation:
+        """Predict, weigh against the candidates this target may see, refine, resample."""
+        tgt = self.targets[t]
+        state = self.machine.state(t)
+        own_c, owners = seen.by(t)
+        before, prev, tgt.prev = tgt.filter.estimate.copy(), tgt.prev, None
+        obs_c = self._predict(t, state, seen, own_c, owners)
+        on_end = False  # the hand is seen as the end of an arm-long blob
+        if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
+            obs_c, on_end = self._nearest_ends(tgt, state, obs_c, own_c, before, prev, len(view.blobs))
+        tgt.filter.weigh(obs_c, view.integral)
+        modes = self._pair_modes(t, obs_c) if state == LimbState.COMBINED else ()
+        if state != LimbState.LOST:
+            self._refine(tgt, obs_c, on_end, view.skin_bins)
+        tgt.filter.resample(self.rng)
+        self._remember(t, state, before, view.skin_bins)
+        observation = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
+                                  labelled=tgt.labelled, modes=modes, size=self._side(t))
+        self._place_pair(t, modes)
+        return observation
 
-        # 2. low layer ---------------------------------------------------------------------
-        active = [t for t in self.machine.trackers()
-                  if self.machine.state(t) != LimbState.UNINITIALIZED and self.machine.is_leader(t)]
-        observations: dict[int, Observation] = {}
-        pixels: list = []  # each blob's pixels, read once when a hand needs its ends
-        sets: dict = {}  # hands' candidate sets (blob ends) and their owners, by box side
-        owner, within = self._owners(cands, active)
-        # a head's blob (face and neck) is no hand's: its lower end would look like one
-        heads = within & np.array([self.targets[o].part == "head" if o >= 0 else False for o in owner], bool)
-
-        def points() -> list[np.ndarray]:
-            if not pixels:
-                pixels.append(blob_points(blobs))
-            return pixels[0]
-
-        def not_heads(c: Candidates) -> Candidates:
-            return self._subset(c, ~heads[c.parents]) if c.parents is not None else c
-
-        def seen_by(t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
+    def _predict(self, t: int, state: LimbState, seen: _CandidateSets, own_c: Candidates, owners) -> Candidates:
+        """Move the filter by its state's dynamics; the candidates it is weighed against."""
+        p, tgt = self.params, self.targets[t]
+        if state == LimbState.LOST:
+            tgt.filter.reset(self._search_centre(t), self.rng, spread=p.dynamics.lost_search)
+            return self._unclaimed(own_c, exclude=t)
+        if state == LimbState.COMBINED:
+            # the pair's filter sees only candidates no other tracker explains (its own blobs)
+            tgt.filter.predict(self.rng, p.dynamics.combined_noise_scale)
             side = self._hand_side(t)
-            if side not in sets:
-                c = cands if side is None else not_heads(tip_candidates(cands, points(), side, p))
-                sets[side] = (c, self._owners(c, active))
-            return sets[side]
+            if side is not None:  # two hands: each blob's part nearest the pair
+                own_c = seen.not_heads(nearest_part_candidates(seen.cands, seen.points(), tgt.filter.estimate,
+                                                               side, p))
+            return self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
+        tgt.filter.predict(self.rng)
+        return self._owned(own_c, t, owners)
 
-        for t in active:
-            tgt = self.targets[t]
-            state = self.machine.state(t)
-            own_c, owners = seen_by(t)
-            before, prev, tgt.prev = tgt.filter.estimate.copy(), tgt.prev, None
-            if state == LimbState.LOST:
-                tgt.filter.reset(self._search_centre(t), self.rng, spread=p.dynamics.lost_search)
-                obs_c = self._unclaimed(own_c, exclude=t)
-            elif state == LimbState.COMBINED:
-                # the pair's filter sees only candidates no other tracker explains (its own blobs)
-                tgt.filter.predict(self.rng, p.dynamics.combined_noise_scale)
-                side = self._hand_side(t)
-                if side is not None:  # two hands: each blob's part nearest the pair
-                    own_c = not_heads(nearest_part_candidates(cands, points(), tgt.filter.estimate, side, p))
-                obs_c = self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
-            else:
-                tgt.filter.predict(self.rng)
-                obs_c = self._owned(own_c, t, owners)
-            on_end = False  # the hand is seen as the end of an arm-long blob
-            if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
-                # one end per blob, the one nearest the predicted hand: the other end of its arm
-                # is its elbow, and a posterior split between both ends would put it mid-arm
-                at = tgt.filter.estimate if state == LimbState.LOST else \
-                    before if prev is None else before + p.dynamics.velocity_decay * (before - prev)
-                ends = np.bincount(own_c.parents, minlength=len(blobs))[obs_c.parents] >= 2
-                keep = nearest_per_parent(obs_c, at)
-                if state != LimbState.LOST:
-                    # an arm's end farther than tip_gate sides is another part of it (an elbow
-                    # when the hand end merged into another blob): not this hand
-                    far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.blobs.tip_gate * max(tgt.size)
-                    keep &= ~(ends & far)
-                obs_c, ends = self._subset(obs_c, keep), ends[keep]
-                if len(obs_c):
-                    on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))])
-            tgt.filter.weigh(obs_c, integral)
-            modes: tuple = ()
-            if state == LimbState.COMBINED:
-                radius = p.states.mode_search * distance_threshold(p.states.split_distance, p.states.split_size, self._side(t))
-                # a kernel as wide as the search: the particles sit on one mode, the other may be far
-                m = candidate_modes(tgt.filter.particles[:, :2], tgt.filter.weights, obs_c, radius, radius)
-                modes = tuple(map(tuple, m[:2]))
-            if state != LimbState.LOST and on_end:
-                # the refinement of an arm's end is the end itself (mean shift on the skin
-                # would slide the window up the arm)
-                d = np.hypot(*(obs_c.centres - tgt.filter.estimate[None, :]).T)
-                if d.min() <= max(tgt.size):
-                    tgt.filter.shift_to(obs_c.centres[int(np.argmin(d))])
-            elif state != LimbState.LOST:
-                bp = back_projection(skin_bins, tgt.filter.ref_hist)
-                tgt.filter.refine(bp)
-            tgt.filter.resample(self.rng)
+    def _nearest_ends(self, tgt: _Target, state: LimbState, obs_c: Candidates, own_c: Candidates,
+                      before: np.ndarray, prev: np.ndarray | None, n_blobs: int) -> tuple[Candidates, bool]:
+        """One end per blob, the one nearest the predicted hand: the other end of its arm is its
+        elbow, and a posterior split between both ends would put it mid-arm. Also whether the
+        nearest kept candidate is an arm's end."""
+        p = self.params
+        at = tgt.filter.estimate if state == LimbState.LOST else \
+            before if prev is None else before + p.dynamics.velocity_decay * (before - prev)
+        ends = np.bincount(own_c.parents, minlength=n_blobs)[obs_c.parents] >= 2
+        keep = nearest_per_parent(obs_c, at)
+        if state != LimbState.LOST:
+            # an arm's end farther than tip_gate sides is another part of it (an elbow
+            # when the hand end merged into another blob): not this hand
+            far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.blobs.tip_gate * max(tgt.size)
+            keep &= ~(ends & far)
+        obs_c, ends = self._subset(obs_c, keep), ends[keep]
+        on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))]) if len(obs_c) else False
+        return obs_c, on_end
+
+    def _pair_modes(self, t: int, obs_c: Candidates) -> tuple:
+        """The two strongest posterior modes of a combined pair's filter, among its own blobs."""
+        s = self.params.states
+        radius = s.mode_search * distance_threshold(s.split_distance, s.split_size, self._side(t))
+        # a kernel as wide as the search: the particles sit on one mode, the other may be far
+        f = self.targets[t].filter
+        m = candidate_modes(f.particles[:, :2], f.weights, obs_c, radius, radius)
+        return tuple(map(tuple, m[:2]))
+
+    def _refine(self, tgt: _Target, obs_c: Candidates, on_end: bool, skin_bins: np.ndarray) -> None:
+        """Mean shift on the skin hue back-projection (Xu, Deng & Jia sec. 3); the refinement of
+        an arm's end is the end itself (mean shift on the skin would slide the window up the arm)."""
+        if on_end:
+            d = np.hypot(*(obs_c.centres - tgt.filter.estimate[None, :]).T)
+            if d.min() <= max(tgt.size):
+                tgt.filter.shift_to(obs_c.centres[int(np.argmin(d))])
+        else:
+            tgt.filter.refine(back_projection(skin_bins, tgt.filter.ref_hist))
+
+    def _remember(self, t: int, state: LimbState, before: np.ndarray, skin_bins: np.ndarray) -> None:
+        """Velocity, last confident place (the lost-state search centre) and the model update."""
+        p, tgt = self.params, self.targets[t]
+        if state == LimbState.NORMAL:
+            tgt.prev = before
+        if tgt.filter.confidence >= p.states.recover_likelihood and state != LimbState.LOST:
+            tgt.last = tgt.filter.estimate.copy()
+            tgt.anchor = self._head_of(t)
             if state == LimbState.NORMAL:
-                tgt.prev = before
-            if tgt.filter.confidence >= p.states.recover_likelihood and state != LimbState.LOST:
-                tgt.last = tgt.filter.estimate.copy()
-                tgt.anchor = self._head_of(t)
-                if state == LimbState.NORMAL:
-                    tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.appearance.hue_bins))
-            observations[t] = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
-                                          labelled=tgt.labelled, modes=modes, size=self._side(t))
-            self._place_pair(t, modes)
-        # followers of a combined pair report the leader's estimate
+                tgt.filter.update_reference(reference_histogram(skin_bins, tgt.filter.box(), p.appearance.hue_bins))
+
+    def _follow_leaders(self, observations: dict[int, Observation]) -> None:
+        """Followers of a combined pair report the leader's estimate."""
         for t in self.machine.trackers():
             if self.machine.state(t) == LimbState.COMBINED and not self.machine.is_leader(t):
                 lead = observations.get(self.machine.partner(t))
                 if lead is not None:
                     observations[t] = Observation(position=lead.position, likelihood=lead.likelihood,
                                                   labelled=self.targets[t].labelled, size=self._side(t))
-        if self.auto_start:
-            self._propose(cands, observations)
-        self._label(index, frame, observations)
-        self._reacquire_heads(frame, skin_bins, observations)
-
-        # 3. high layer --------------------------------------------------------------------
-        for tr in self.machine.update(index, observations):
-            self._apply(tr, index, skin_bins)
-        self._fill_references(skin_bins)
-        return self._records(index)
 
     def _side(self, t: int) -> float:
         """Box side of a target (mean of width and height), the unit of the state machine's
@@ -429,7 +502,7 @@ class LimbTracker:
     def _fill_references(self, skin_bins: np.ndarray) -> None:
         """Targets started without a usable reference take their person's face colour (seed 003
         sec. 3: the hands' reference comes from the face), else the hue of all skin in view."""
-        for t, tgt in self.targets.items():
+        for tgt in self.targets.values():
             if tgt.filter is None or tgt.ref_hist is not None:
                 continue
             head = next((h for h in self.targets.values() if h.track_id == tgt.track_id and h.part == "head"

@@ -7,7 +7,6 @@ import pytest
 
 from partlab.labelling.evaluation import iou_distance
 from partlab.labelling.formats import FormatError, export_dataset, import_dataset
-from partlab.tracking.parts import BOX_PARTS
 
 CORE = ["frame", "track_id", "part", "x", "y", "w", "h", "occluded"]
 

@@ -1,0 +1,173 @@
+"""Xu, Deng & Jia sec. 5: the 3D upper-body posture from the 2D tracks, the depth map and the
+calibration.
+
+Head and hands: the box centre back-projected at the median depth of the box's near pixels, pushed
+back by the part's radius (the depth map sees the surface; the part's centre is behind it). Torso:
+a rectangle under the head, in the face's depth plane (constraint 1 of sec. 4), its upper corners
+the shoulders. Sizes are in proportion to the head (sec. 5: "the size of torso, upper arm and
+forearm are in a fixed proportion to that of head"), the head's size being its box width at its
+depth. Elbows: the possible elbows of an arm with a given upper-arm and forearm length form a
+circle around the shoulder-hand line; the candidate whose image point's depth best matches it is
+the elbow; when none matches (the hand covers the elbow) the elbow is put at ``(X_h, Y_h, Z_h +
+l_f)``, behind the hand, as in the paper.
+
+Points are millimetres in the camera's world frame (``Camera.back_project``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from partlab.tracking.camera import Camera
+from partlab.tracking.depth.params import Posture
+
+
+@dataclass(frozen=True)
+class Pose3D:
+    """World points ``(3,)`` in mm; ``head_width`` the size unit (mm); elbows_matched: per arm,
+    whether the elbow came from the depth map (False: the occlusion fallback)."""
+
+    head: np.ndarray
+    left_hand: np.ndarray | None
+    right_hand: np.ndarray | None
+    torso: np.ndarray
+    torso_size: tuple[float, float]
+    left_shoulder: np.ndarray
+    right_shoulder: np.ndarray
+    left_elbow: np.ndarray | None
+    right_elbow: np.ndarray | None
+    head_width: float
+    elbows_matched: tuple[bool, bool] = (False, False)
+
+
+def surface_depth(depth: np.ndarray, box) -> float | None:
+    """Median of the nearer half of the measured depths in ``box`` (the part, not what shows past
+    its edges); None when nothing is measured there."""
+    x, y, w, h = (int(round(v)) for v in box)
+    hgt, wid = depth.shape
+    patch = depth[max(y, 0):min(y + h, hgt), max(x, 0):min(x + w, wid)]
+    vals = patch[np.isfinite(patch)]
+    if vals.size == 0:
+        return None
+    near = vals[vals <= np.median(vals)]
+    return float(np.median(near))
+
+
+def _centre_point(camera: Camera, box, z: float, behind: float) -> np.ndarray:
+    """The box centre at depth ``z`` moved ``behind`` mm further along its line of sight."""
+    x, y, w, h = box
+    centre = np.array([[x + w / 2, y + h / 2]])
+    surf = camera.back_project(centre, np.array([z]))[0]
+    ray = camera.rays(centre)[0]
+    return surf + behind * ray / max(float(ray @ camera.R[2]), 1e-6)
+
+
+def head_width(camera: Camera, depth: np.ndarray, head_box, p: Posture) -> float | None:
+    """The head's width in mm from its box and depth, at the depth of its silhouette (its centre:
+    the surface plus its radius, itself ``head_depth`` head widths): ``w = px (z_s + head_depth w) / f``."""
+    zh = surface_depth(depth, head_box)
+    if zh is None:
+        return None
+    fx = float(camera.K[0, 0])
+    return float(head_box[2]) * zh / max(fx - float(head_box[2]) * p.head_depth, 1e-6)
+
+
+def recover(camera: Camera, depth: np.ndarray, head_box, hand_boxes, p: Posture,
+            head_mm: float | None = None) -> Pose3D | None:
+    """The posture of one person: ``hand_boxes`` ``[left, right]``, each a box or None; ``head_mm``:
+    the head's width measured once (a head does not change size; the filter's alpha does), else
+    from this box."""
+    zh = surface_depth(depth, head_box)
+    if zh is None:
+        return None
+    head_w = head_mm if head_mm is not None else head_width(camera, depth, head_box, p)
+    head = _centre_point(camera, head_box, zh, p.head_depth * head_w)
+    hands: list[np.ndarray | None] = []
+    for box in hand_boxes:
+        z = surface_depth(depth, box) if box is not None else None
+        hands.append(None if z is None else _centre_point(camera, box, z, p.hand_depth * head_w))
+    # the torso's plane: the face surface (constraint 1) plus the shoulders' depth behind it
+    down = camera.R[1]  # the camera's image-down axis in the world (the body is upright, sec. 4)
+    right = camera.R[0]
+    back = camera.R[2]
+    face_surface_z = head - p.head_depth * head_w * back
+    shoulder_mid = face_surface_z + p.shoulder_depth * head_w * back + p.shoulder_drop * head_w * down
+    # the person faces the camera: their left is the image's right
+    left_sh = shoulder_mid + p.shoulder_half * head_w * right
+    right_sh = shoulder_mid - p.shoulder_half * head_w * right
+    tw, th = p.torso_size[0] * head_w, p.torso_size[1] * head_w
+    torso = shoulder_mid + 0.5 * th * down
+    elbows, matched = [], []
+    for shoulder, hand in ((left_sh, hands[0]), (right_sh, hands[1])):
+        if hand is None:
+            elbows.append(None)
+            matched.append(False)
+            continue
+        outward = right if shoulder is left_sh else -right
+        e, ok = elbow(camera, depth, shoulder, hand, p.upper_arm * head_w, p.forearm * head_w,
+                      p.arm_depth * head_w, p.elbow_tolerance * head_w, p.elbow_candidates,
+                      in_range=lambda c, s=shoulder, o=outward: (((c - s) @ down) > -p.elbow_above * head_w)
+                      & (((c - s) @ o) > -p.elbow_medial * head_w))
+        elbows.append(e)
+        matched.append(ok)
+    return Pose3D(head, hands[0], hands[1], torso, (tw, th), left_sh, right_sh, elbows[0], elbows[1], head_w,
+                  (matched[0], matched[1]))
+
+
+def elbow_circle(shoulder: np.ndarray, hand: np.ndarray, upper: float, fore: float, n: int) -> np.ndarray:
+    """``(n, 3)`` points where an upper arm of length ``upper`` from ``shoulder`` meets a forearm of
+    length ``fore`` from ``hand`` (the circle of possible elbows; one point on the line when the
+    arm is stretched beyond its length)."""
+    d = hand - shoulder
+    dist = float(np.linalg.norm(d))
+    u = d / max(dist, 1e-9)
+    reach = min(max(dist, 1e-6), 0.999 * (upper + fore))
+    a = (upper**2 - fore**2 + reach**2) / (2 * reach)
+    r = np.sqrt(max(upper**2 - a**2, 0.0))
+    # two unit vectors perpendicular to the arm's line
+    helper = np.array([0.0, 1.0, 0.0]) if abs(u[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    e1 = np.cross(u, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(u, e1)
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return shoulder + a * u + r * (np.cos(t)[:, None] * e1 + np.sin(t)[:, None] * e2)
+
+
+def elbow(camera: Camera, depth: np.ndarray, shoulder: np.ndarray, hand: np.ndarray, upper: float, fore: float,
+          arm_depth: float, tolerance: float, n: int, in_range=None) -> tuple[np.ndarray, bool]:
+    """Sec. 5's kinematic search: among the candidates on :func:`elbow_circle` within the kinetic
+    range (``in_range(points) -> bool mask``), the one whose depth best matches the depth map (its
+    surface ``arm_depth`` mm in front of the axis); the paper's fallback otherwise."""
+    cands = elbow_circle(shoulder, hand, upper, fore, n)
+    uv = camera.project(cands)
+    hgt, wid = depth.shape
+    col, row = np.round(uv[:, 0]).astype(int), np.round(uv[:, 1]).astype(int)
+    inside = (col >= 0) & (col < wid) & (row >= 0) & (row < hgt)
+    z_cand = camera.to_camera(cands)[:, 2] - arm_depth
+    seen = np.full(n, np.nan)
+    seen[inside] = depth[row[inside], col[inside]]
+    err = np.abs(seen - z_cand)
+    # an elbow hidden behind the arm's own surface reads a nearer depth: that is no match either
+    err[~np.isfinite(err)] = np.inf
+    if in_range is not None:
+        err[~in_range(cands)] = np.inf
+    best = int(np.argmin(err))
+    if not np.isfinite(err[best]) or err[best] > tolerance:
+        return hand + fore * camera.R[2], False  # (X_h, Y_h, Z_h + l_f) along the camera's axis
+    # the arm is thick: the candidates next to the elbow match too, an arc around it. Its middle,
+    # not its best point, is the elbow (the best point wanders along the arc with the noise)
+    arc, close = [best], err[best] + 0.25 * tolerance
+    for step in (1, -1):
+        k = best
+        for _ in range(n // 2):
+            k = (k + step) % n
+            if err[k] > close or k in arc:
+                break
+            arc.append(k)
+    centre = cands.mean(axis=0)  # the circle's centre (the candidates are evenly spaced on it)
+    mid = cands[arc].mean(axis=0) - centre
+    radius = float(np.linalg.norm(cands[0] - centre))
+    norm = float(np.linalg.norm(mid))
+    return (centre + mid * radius / norm if norm > 1e-9 else cands[best]), True

@@ -1,0 +1,104 @@
+"""Xu, Deng & Jia: Table 1's hand regions in millimetres, eq. 3 and the f/g weight, the filter's
+second-order dynamics, and the elbow search of sec. 5."""
+
+import numpy as np
+import pytest
+
+from partlab.tracking.camera import Camera
+from partlab.tracking.depth.filter import HueFilter
+from partlab.tracking.depth.params import DepthCue, Posture
+from partlab.tracking.depth.posture import elbow, elbow_circle
+from partlab.tracking.depth.regions import depth_foreground, face_depth, hand_regions
+from partlab.tracking.depth.sampling import icondensation_correction, importance_density, prior_density
+
+
+def _room(h=120, w=160):
+    d = np.full((h, w), 3000.0, np.float32)  # the wall
+    d[30:120, 50:110] = 1500.0  # torso, at the face's depth
+    d[8:30, 70:90] = 1500.0  # the face
+    return d
+
+
+def _blob(d, cx, cy, r, z_centre, slope=0.0):
+    yy, xx = np.mgrid[: d.shape[0], : d.shape[1]]
+    inside = (xx - cx) ** 2 + (yy - cy) ** 2 <= r * r
+    # a rounded blob: nearest at its centre (plus a slope, as an arm reaching forward)
+    d[inside] = (z_centre + 2.0 * ((xx - cx) ** 2 + (yy - cy) ** 2) ** 0.5 + slope * (xx - cx))[inside]
+
+
+def test_hands_are_what_is_nearer_than_the_face_and_the_region_centres_on_the_nearest_part():
+    d = _room()
+    _blob(d, 40, 70, 9, 1150.0)  # a hand 350 mm in front of the face
+    # a forearm and hand: a bar getting nearer to the right, ending in a hand at x = 130
+    d[66:74, 100:125] = np.linspace(1400, 1250, 25)[None, :]
+    _blob(d, 130, 70, 8, 1180.0)
+    d[100:110, 5:15] = 3500.0  # something far: never a hand (the paper's d > ... is for disparity)
+    d[0, 0] = np.nan  # unmeasured stays out
+    face_box = (70, 8, 20, 22)
+    fd = face_depth(d, face_box, fx=160.0)
+    assert fd.mean == pytest.approx(1500.0) and fd.sd == pytest.approx(0.0)
+    regions = hand_regions(d, fd, face_box, 160.0, DepthCue())
+    assert len(regions) == 2
+    centres = sorted((r.xc, r.yc) for r in regions)
+    assert centres[0] == pytest.approx((40, 70), abs=1.5)
+    # the coarse box spans the forearm too; step 4's iteration moves it onto the hand
+    right = max(regions, key=lambda r: r.xc)
+    assert right.coarse[0] < 110 and right.xc > 124  # the hand blob starts at x = 122
+    fg = depth_foreground(d, fd, DepthCue())
+    assert fg[50, 80] == 1 and fg[5, 5] == 0 and fg[0, 0] == 0
+
+
+def test_components_of_improper_size_are_not_hands():
+    d = _room()
+    d[100:120, :] = 1200.0  # a desk top across the frame, in front of the person
+    face_box = (70, 8, 20, 22)
+    fd = face_depth(d, face_box, fx=160.0)
+    assert hand_regions(d, fd, face_box, 160.0, DepthCue()) == []
+
+
+def test_importance_weight_is_f_over_g():
+    u, sigma = np.array([50.0, 40.0]), np.array([4.0, 6.0])
+    xy = np.array([[50.0, 40.0], [58.0, 40.0], [20.0, 10.0]])
+    g = importance_density(xy, u, sigma)
+    assert g[0] == pytest.approx(1 / (2 * np.pi * 24))
+    assert g[1] == pytest.approx(g[0] * np.exp(-2.0))
+    pred = np.array([[20.0, 10.0], [22.0, 10.0]])
+    f = prior_density(xy, pred, noise=5.0, floor=0.05, area=1e4)
+    assert np.allclose(icondensation_correction(xy, u, sigma, pred, 5.0, 0.05, 1e4), f / g)
+    # a sample where the dynamics expect the hand gains, one where only the region is loses
+    w = icondensation_correction(xy, u, sigma, pred, 5.0, 0.05, 1e4)
+    assert w[2] > 1e3 * w[0]
+    # the uniform floor keeps a region sample far from every prediction weighted, not zero
+    assert w[0] >= 0.05 / 1e4 / g[0] * 0.999
+
+
+def test_second_order_dynamics_carry_the_velocity():
+    rng = np.random.default_rng(0)
+    f = HueFilter((10.0, 20.0), (8, 8), np.ones(4) / 4, 50, rng)
+    f.pos[:, 0] += 5.0
+    f.vel[:, 0] = 5.0  # moved 5 px last frame
+    f.propagate(decay=1.0, noise_xy=0.0, noise_alpha=0.0)
+    assert np.allclose(f.pos[:, :2], [20.0, 20.0])  # x_t - x_{t-1} = x_{t-1} - x_{t-2}
+    assert np.allclose(f.boxes()[0], [16.0, 16.0, 8.0, 8.0])  # centred window of the reference size
+
+
+def test_elbow_found_on_the_depth_of_the_arm_and_fallback_when_hidden():
+    cam = Camera("c", [[300, 0, 160], [0, 300, 120], [0, 0, 1]], (320, 240))
+    shoulder, hand = np.array([0.0, 0.0, 1500.0]), np.array([100.0, 300.0, 1300.0])
+    cands = elbow_circle(shoulder, hand, 300.0, 260.0, 36)
+    assert np.allclose(np.linalg.norm(cands - shoulder, axis=1), 300.0)
+    assert np.allclose(np.linalg.norm(cands - hand, axis=1), 260.0)
+    true = cands[9]
+    # a depth map of the two arm segments' surfaces (20 mm in front of their axes) over a far wall
+    depth = np.full((240, 320), 3000.0, np.float32)
+    for a, b in ((shoulder, true), (true, hand)):
+        for s in np.linspace(0, 1, 200):
+            p = a + s * (b - a)
+            (u, v), = cam.project(p[None])
+            depth[int(v) - 3:int(v) + 4, int(u) - 3:int(u) + 4] = p[2] - 20.0
+    got, ok = elbow(cam, depth, shoulder, hand, 300.0, 260.0, 20.0, 60.0, 36)
+    assert ok and np.linalg.norm(got - true) < 60.0
+    hidden = np.full((240, 320), 600.0, np.float32)  # something right in front of the camera
+    got, ok = elbow(cam, hidden, shoulder, hand, 300.0, 260.0, 20.0, 60.0, 36)
+    assert not ok and np.allclose(got, hand + [0, 0, 260.0])  # (X_h, Y_h, Z_h + l_f)
+    assert Posture().upper_arm > Posture().forearm
