@@ -17,6 +17,7 @@ saw; if someone else has written since, :class:`StaleEditError` refuses the writ
 from __future__ import annotations
 
 import json
+import os
 import threading
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -41,7 +42,8 @@ from sqlalchemy import (
     insert,
     select,
 )
-from sqlalchemy.exc import IntegrityError
+from sqlalchemy.engine import make_url
+from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column
 
 from partlab.labelling import migrations
@@ -313,6 +315,18 @@ _ENGINES: dict[str, object] = {}
 _ENGINES_LOCK = threading.Lock()
 
 
+def connect_timeout() -> int:
+    """Seconds to wait for a database server (``PARTLAB_DB_CONNECT_TIMEOUT``, default 5)."""
+    raw = os.environ.get("PARTLAB_DB_CONNECT_TIMEOUT", "5")
+    try:
+        value = int(raw)
+    except ValueError:
+        raise StoreError(f"PARTLAB_DB_CONNECT_TIMEOUT must be a whole number of seconds, got {raw!r}") from None
+    if value < 1:
+        raise StoreError(f"PARTLAB_DB_CONNECT_TIMEOUT must be at least 1, got {value}")
+    return value
+
+
 def _engine(url: str):
     """One engine per URL per process (Streamlit reruns must not open new pools)."""
     with _ENGINES_LOCK:
@@ -321,6 +335,8 @@ def _engine(url: str):
             kwargs = {}
             if url.startswith("sqlite"):
                 kwargs["connect_args"] = {"check_same_thread": False, "timeout": 30}
+            elif url.startswith("postgresql"):  # a server that never answers fails in seconds, not minutes
+                kwargs["connect_args"] = {"connect_timeout": connect_timeout()}
             eng = create_engine(url, **kwargs)
             if url.startswith("sqlite"):
                 @event.listens_for(eng, "connect")
@@ -336,6 +352,12 @@ def _engine(url: str):
             except migrations.SchemaError as exc:
                 eng.dispose()
                 raise StoreError(str(exc)) from None
+            except OperationalError as exc:
+                eng.dispose()
+                shown = make_url(url).render_as_string(hide_password=True)
+                reason = " ".join(str(getattr(exc, "orig", exc)).split())[:200]
+                raise StoreError(f"cannot reach the database {shown} within {connect_timeout()} s ({reason}); "
+                                 "check PARTLAB_DATABASE_URL and that the server is up") from None
             _ENGINES[url] = eng
         return eng
 

@@ -195,3 +195,25 @@ def test_unusable_boxes_are_refused_by_the_store(store_and_clip):
     with _pytest.raises(StoreError, match="row 2, column 'w': negative size -3"):
         store.save_tracker_run(clip.id, run)
     assert store.tracks(clip.id).empty
+
+
+def test_an_unreachable_database_fails_fast_without_its_password(monkeypatch):
+    """A server that accepts the connection and never answers: refused within the connect timeout, the
+    message names the URL with its password hidden."""
+    import socket
+    import threading
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    port = listener.getsockname()[1]
+    held = []
+    threading.Thread(target=lambda: held.append(listener.accept()), daemon=True).start()
+    monkeypatch.setenv("PARTLAB_DB_CONNECT_TIMEOUT", "1")
+    url = f"postgresql+psycopg://labeller:s3cret@127.0.0.1:{port}/partlab"
+    start = time.monotonic()
+    shown = rf"postgresql\+psycopg://labeller:\*\*\*@127.0.0.1:{port}/partlab"
+    with pytest.raises(StoreError, match=rf"cannot reach the database {shown} within 1 s") as exc:
+        Store(url)
+    assert time.monotonic() - start < 10 and "s3cret" not in str(exc.value)
+    listener.close()
