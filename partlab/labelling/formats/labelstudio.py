@@ -220,7 +220,8 @@ def tracks_from_results(regions_: list, size: tuple[int, int] | None, source: st
             raise FormatError(f"{source}: region {r.get('id')} gives no frame size (original_width/height) to turn "
                               "its percentages into pixels; pass the clip with --video")
         try:
-            boxes = expand(seq, value.get("framesCount"))
+            with np.errstate(over="ignore", invalid="ignore"):  # huge numbers become inf, refused below
+                boxes = expand(seq, value.get("framesCount"))
         except (KeyError, TypeError) as exc:
             raise FormatError(f"{source}: region {r.get('id')} has a keyframe without {exc}; expected "
                               "frame, x, y, width, height") from None
@@ -228,6 +229,7 @@ def tracks_from_results(regions_: list, size: tuple[int, int] | None, source: st
             raise FormatError(f"{source}: region {r.get('id')}: a keyframe's x, y, width, height are not numbers "
                               f"({exc})") from None
         for frame, x, y, w, h, key in boxes:
+            x, y, w, h = (float(v) for v in (x, y, w, h))
             if frame < 1:
                 raise FormatError(f"{source}: region {r.get('id')} has frame {frame}; Label Studio frames count "
                                   "from 1")
