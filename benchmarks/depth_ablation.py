@@ -15,7 +15,8 @@ A hand is right when the seed 002 rule holds (half of the box on the true box an
 :func:`partlab.labelling.evaluation.box_correct`). Printed: the rate at frame 105 over seeds, the
 fraction of frames right over the clip (mean and standard deviation over seeds), the fraction of
 frames with both hands right, 3D errors (mm) of the head, hands, shoulders and elbows, and the
-tracker's frames per second (its ``step`` only; stereo matching timed apart) on one OpenCV thread, from CPU time (``time.process_time``), so that other work on a shared machine does not count.
+tracker's frames per second (its ``step`` only; stereo matching timed apart) on one OpenCV thread,
+from CPU time (``time.process_time``), so that other work on a shared machine does not count.
 
     PYTHONPATH=. nice python benchmarks/depth_ablation.py [--seeds 10] [--frames 150]
 
@@ -100,20 +101,23 @@ def main() -> None:
         scene = make_depth_scene(name, seed, args.frames, args.width, args.height)
         rig = StereoRig(scene.cameras["cam0"], scene.cameras["cam0_right"])
         t = time.process_time()
-        stereo = np.stack([rig.depth(l, r) for l, r in zip(scene.frames, scene.right)])
+        stereo = np.stack([rig.depth(left, right) for left, right in zip(scene.frames, scene.right)])
         stereo_fps = len(stereo) / (time.process_time() - t)
         person = (scene.labels > 0) & (scene.labels != 9)
         err = np.abs(stereo - scene.depth)[person]
         for variant in VARIANTS:
             tracks, fps = run_variant(scene, stereo if variant == "stereo" else scene.depth, variant, seed)
-            row = {"seed": seed, "scene": name, "variant": variant, "fps": fps, **score(tracks, scene.truth, args.frames)}
+            row = {"seed": seed, "scene": name, "variant": variant, "fps": fps,
+                   **score(tracks, scene.truth, args.frames)}
             if variant == "stereo":
                 row.update({"stereo fps": stereo_fps, "stereo valid": float(np.isfinite(err).mean()),
                             "stereo median mm": float(np.nanmedian(err))})
             results.append(row)
-            print(f"seed {seed} {name:15s} {variant:9s} hands clip {row['left_hand clip']:.2f}/{row['right_hand clip']:.2f}"
+            print(f"seed {seed} {name:15s} {variant:9s} hands clip "
+                  f"{row['left_hand clip']:.2f}/{row['right_hand clip']:.2f}"
                   f" both {row['both clip']:.2f}  elbows {row['left_elbow mm']:.0f}/{row['right_elbow mm']:.0f} mm"
-                  f"  shoulders {row['left_shoulder mm']:.0f}/{row['right_shoulder mm']:.0f} mm  {fps:.1f} fps", flush=True)
+                  f"  shoulders {row['left_shoulder mm']:.0f}/{row['right_shoulder mm']:.0f} mm  {fps:.1f} fps",
+                  flush=True)
     df = pd.DataFrame(results)
     if args.csv:
         df.to_csv(args.csv, index=False)
@@ -132,14 +136,16 @@ def summarise(df: pd.DataFrame, args) -> None:
     print("\n3D errors, mm: mean over frames, then mean (sd) over seeds")
     for variant in ("all", "stereo", "color_ms"):
         d = df[df["variant"] == variant]
-        print(f"  {variant:9s} " + "  ".join(f"{p} {d[p + ' mm'].mean():.0f} ({d[p + ' mm'].std():.0f})" for p in POINTS))
+        print(f"  {variant:9s} " + "  ".join(f"{p} {d[p + ' mm'].mean():.0f} ({d[p + ' mm'].std():.0f})"
+                                             for p in POINTS))
     d = df[df["variant"] == "stereo"].sort_values("seed")
     a = df[df["variant"] == "all"].sort_values("seed")
     diff = d["both clip"].to_numpy() - a["both clip"].to_numpy()
-    print(f"\nstereo - rendered, both hands over the clip: mean {diff.mean():+.3f}, per seed {np.round(diff, 3).tolist()}")
+    print(f"\nstereo - rendered, both hands over the clip: mean {diff.mean():+.3f}, "
+          f"per seed {np.round(diff, 3).tolist()}")
     print(f"stereo depth on the person: valid {d['stereo valid'].mean():.3f}, median error "
           f"{d['stereo median mm'].mean():.1f} mm; matching {d['stereo fps'].mean():.1f} frames/s")
-    print("\nframes/s of the tracker at %dx%d (one OpenCV thread), mean (sd) over seeds:" % (args.width, args.height))
+    print(f"\nframes/s of the tracker at {args.width}x{args.height} (one OpenCV thread), mean (sd) over seeds:")
     for variant in VARIANTS:
         f = df[df["variant"] == variant]["fps"]
         print(f"  {variant:9s} {f.mean():.1f} ({f.std():.1f})")

@@ -17,11 +17,13 @@ from partlab.errors import UserError
 #: sub-command -> one-line help (the order is the order of ``partlab --help``).
 COMMANDS: dict[str, str] = {
     "track": "track people's parts in a video and write a tracks CSV",
+    "batch": "track every clip of a folder, manifest or project on Dask (resumable)",
     "train": "train failure detectors and variance parameters from corrected clips",
     "eval": "compare tracks with truth: per-part tracking rates and MOT metrics",
     "export": "export tracks as a dataset (mot, cvat, coco, yolo, voc, parquet, labelstudio)",
     "import": "import a dataset (mot, cvat, coco, parquet, labelstudio) as a tracks CSV",
     "synth": "render a synthetic scene with exact ground truth",
+    "calibrate": "calibrate cameras from chessboard clips (or import OpenCV/PETS XML) into calibration.json",
     "app": "start the Streamlit labelling app (headless)",
     "serve-ml": "serve partlab as a Label Studio ML backend (predict part boxes, retrain from annotations)",
 }

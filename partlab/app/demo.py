@@ -64,3 +64,27 @@ def ensure_demo(store=None) -> bool:
 
 if __name__ == "__main__":
     ensure_demo()
+
+
+def track_demo(store=None) -> list:
+    """Start tracking every demo clip that has no tracker run yet (from its scene's init
+    boxes, in the background), so a first-time user sees boxes on Correct at once; returns
+    the jobs started."""
+    from partlab.app import jobs
+    from partlab.app.runs import start_tracking
+    from partlab.labelling.store import Store
+    from partlab.tracking.tracks import read_tracks_csv
+
+    store = store or Store()
+    project = store.project_by_name(DEMO_PROJECT)
+    if project is None:
+        return []
+    started = []
+    for clip in store.clips(project.id):
+        files = demo_files(clip.name)
+        if len(store.runs(clip.id)) or "init" not in files or jobs.active("track", clip_id=clip.id):
+            continue
+        init = read_tracks_csv(files["init"])
+        started.append(start_tracking(store, clip, tracker="body", init=init,
+                                      start=int(init.frame.min()) if len(init) else 0))
+    return started

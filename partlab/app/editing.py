@@ -1,39 +1,53 @@
 """Apply the box editor's events to the store, with a per-session undo/redo history.
 
-Every edit is written at once (``Store.edit_box``) with the revision the user saw, so
-a stale edit is refused with the store's message instead of overwriting someone
-else's work, and a killed app loses nothing that was shown as saved. Undo/redo walk
-this session's own edits; the store keeps every revision, so an undo is itself a new
-revision (``Store.undo``) and a redo writes the undone content again.
+Every edit is written at once with the revision the user saw, so a stale edit is
+refused with the store's message instead of overwriting someone else's work, and a
+killed app loses nothing that was shown as saved. Undo/redo walk this session's own
+*steps*: one step is everything one action wrote (a box and the person box recomputed
+from it, the in-between boxes refilled from it, every box of a merged track), undone
+together. The store keeps every revision, so an undo is itself a new revision
+(``Store.undo_many``) and a redo writes the undone content again.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from partlab.labelling import trackops
 from partlab.labelling.store import StaleEditError, Store, StoreError
 from partlab.tracking.core.box import Box
+from partlab.tracking.parts import BODY_PARTS
 from partlab.tracking.tracks import TracksCSVError, check_value
 
 
-@dataclass(frozen=True)
-class EditRef:
-    """One of this session's writes: the key and the revision it produced;
-    ``content`` is what a redo writes back (``None`` for undo entries)."""
+@dataclass
+class Step:
+    """One undoable action: the keys it wrote ``(frame, track_id, part, revision)``, the
+    human layer of those keys before and after it (changes for ``Store.edit_boxes``), the
+    tracker run it wrote (in-between boxes; None: none), the keys whose in-betweens it
+    refilled ``(track_id, part, frame)``, a label for the messages and the frame to show."""
 
+    keys: list[tuple[int, int, str, int]]
+    before: list[dict]
+    after: list[dict]
+    label: str
     frame: int
-    track_id: int
-    part: str
-    revision: int
-    content: dict | None = None
+    run_id: int | None = None
+    refill: list[tuple[int, str, int]] = field(default_factory=list)
 
 
 @dataclass
 class EditHistory:
-    """Undo/redo stacks of one session and clip (newest last)."""
+    """Undo/redo stacks of one session and clip (newest last); ``revs``: the revision this
+    session wrote last for each key (what its next undo or redo of that key expects)."""
 
-    undo: list[EditRef] = field(default_factory=list)
-    redo: list[EditRef] = field(default_factory=list)
+    undo: list[Step] = field(default_factory=list)
+    redo: list[Step] = field(default_factory=list)
+    revs: dict[tuple[int, int, str], int] = field(default_factory=dict)
+
+    def wrote(self, keys: list[tuple[int, int, str, int]]) -> None:
+        for f, t, p, r in keys:
+            self.revs[(f, t, p)] = r
 
 
 @dataclass
@@ -65,19 +79,83 @@ def _flag(value) -> bool:
         raise StoreError(str(exc)) from None
 
 
-def _current(store: Store, clip_id: int, frame: int, track_id: int, part: str) -> dict | None:
-    df = store.frame_boxes(clip_id, frame)
-    row = df[(df.track_id == track_id) & (df.part == part)]
-    if not len(row):
-        return None
-    r = row.iloc[0]
-    return dict(box=[float(r.x), float(r.y), float(r.w), float(r.h)], failure=bool(r.failure),
-                occluded=float(r.occluded))
+def _write(store: Store, clip_id: int, changes: list[dict], author: str) -> tuple[list, list, list]:
+    """Write ``changes``; returns (keys written, human layer before, human layer after)."""
+    keys = [(int(c["frame"]), int(c["track_id"]), str(c["part"])) for c in changes]
+    before = store.edit_state(clip_id, keys)
+    written = trackops.apply(store, clip_id, changes, author=author)
+    return written, before, store.edit_state(clip_id, keys)
+
+
+def record(store: Store, clip_id: int, changes: list[dict], history: EditHistory, label: str, frame: int,
+           author: str = "", fill: bool = False) -> Step:
+    """Write ``changes`` as one step (plus the person boxes recomputed from body-part edits
+    and, with ``fill``, the in-between boxes of the edited key) and push it on the undo stack."""
+    keys, before, after = _write(store, clip_id, changes, author)
+    boxes = [c for c in changes if c.get("box") is not None and c.get("kind", "box") == "box"]
+    person = []
+    for tid in sorted({int(c["track_id"]) for c in boxes if c["part"] in BODY_PARTS}):
+        for f in sorted({int(c["frame"]) for c in boxes if int(c["track_id"]) == tid}):
+            person += trackops.person_update(store, clip_id, f, tid)
+    if person:
+        k, b, a = _write(store, clip_id, person, author)
+        keys, before, after = keys + k, before + b, after + a
+    history.wrote(keys)
+    step = Step(keys=keys, before=before, after=after, label=label, frame=frame)
+    if fill and len(boxes) == 1:  # one tracker run per step keeps the step undoable
+        c = boxes[0]
+        step.refill = [(int(c["track_id"]), str(c["part"]), int(c["frame"]))]
+        step.run_id = _refill(store, clip_id, step.refill)
+    history.undo.append(step)
+    history.redo.clear()
+    return step
+
+
+def _refill(store: Store, clip_id: int, refill: list[tuple[int, str, int]]) -> int | None:
+    run = None
+    for tid, part, f in refill:
+        run = trackops.fill_between(store, clip_id, tid, part, f)
+    return run
+
+
+def _rewrite(store: Store, clip_id: int, history: EditHistory, step: Step, contents: list[dict],
+             author: str) -> list:
+    """Write ``contents`` over the keys ``step`` wrote, expecting the revisions this session wrote last."""
+    changes = [dict(c, expected_revision=history.revs.get(k[:3], k[3])) for c, k in zip(contents, step.keys)]
+    keys = trackops.apply(store, clip_id, changes, author=author)
+    history.wrote(keys)
+    return keys
+
+
+def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
+    """Take the newest step back: its keys get their human layer from before it (a key the
+    tracker had goes back to the tracker), and its tracker run is undone."""
+    step = history.undo[-1]
+    if step.run_id is not None:
+        store.undo_run(clip_id, step.run_id)
+    keys = _rewrite(store, clip_id, history, step, step.before, author)
+    history.undo.pop()
+    history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
+                             refill=step.refill))
+    return step
+
+
+def redo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
+    step = history.redo[-1]
+    keys = _rewrite(store, clip_id, history, step, step.after, author)
+    history.redo.pop()
+    again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
+                 refill=step.refill)
+    if step.refill:
+        again.run_id = _refill(store, clip_id, step.refill)
+    history.undo.append(again)
+    return again
 
 
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
-                 author: str = "") -> ApplyResult:
-    """Write the editor's events to the store in order; see :mod:`partlab.app.box_editor` for their shape."""
+                 author: str = "", fill: bool = False) -> ApplyResult:
+    """Write the editor's events to the store in order; see :mod:`partlab.app.box_editor` for
+    their shape. ``fill``: refill the in-between boxes of an edited track between its keyframes."""
     res = ApplyResult()
     for ev in events:
         kind = ev.get("kind")
@@ -93,41 +171,29 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 if expected is None or ev.get("added"):
                     # a new key: nobody's edit to be stale against, unless one appeared meanwhile
                     expected = store.revision(clip_id, frame, tid, part)
-                box = _box(ev["box"]) if kind == "edit" else None
-                rev = store.edit_box(clip_id, frame, tid, part, box,
-                                     failure=_flag(ev.get("failure")) if kind == "edit" else None,
-                                     occluded=ev.get("occluded") or 0.0 if kind == "edit" else None,
-                                     expected_revision=int(expected), author=author)
-                history.undo.append(EditRef(frame, tid, part, rev))
-                history.redo.clear()
+                change = dict(frame=frame, track_id=tid, part=part, expected_revision=int(expected),
+                              box=_box(ev["box"]) if kind == "edit" else None)
+                if kind == "edit":
+                    change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
+                record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
+                       author=author, fill=fill and kind == "edit")
                 res.written += 1
             elif kind == "undo":
                 if not history.undo:
                     res.notes.append("nothing to undo in this session")
                     continue
-                ref = history.undo[-1]
-                before = _current(store, clip_id, ref.frame, ref.track_id, ref.part)
-                rev = store.undo(clip_id, ref.frame, ref.track_id, ref.part, expected_revision=ref.revision,
-                                 author=author)
-                history.undo.pop()
-                history.redo.append(EditRef(ref.frame, ref.track_id, ref.part, rev, content=before or {}))
-                res.frame = ref.frame
+                step = undo_step(store, clip_id, history, author=author)
+                res.frame = step.frame
                 res.written += 1
-                res.notes.append(f"undid the edit of {ref.part} #{ref.track_id} at frame {ref.frame}")
+                res.notes.append(f"undid the {step.label}")
             elif kind == "redo":
                 if not history.redo:
                     res.notes.append("nothing to redo")
                     continue
-                ref = history.redo[-1]
-                c = ref.content or {}
-                box = _box(c["box"]) if c.get("box") else None
-                rev = store.edit_box(clip_id, ref.frame, ref.track_id, ref.part, box, failure=c.get("failure"),
-                                     occluded=c.get("occluded"), expected_revision=ref.revision, author=author)
-                history.redo.pop()
-                history.undo.append(EditRef(ref.frame, ref.track_id, ref.part, rev))
-                res.frame = ref.frame
+                step = redo_step(store, clip_id, history, author=author)
+                res.frame = step.frame
                 res.written += 1
-                res.notes.append(f"redid the edit of {ref.part} #{ref.track_id} at frame {ref.frame}")
+                res.notes.append(f"redid the {step.label}")
         except StaleEditError as exc:
             res.errors.append(f"Not saved: {exc}")
         except (StoreError, ValueError, KeyError, TypeError) as exc:

@@ -1,13 +1,17 @@
 """Background jobs (tracking, training, comparison runs) with progress read back on rerun.
 
-A job runs in a worker thread of the Streamlit server process, so it keeps running
-while the user browses other pages or closes the tab; pages poll :func:`jobs` on each
-rerun (a fragment refreshes itself every second while something runs). The registry
-is process-wide: every browser session sees every job. Workers default to one
-(``PARTLAB_WORKERS``): tracking is CPU-bound and the machine is shared.
+Two engines behind one job list. With ``PARTLAB_JOBS=engine`` (what ``partlab app`` sets unless
+told otherwise) tracking and training are Dask tasks on workers outside the server process
+(:mod:`partlab.engine.jobs`): their state is a row of the store's ``jobs`` table, so they keep
+running when the server restarts, the restarted server shows them with their progress, and
+:func:`cancel` stops them. Otherwise (the library's default, and always for comparison runs,
+whose result is a table the page reads back) a job runs in a worker thread of the server
+process; pages poll :func:`jobs` on each rerun (a fragment refreshes itself every second while
+something runs). Thread workers default to one (``PARTLAB_WORKERS``): tracking is CPU-bound and
+the machine is shared.
 
-Jobs live in the server process, so stopping the app stops them (what they had already
-stored stays). So that this is not silent, every job's state is also appended to a journal,
+Thread jobs live in the server process, so stopping the app stops them (what they had already
+stored stays). So that this is not silent, every thread job's state is also appended to a journal,
 ``jobs.jsonl`` in the data directory; :func:`interrupted` lists the jobs a previous server
 process left queued or running, which the app shows until they are cleared.
 """
@@ -33,13 +37,15 @@ class Job:
     kind: str
     label: str
     meta: dict = field(default_factory=dict)
-    status: str = "queued"  # queued, running, done, failed
+    status: str = "queued"  # queued, running, done, failed, cancelled
     done: int = 0
     total: int = 0
     error: str = ""
     result: Any = None
     created: float = field(default_factory=time.time)
     finished: float | None = None
+    engine: bool = False  # a Dask job (a row of the store's jobs table), not a thread of this process
+    cancel_requested: bool = False
 
     @property
     def fraction(self) -> float:
@@ -131,6 +137,8 @@ def submit(kind: str, label: str, fn: Callable[[Callable[[int, int], None]], Any
     journalled = [0.0]
 
     def progress(done: int, total: int) -> None:
+        if job.cancel_requested:
+            raise _Cancelled(job.id)
         job.done, job.total = int(done), int(total)
         if time.time() - journalled[0] >= JOURNAL_EVERY:
             journalled[0] = time.time()
@@ -140,8 +148,12 @@ def submit(kind: str, label: str, fn: Callable[[Callable[[int, int], None]], Any
         job.status = "running"
         _journal(job)
         try:
+            if job.cancel_requested:
+                raise _Cancelled(job.id)
             job.result = fn(progress)
             job.status = "done"
+        except _Cancelled:
+            job.status = "cancelled"
         except Exception as exc:  # shown to the user on the page, with the trace in the log
             job.error = f"{type(exc).__name__}: {exc}"
             job.status = "failed"
@@ -157,16 +169,63 @@ def submit(kind: str, label: str, fn: Callable[[Callable[[int, int], None]], Any
     return job
 
 
+class _Cancelled(Exception):
+    pass
+
+
+def engine_enabled() -> bool:
+    """Whether tracking and training go to Dask workers (``PARTLAB_JOBS=engine``)."""
+    return os.environ.get("PARTLAB_JOBS", "threads") == "engine"
+
+
+def submit_engine(kind: str, label: str, task: Callable[..., Any], meta: dict, **kwargs) -> Job:
+    """Run ``task(progress, **kwargs)`` (a function of :mod:`partlab.engine.tasks`) on a Dask worker."""
+    from partlab.engine import jobs as engine
+
+    job_id = engine.submit(kind, label, task, store_url=kwargs.get("url"), meta=meta, **kwargs)
+    return get(job_id) or Job(id=job_id, kind=kind, label=label, meta=meta, engine=True)
+
+
+def _engine_jobs() -> list[Job]:
+    if not engine_enabled():
+        return []
+    from partlab.engine import jobs as engine
+
+    out = []
+    for r in engine.list_jobs():
+        out.append(Job(id=r["id"], kind=r["kind"], label=r["label"], meta=dict(r["meta"] or {}), status=r["status"],
+                       done=r["done"], total=r["total"], error=r["error"], result=r["result"],
+                       created=r["created"].timestamp(),
+                       finished=r["finished"].timestamp() if r["finished"] else None, engine=True,
+                       cancel_requested=bool(r["cancel"])))
+    return out
+
+
 def get(job_id: str) -> Job | None:
-    return _JOBS.get(job_id)
+    if job_id in _JOBS:
+        return _JOBS[job_id]
+    return next((j for j in _engine_jobs() if j.id == job_id), None)
 
 
 def jobs(kind: str | None = None, **meta) -> list[Job]:
-    """Jobs, newest first, filtered by kind and by equal meta values (e.g. ``clip_id=3``)."""
+    """Jobs of both engines, newest first, filtered by kind and by equal meta values (e.g. ``clip_id=3``)."""
     with _LOCK:
-        out = [j for j in _JOBS.values()
-               if (kind is None or j.kind == kind) and all(j.meta.get(k) == v for k, v in meta.items())]
+        out = list(_JOBS.values())
+    out += _engine_jobs()
+    out = [j for j in out if (kind is None or j.kind == kind) and all(j.meta.get(k) == v for k, v in meta.items())]
     return sorted(out, key=lambda j: j.created, reverse=True)
+
+
+def cancel(job_id: str) -> None:
+    """Stop a job: a Dask job at its next progress report (or before it starts), a thread job at
+    its next progress report."""
+    job = _JOBS.get(job_id)
+    if job is not None:
+        job.cancel_requested = True
+        return
+    from partlab.engine import jobs as engine
+
+    engine.cancel(job_id)
 
 
 def active(kind: str | None = None, **meta) -> list[Job]:
@@ -176,6 +235,11 @@ def active(kind: str | None = None, **meta) -> list[Job]:
 def wait(job_id: str, timeout: float = 60.0) -> Job:
     """Block until a job ends (tests and scripts)."""
     end = time.time() + timeout
+    if job_id not in _JOBS:
+        from partlab.engine import jobs as engine
+
+        engine.wait(job_id, timeout)
+        return get(job_id)
     job = _JOBS[job_id]
     while job.active:
         if time.time() > end:
@@ -194,4 +258,8 @@ def clear_finished() -> int:
         live = {k for k, j in _JOBS.items() if j.active}
     gone = len(interrupted())
     _rewrite_journal(lambda e: e["id"] in live)
+    if engine_enabled():
+        from partlab.engine import jobs as engine
+
+        gone += engine.clear_finished()
     return len(done) + gone

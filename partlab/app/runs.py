@@ -3,7 +3,8 @@
 This is glue only: the algorithms are ``partlab.app.pipeline.track_video`` (trackers),
 ``partlab.models.training.train_bundle`` (SVMs and variances) and the store. They are imported
 when a job starts (the pages stay quick to load); an import that breaks fails the job or the page,
-it is never hidden.
+it is never hidden. Jobs run on the engine (:mod:`partlab.engine`, a local Dask cluster outside the
+server) unless the app was started with ``--jobs threads``.
 """
 
 from __future__ import annotations
@@ -61,39 +62,56 @@ def next_human_frame(store: Store, clip_id: int, after: int) -> int | None:
 
 def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path: str | Path | None = None,
                    seed: int = 0, start: int = 0, retrack: bool = False, init_from_boxes: bool = False,
-                   init: pd.DataFrame | None = None) -> jobs.Job:
+                   init: pd.DataFrame | None = None, track_id: int | None = None) -> jobs.Job:
     """Track a clip in the background and store the result as a tracker run.
 
-    With ``retrack``, the tracker starts from the effective boxes at frame ``start``
-    (the user's fix) and runs to the next human-corrected frame or the end; tracker
-    boxes of other frames and every human edit stay as they are. With
+    With ``retrack``, the tracker runs between the keyframes around frame ``start``
+    (:func:`partlab.labelling.trackops.retrack_window`; only ``track_id`` when given) from
+    the effective boxes at the first of them, and replaces the boxes of those tracks in
+    that range only; every other track, every human edit and every other frame stay as
+    they are, and ``Store.undo_run`` takes the run back as one step. With
     ``init_from_boxes``, a whole-clip run starts from the stored boxes of frame
     ``start`` instead of detecting people; ``init`` gives such boxes directly (e.g. a
     synthetic scene's init.csv).
     """
     from partlab.app import pipeline
-
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
-    stop = None
+    stop, track_ids = None, None
+    if retrack:
+        from partlab.labelling.trackops import retrack_window
+
+        start, stop, track_ids = retrack_window(store, clip.id, start, track_id)
+        if not track_ids:
+            raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
     if retrack or init_from_boxes:
         init = store.frame_boxes(clip.id, start)
         if not len(init):
             raise ValueError(f"frame {start} has no boxes to re-track from; draw them first")
         init = init.drop(columns=["revision"], errors="ignore")
-    if retrack:
-        stop = next_human_frame(store, clip.id, start)
+        if track_ids is not None:
+            init = init[init.track_id.isin(track_ids)]
     occluders = tuple(store.occluders(clip.id))
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
+        else f"track {clip.name} ({tracker})"
+    if jobs.engine_enabled():  # on a Dask worker: survives a server restart, can be cancelled
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("track", what, tasks.track_clip, dict(clip_id=clip.id, project_id=clip.project_id),
+                                  url=store.url, clip_id=clip.id, tracker=tracker,
+                                  bundle_path=str(bundle_path) if bundle_path else None, seed=seed, start=start,
+                                  stop=stop, init=None if init is None else init.to_dict("records"))
 
     def work(progress):
         model = _load_model(bundle_path)
         df = pipeline.track_video(str(clip.path), tracker=tracker, init=init, model=model, occluders=occluders,
                                   seed=seed, progress=progress, start=start, stop=stop)
         run_id = store.save_tracker_run(clip.id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
-                                        start_frame=start, stop_frame=stop)
-        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
+                                        start_frame=start, stop_frame=stop, track_ids=track_ids)
+        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop, track_ids=track_ids)
 
-    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") if retrack \
+    what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") \
+        + (f" (tracks {', '.join(map(str, track_ids))})" if track_ids else "") if retrack \
         else f"track {clip.name} ({tracker})"
     return jobs.submit("track", what, work, clip_id=clip.id, project_id=clip.project_id)
 
@@ -131,15 +149,8 @@ def training_truth(store: Store, clip_id: int) -> pd.DataFrame:
     return tracks[tracks.frame.isin(human)].drop(columns=["revision"]).reset_index(drop=True)
 
 
-def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
-                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
-    """Train a bundle from corrected clips in the background, save it and register it.
-    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
-    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
-    from partlab.models import bundle as bundle_mod
-    from partlab.models import training
-    from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
-
+def _training_inputs(store: Store, project_id: int, clip_ids: list[int], name: str) -> tuple[list, Path]:
+    """The clips to train from ``(frames, fps, truth)`` and the bundle's new folder, or ValueError."""
     if not clip_ids:
         raise ValueError("pick at least one corrected clip")
     folder = safe_name(name)
@@ -155,7 +166,27 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
+    return clips, out
+
+
+def start_training(store: Store, project_id: int, clip_ids: list[int], name: str, seed: int = 0,
+                   make_default: bool = False, start_path: str | Path | None = None) -> jobs.Job:
+    """Train a bundle from corrected clips in the background, save it and register it.
+    ``start_path``: the bundle to improve on (its detector stays unless the new one does no
+    worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    from partlab.models import bundle as bundle_mod
+    from partlab.models import training
+    from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
+
+    clips, out = _training_inputs(store, project_id, clip_ids, name)
     names = [store.clip(cid).name for cid in clip_ids]
+    if jobs.engine_enabled():  # on a Dask worker, like tracking
+        from partlab.engine import tasks
+
+        return jobs.submit_engine("train", f"train bundle {name}", tasks.train_bundle, dict(project_id=project_id),
+                                  url=store.url, project_id=project_id, clip_ids=list(clip_ids), name=name,
+                                  out=str(out), seed=seed, make_default=make_default,
+                                  start_path=str(start_path) if start_path else None)
     start = _load_model(start_path)
 
     def work(progress):

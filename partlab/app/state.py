@@ -39,14 +39,19 @@ def history_key(clip_id: int) -> str:
 
 
 def project_id(s: Store) -> int | None:
-    """The chosen project, falling back to the first one."""
+    """The chosen project, falling back to the newest one that is not the demo (a new
+    session of someone with projects of their own does not open the demo)."""
+    from partlab.app.demo import DEMO_PROJECT
+
     pid = st.session_state.get(PROJECT)
     projects = s.projects()
     if pid is not None and any(p.id == pid for p in projects):
         return int(pid)
     if projects:
-        st.session_state[PROJECT] = projects[0].id
-        return projects[0].id
+        own = [p for p in projects if p.name != DEMO_PROJECT]
+        pick = own[-1] if own else projects[0]
+        st.session_state[PROJECT] = pick.id
+        return pick.id
     return None
 
 

@@ -4,20 +4,28 @@ Run with ``partlab app`` (or ``make run``). Every page is a short script under
 ``app/views/`` that calls library functions; long work runs in :mod:`partlab.app.jobs`.
 """
 
+import os
+
 import streamlit as st
 
 st.set_page_config(page_title="partlab", layout="wide")
 
-from partlab.app import jobs, state  # noqa: E402
-from partlab.app.demo import ensure_demo  # noqa: E402
-from partlab.app.views.common import bound_widget  # noqa: E402
+from partlab.app import jobs, prefs, state  # noqa: E402
+from partlab.app.demo import ensure_demo, track_demo  # noqa: E402
+from partlab.app.views.common import bound_widget, plain  # noqa: E402
 from partlab.labelling.config import data_dir  # noqa: E402
 
 
 @st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
 def _demo_ready(data: str) -> bool:
-    """Once per server process and data directory."""
-    return ensure_demo()
+    """Once per server process and data directory; the demo clips are tracked in the background.
+    ``PARTLAB_DEMO=0`` leaves the demo out (a shared server, or a test that measures speed)."""
+    if os.environ.get("PARTLAB_DEMO", "1") == "0":
+        return False
+    ready = ensure_demo()
+    if ready:
+        track_demo()
+    return ready
 
 
 _demo_ready(str(data_dir()))
@@ -50,6 +58,7 @@ with st.sidebar:
         st.page_link(page)
     st.divider()
     st.markdown("### partlab")
+    prefs.remember(store)  # this browser's project and name, across sessions
     projects = store.projects()
     if projects:
         state.project_id(store)
@@ -66,12 +75,16 @@ with st.sidebar:
         if running or recent or stopped:
             st.caption("Background jobs")
         for j in running:
-            st.progress(j.fraction, text=f"{j.label}: {j.done}/{j.total or '?'}")
+            st.progress(j.fraction, text=f"{plain(j.label)}: {j.done}/{j.total or '?'}"
+                        + (" (cancelling)" if j.cancel_requested else ""))
+            if not j.cancel_requested:
+                st.button("Cancel", key=f"cancel_{j.id}", on_click=jobs.cancel, args=(j.id,), type="tertiary")
         for j in recent:
-            st.caption(f"{'done' if j.status == 'done' else 'FAILED'}: {j.label}" +
+            word = j.status if j.status in ("done", "cancelled") else "FAILED"
+            st.caption(f"{word}: {plain(j.label)}" +
                        (f" ({j.error})" if j.error else ""))
         for e in stopped:
-            st.caption(f"INTERRUPTED: {e['label']} (the app stopped at {e['done']}/{e['total'] or '?'}; "
+            st.caption(f"INTERRUPTED: {plain(e['label'])} (the app stopped at {e['done']}/{e['total'] or '?'}; "
                        "start it again from its page)")
         if recent or stopped:
             st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")

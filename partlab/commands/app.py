@@ -21,6 +21,12 @@ def add_arguments(p) -> None:
     p.add_argument("--allowed-hosts", metavar="NAMES", default=os.environ.get("PARTLAB_ALLOWED_HOSTS", ""),
                    help="comma-separated host names the app may be reached by besides localhost and --host "
                         "(PARTLAB_ALLOWED_HOSTS); requests naming any other host are refused (DNS rebinding)")
+    p.add_argument("--jobs", choices=("engine", "threads"), default=os.environ.get("PARTLAB_JOBS", "engine"),
+                   help="where tracking and training run: 'engine' (default) on Dask workers outside the server, "
+                        "so they survive a restart and can be cancelled; 'threads' inside the server process")
+    p.add_argument("--scheduler", metavar="tcp://HOST:PORT", default=os.environ.get("PARTLAB_SCHEDULER"),
+                   help="the Dask scheduler for jobs (PARTLAB_SCHEDULER); default: partlab's own local cluster, "
+                        "started on the first job and left running (its address in DATA/engine.json)")
 
 
 def allowed_hosts(host: str, extra: str = "") -> list[str]:
@@ -63,4 +69,8 @@ def streamlit_command(host: str, port: int, extra_hosts: str = "") -> list[str]:
 
 def run(args) -> int:
     print(f"partlab app: serving on http://{args.host}:{args.port} (Ctrl+C to stop)", flush=True)
-    return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=os.environ.copy())
+    env = os.environ.copy()
+    env["PARTLAB_JOBS"] = args.jobs
+    if args.scheduler:
+        env["PARTLAB_SCHEDULER"] = args.scheduler
+    return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=env)

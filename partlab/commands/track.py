@@ -18,6 +18,10 @@ def add_arguments(p) -> None:
     p.add_argument("--tracker", choices=registry.names(), default="body",
                    help="; ".join(f"{e.name}: {e.summary}" for e in registry.TRACKERS.values()))
     p.add_argument("--init", metavar="INIT.csv", help="start tracks from these boxes instead of detecting people")
+    p.add_argument("--keyframes", metavar="KEYS.csv",
+                   help="boxes drawn on some frames (any tracks, any parts): each track is tracked forward and "
+                        "backward between its consecutive keyframes and the two blended, meeting every keyframe "
+                        "exactly; frames to look at are flagged (failure column, state 'review')")
     p.add_argument("--model", metavar="BUNDLE_DIR",
                    help="model bundle from partlab train, or 'default' for the one shipped with partlab "
                         "(failure detection and adjustment on); without it: the built-in parameters, no "
@@ -70,6 +74,23 @@ def load_model(path: str | Path):
         raise CommandError(f"{path}: cannot load model bundle: {exc}") from None
 
 
+def write_events(events, args) -> None:
+    """``--events``: the tracker's events table, written atomically."""
+    if events is None:
+        raise CommandError(f"--events: tracker {args.tracker!r} recognises no events "
+                           "(limbs and all write the hands' activities)")
+    from partlab.files import replacing
+
+    try:
+        with replacing(args.events) as tmp:
+            events.to_csv(tmp, index=False, lineterminator="\n")
+    except OSError as exc:
+        raise CommandError(f"{args.events}: cannot write: {describe_os_error(exc)}") from None
+    kinds = events["kind"].value_counts().to_dict() if len(events) else {}
+    print(f"wrote {len(events)} event(s) to {args.events}"
+          + (f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""))
+
+
 def run(args) -> int:
     from tqdm import tqdm
 
@@ -84,6 +105,16 @@ def run(args) -> int:
             raise CommandError(str(exc)) from None
         if init.empty:
             raise CommandError(f"{args.init}: no boxes to start from")
+    keyframes = None
+    if args.keyframes:
+        if args.init:
+            raise CommandError("--keyframes and --init: give one of them (a track's first keyframe is its start)")
+        try:
+            keyframes = read_tracks_csv(args.keyframes)
+        except TracksCSVError as exc:
+            raise CommandError(str(exc)) from None
+        if keyframes.empty:
+            raise CommandError(f"{args.keyframes}: no keyframe boxes")
     occluders = read_occluders(args.occluders) if args.occluders else ()
     model = load_model(args.model) if args.model else None
     bar = None
@@ -95,8 +126,16 @@ def run(args) -> int:
         bar.update(done - bar.n)
 
     try:
-        result = track_path(args.video, args.tracker, init=init, model=model, occluders=occluders,
-                            seed=args.seed, progress=progress if args.progress else None)
+        if keyframes is not None:
+            from partlab.labelling.take import open_take
+            from partlab.tracking.keyframes import track_with_keyframes
+
+            with open_take(args.video) as take:
+                result = track_with_keyframes(take, keyframes, tracker=args.tracker, model=model, seed=args.seed,
+                                              progress=progress if args.progress else None)
+        else:
+            result = track_path(args.video, args.tracker, init=init, model=model, occluders=occluders,
+                                seed=args.seed, progress=progress if args.progress else None)
     finally:
         if bar is not None:
             bar.close()
@@ -108,17 +147,5 @@ def run(args) -> int:
     people = tracks["track_id"].nunique() if len(tracks) else 0
     print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
     if args.events:
-        if result.events is None:
-            raise CommandError(f"--events: tracker {args.tracker!r} recognises no events "
-                               "(limbs and all write the hands' activities)")
-        from partlab.files import replacing
-
-        try:
-            with replacing(args.events) as tmp:
-                result.events.to_csv(tmp, index=False, lineterminator="\n")
-        except OSError as exc:
-            raise CommandError(f"{args.events}: cannot write: {describe_os_error(exc)}") from None
-        kinds = result.events["kind"].value_counts().to_dict() if len(result.events) else {}
-        print(f"wrote {len(result.events)} event(s) to {args.events}"
-              + (f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""))
+        write_events(result.events, args)
     return 0

@@ -11,8 +11,9 @@ where at least two of the three are present in the truth; tracks without body pa
 whole-body tracker) are judged by their ``person`` boxes, as in that figure.
 
 Tracks are matched to truth by ``track_id`` when the ids agree (runs from ``--init``
-keep them): every truth track has a tracker track of the same id whose boxes overlap it
-with IoU >= 0.5 at their first common frame. Otherwise (automatic runs) each truth track
+keep them): at least 80 % of the truth tracks have a tracker track of the same id whose boxes
+overlap them with IoU >= 0.3 at their first common frame (:func:`ids_agree`). Otherwise (automatic runs)
+each truth track
 is matched to the tracker track with the greatest mean IoU over the truth's boxes
 (Hungarian assignment, scipy), and the report says so.
 
@@ -42,7 +43,14 @@ from partlab.tracking.tracks import normalise_tracks
 DEFAULT_AT = 105  # seed 002 reports its rates at the 105th frame after initialisation
 MIN_COVER = measures.MIN_COVER
 MOT_IOU = 0.5  # the usual MOTChallenge threshold for a match
-ID_AGREE_IOU = 0.5  # same-id boxes overlapping this much at their first common frame: ids agree
+# Ids agree when at least ID_AGREE_SHARE of the truth tracks have a same-id tracker track overlapping
+# them by ID_AGREE_IOU at their first common frame. A run from --init starts every track on its
+# truth box, but its person box is the tracker's own (the body tracker's: the minimum bounding
+# rectangle of the decomposed parts, IoU 0.35-0.85 with the drawn box on PETS09-S2L1) and a track
+# may be gone (ended early); automatic runs number their tracks 1, 2, ... in their own order, and
+# the chance that 80 % of them overlap the same-numbered truth track at its start is nil.
+ID_AGREE_IOU = 0.3
+ID_AGREE_SHARE = 0.8
 MOT_METRICS: tuple[str, ...] = ("mota", "motp", "idf1", "num_switches", "num_false_positives", "num_misses",
                                 "num_objects", "precision", "recall")
 PERSON_MBR = "person_mbr"
@@ -137,15 +145,17 @@ def _pair_iou(truth: pd.DataFrame, tracks: pd.DataFrame) -> pd.DataFrame:
 
 
 def ids_agree(truth: pd.DataFrame, tracks: pd.DataFrame) -> bool:
-    """True when every truth track's same-id tracker track overlaps it (IoU >= 0.5, averaged
-    over the parts both have) at their first common frame, as in runs started from ``--init``."""
+    """True when the truth tracks' same-id tracker tracks overlap them (IoU >= :data:`ID_AGREE_IOU`,
+    averaged over the parts both have) at their first common frame for at least
+    :data:`ID_AGREE_SHARE` of the truth tracks, as in runs started from ``--init``."""
     m = truth[["frame", "track_id", "part"] + XYWH].merge(
         tracks[["frame", "track_id", "part"] + XYWH], on=["frame", "track_id", "part"], suffixes=("_t", "_k"))
-    if m.empty or set(truth["track_id"]) - set(m["track_id"]):
+    if m.empty:
         return False
     m["iou"] = _rowwise_iou(m[[c + "_t" for c in XYWH]].to_numpy(), m[[c + "_k" for c in XYWH]].to_numpy())
     first = m[m["frame"] == m.groupby("track_id")["frame"].transform("min")]
-    return bool((first.groupby("track_id")["iou"].mean() >= ID_AGREE_IOU).all())
+    agree = int((first.groupby("track_id")["iou"].mean() >= ID_AGREE_IOU).sum())
+    return agree >= ID_AGREE_SHARE * truth["track_id"].nunique()
 
 
 def match_tracks(truth: pd.DataFrame, tracks: pd.DataFrame, how: str = "auto") -> tuple[str, pd.DataFrame]:
@@ -342,3 +352,145 @@ def rate_curve_figure(report: EvaluationReport):
                       xaxis_title="frames after initialisation", yaxis_title="tracking rate",
                       yaxis_range=[0, 1.05], template="plotly_white")
     return fig
+
+
+# -- takes of several calibrated views ------------------------------------------------------------
+
+TRUTH3D_COLUMNS = ("frame", "track_id", "part", "X", "Y", "Z")
+
+
+def read_truth3d(path) -> pd.DataFrame:
+    """A ``truth3d.csv`` (``frame, track_id, part, X, Y, Z`` in mm); :class:`EvaluationError` names
+    the file and what is missing."""
+    try:
+        df = pd.read_csv(path)
+    except (OSError, ValueError, pd.errors.ParserError) as exc:
+        raise EvaluationError(f"{path}: cannot read a 3D truth table ({exc})") from None
+    missing = [c for c in TRUTH3D_COLUMNS if c not in df.columns]
+    if missing:
+        raise EvaluationError(f"{path}: a 3D truth table needs columns {', '.join(TRUTH3D_COLUMNS)}; "
+                              f"missing {', '.join(missing)}")
+    return df[list(TRUTH3D_COLUMNS)]
+
+
+def error_3d(tracks: pd.DataFrame, truth3d: pd.DataFrame) -> pd.DataFrame:
+    """Mean 3D error in mm per part (the multi-camera paper's protocol, sec. 8): tracked ``X, Y, Z``
+    against the truth at every frame both have, matched by ``track_id`` and part. Columns
+    ``frames, mean_mm, median_mm, p90_mm, within_100mm`` (fraction of frames under 10 cm); a
+    missed frame (truth but no estimate) counts in ``missed``."""
+    est = tracks.dropna(subset=["X", "Y", "Z"]).drop_duplicates(["frame", "track_id", "part"])
+    m = truth3d.merge(est[["frame", "track_id", "part", "X", "Y", "Z"]], on=["frame", "track_id", "part"],
+                      how="left", suffixes=("_t", ""))
+    m["err"] = np.linalg.norm(m[["X", "Y", "Z"]].to_numpy(float) - m[["X_t", "Y_t", "Z_t"]].to_numpy(float), axis=1)
+    rows = []
+    for part, g in m.groupby("part", sort=False):
+        e = g["err"].dropna()
+        rows.append({"part": part, "frames": int(len(e)), "missed": int(g["err"].isna().sum()),
+                     "mean_mm": float(e.mean()) if len(e) else float("nan"),
+                     "median_mm": float(e.median()) if len(e) else float("nan"),
+                     "p90_mm": float(e.quantile(0.9)) if len(e) else float("nan"),
+                     "within_100mm": float((e < 100).mean()) if len(e) else float("nan")})
+    return pd.DataFrame(rows).set_index("part")
+
+
+def evaluate_views(truth: pd.DataFrame, tracks: pd.DataFrame, at: int = DEFAULT_AT) -> dict[str, EvaluationReport]:
+    """Per view (``camera`` column), the 2D tracking-rate report of :func:`evaluate`."""
+    out = {}
+    for cam in sorted(set(truth["camera"]) - {""}):
+        t, k = truth[truth["camera"] == cam], tracks[tracks["camera"] == cam]
+        if len(k):
+            out[cam] = evaluate(t.reset_index(drop=True), k.reset_index(drop=True), at=at, matching="id")
+    return out
+
+
+# -- annotation effort ---------------------------------------------------------------------------
+
+EDIT_IOU = 0.5  # a proposal on a truth box at IoU >= 0.5 needs no correction
+
+
+@dataclass(frozen=True)
+class EditCount:
+    """What correcting proposals into the truth costs (one part, e.g. ``person``).
+
+    ``edits``: per frame ``max(truth boxes, proposals) - proposals matched to a truth box at
+    IoU >= 0.5`` (one-to-one, Hungarian): a wrong box is moved once, a missing one drawn, a
+    spurious one deleted; plus every keyframe box the annotator drew. ``per_100``: edits per 100
+    truth boxes; ``moved``, ``drawn``, ``deleted`` split the corrections, ``keyframes`` the boxes
+    drawn before the proposals were made.
+    """
+
+    edits: int
+    truth_boxes: int
+    keyframes: int
+    moved: int
+    drawn: int
+    deleted: int
+
+    @property
+    def per_100(self) -> float:
+        return 100.0 * self.edits / self.truth_boxes if self.truth_boxes else float("nan")
+
+
+def count_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = "person",
+                keyframes: int = 0, threshold: float = EDIT_IOU) -> EditCount:
+    """Corrections that turn ``proposals`` into ``truth`` for ``part`` (see :class:`EditCount`).
+
+    ``keyframes``: boxes the annotator drew by hand to make the proposals (the init boxes of a
+    tracker run, the keyframes of an interpolation); each costs one edit. Proposals are expected
+    to contain them (at a keyframe the proposal *is* the drawn box, so it costs nothing more).
+    Track ids play no part: an annotator corrects boxes, and a swapped id on a right box is
+    corrected in the id column, which this measure does not count.
+    """
+    truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
+    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
+    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
+    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
+    moved = drawn = deleted = 0
+    for f in set(t_by) | set(k_by):
+        t = t_by.get(f, np.empty((0, 4)))
+        k = k_by.get(f, np.empty((0, 4)))
+        matched = 0
+        if len(t) and len(k):
+            iou = iou_xywh(t, k)
+            rows, cols = linear_sum_assignment(iou, maximize=True)
+            matched = int((iou[rows, cols] >= threshold).sum())
+        pairs = min(len(t), len(k))
+        moved += pairs - matched
+        drawn += len(t) - pairs
+        deleted += len(k) - pairs
+    edits = moved + drawn + deleted + int(keyframes)
+    return EditCount(edits, len(truth), int(keyframes), moved, drawn, deleted)
+
+
+def keyframe_frames(first: int, last: int, every: int) -> np.ndarray:
+    """The frames an annotator keys on a track seen from ``first`` to ``last``: every
+    ``every``-th frame from its first, and its last (where it leaves)."""
+    frames = np.arange(first, last + 1, max(int(every), 1))
+    return np.unique(np.append(frames, last))
+
+
+def keyframes_of(truth_df: pd.DataFrame, every: int, part: str = "person") -> pd.DataFrame:
+    """The truth rows of ``part`` an annotator would key with a keyframe every ``every`` frames of
+    each track (:func:`keyframe_frames`); what ``--keyframes`` and interpolation start from."""
+    truth = truth_df[truth_df["part"] == part]
+    out = []
+    for _tid, g in truth.groupby("track_id"):
+        keys = keyframe_frames(int(g["frame"].min()), int(g["frame"].max()), every)
+        out.append(g[g["frame"].isin(keys)])
+    return pd.concat(out, ignore_index=True) if out else truth.iloc[:0]
+
+
+def interpolate_keyframes(keys_df: pd.DataFrame) -> pd.DataFrame:
+    """Linear interpolation of every track's boxes between its consecutive keyframes (CVAT's
+    track mode): rows ``frame, track_id, part, x, y, w, h`` for every frame from a track's first
+    keyframe to its last, per part."""
+    out = []
+    for (tid, part), g in keys_df.groupby(["track_id", "part"]):
+        g = g.sort_values("frame")
+        f = g["frame"].to_numpy(int)
+        frames = np.arange(f[0], f[-1] + 1)
+        cols = {c: np.interp(frames, f, g[c].to_numpy(float)) for c in XYWH}
+        out.append(pd.DataFrame({"frame": frames, "track_id": tid, "part": part, **cols}))
+    if not out:
+        return pd.DataFrame(columns=["frame", "track_id", "part"] + XYWH)
+    return pd.concat(out, ignore_index=True)

@@ -41,6 +41,7 @@ from sqlalchemy import (
     func,
     insert,
     select,
+    update,
 )
 from sqlalchemy.engine import make_url
 from sqlalchemy.exc import IntegrityError, OperationalError
@@ -125,6 +126,15 @@ class TrackerBoxRow(Base):
     X: Mapped[float | None] = mapped_column("world_x", Float, nullable=True)
     Y: Mapped[float | None] = mapped_column("world_y", Float, nullable=True)
     Z: Mapped[float | None] = mapped_column("world_z", Float, nullable=True)
+    # the run that replaced this box (None: in effect); kept so a re-track is undone as one step
+    superseded_by: Mapped[int | None] = mapped_column(Integer, nullable=True, index=True)
+
+
+#: what a revision of a human edit is: ``box`` a box the user drew, moved or flagged (a
+#: keyframe, a corrected frame, training truth); ``restore`` hands the key back to the tracker
+#: (an undone first edit); ``track`` an identity operation (merge, split, change id, delete from
+#: a frame on) that moved or removed the tracker's box without checking its position.
+EDIT_KINDS: tuple[str, ...] = ("box", "restore", "track")
 
 
 class EditRow(Base):
@@ -144,6 +154,7 @@ class EditRow(Base):
     failure: Mapped[bool] = mapped_column(Boolean, default=False)
     occluded: Mapped[float] = mapped_column(Float, default=0.0)
     deleted: Mapped[bool] = mapped_column(Boolean, default=False)
+    kind: Mapped[str] = mapped_column(String(12), default="box", server_default="box")
     author: Mapped[str] = mapped_column(String(100), default="")
     created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
     camera: Mapped[str] = mapped_column(String(100), default="", server_default="")
@@ -163,6 +174,21 @@ class OccluderRow(Base):
     y: Mapped[float] = mapped_column(Float)
     w: Mapped[float] = mapped_column(Float)
     h: Mapped[float] = mapped_column(Float)
+
+
+class ReviewRow(Base):
+    """A reviewer's verdict on frames ``start..stop`` (inclusive) of one track; the newest
+    verdict covering a frame is the one in effect."""
+
+    __tablename__ = "reviews"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    clip_id: Mapped[int] = mapped_column(ForeignKey("clips.id"), index=True)
+    track_id: Mapped[int] = mapped_column(Integer)
+    start: Mapped[int] = mapped_column(Integer)
+    stop: Mapped[int] = mapped_column(Integer)
+    accepted: Mapped[bool] = mapped_column(Boolean)
+    author: Mapped[str] = mapped_column(String(100), default="")
+    created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
 
 
 class BundleRow(Base):
@@ -229,6 +255,26 @@ class EventRow(Base):
     author: Mapped[str] = mapped_column(String(100), default="")
     created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
     __table_args__ = (UniqueConstraint("clip_id", "event_id", "revision"),)
+
+
+class JobRow(Base):
+    """A job of the app run by a Dask worker (revision 3); see :mod:`partlab.engine.jobs`."""
+
+    __tablename__ = "jobs"
+    id: Mapped[str] = mapped_column(String(64), primary_key=True)
+    kind: Mapped[str] = mapped_column(String(40))
+    label: Mapped[str] = mapped_column(Text)
+    meta: Mapped[dict] = mapped_column(JSON, default=dict)
+    status: Mapped[str] = mapped_column(String(20), default="queued", index=True)
+    done: Mapped[int] = mapped_column(Integer, default=0)
+    total: Mapped[int] = mapped_column(Integer, default=0)
+    error: Mapped[str] = mapped_column(Text, default="")
+    result: Mapped[dict | None] = mapped_column(JSON, nullable=True)
+    cancel: Mapped[bool] = mapped_column(Boolean, default=False)
+    worker: Mapped[str] = mapped_column(String(200), default="")
+    created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+    updated: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+    finished: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
 
 
 @dataclass(frozen=True)
@@ -476,9 +522,13 @@ class Store:
 
     # -------------------------------------------------------------- tracker runs
     def save_tracker_run(self, clip_id: int, tracks: pd.DataFrame, tracker: str = "body", bundle: str = "",
-                         seed: int = 0, start_frame: int = 0, stop_frame: int | None = None) -> int:
-        """Store a tracker's boxes, replacing earlier tracker boxes of frames in
-        ``[start_frame, stop_frame)``; human edits are never touched."""
+                         seed: int = 0, start_frame: int = 0, stop_frame: int | None = None,
+                         track_ids: list[int] | None = None, parts: list[str] | None = None) -> int:
+        """Store a tracker's boxes; they replace earlier tracker boxes of frames in
+        ``[start_frame, stop_frame)`` (of the tracks in ``track_ids`` only, when given: a
+        re-track keeps every track it was not asked to change), and of ``parts`` only when
+        given. Replaced boxes are kept as
+        superseded by this run, so :meth:`undo_run` brings them back; human edits are never touched."""
         self.clip(clip_id)
         df = normalise_tracks(tracks)
         try:  # the tracks CSV's rules: nothing is stored that partlab's own reader would refuse
@@ -489,11 +539,19 @@ class Store:
             run = RunRow(clip_id=clip_id, tracker=tracker, bundle=str(bundle), seed=seed, start_frame=start_frame)
             s.add(run)
             s.flush()
-            cond = [TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame >= start_frame]
+            cond = [TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame >= start_frame,
+                    TrackerBoxRow.superseded_by.is_(None)]
             if stop_frame is not None:
                 cond.append(TrackerBoxRow.frame < stop_frame)
                 df = df[df.frame < stop_frame]
-            s.execute(delete(TrackerBoxRow).where(*cond))
+            if track_ids is not None:
+                ids = [int(t) for t in track_ids]
+                cond.append(TrackerBoxRow.track_id.in_(ids))
+                df = df[df.track_id.isin(ids)]
+            if parts is not None:
+                cond.append(TrackerBoxRow.part.in_(list(parts)))
+                df = df[df.part.isin(list(parts))]
+            s.execute(update(TrackerBoxRow).where(*cond).values(superseded_by=run.id))
             df = df[df.frame >= start_frame]
             records = [
                 dict(clip_id=clip_id, run_id=run.id, frame=int(r.frame), track_id=int(r.track_id), part=r.part,
@@ -508,6 +566,30 @@ class Store:
             s.commit()
             return run.id
 
+    def undo_run(self, clip_id: int, run_id: int) -> None:
+        """Take a tracker run back as one step: its boxes go, the boxes it replaced come back.
+        Only the clip's newest run can be undone (an older one's boxes may be replaced again)."""
+        with self._session() as s:
+            newest = s.scalar(select(func.max(RunRow.id)).where(RunRow.clip_id == clip_id))
+            if newest is None or int(newest) != int(run_id):
+                raise StoreError(f"run {run_id} is not the newest tracker run of clip {clip_id}; "
+                                 "only the newest run can be undone")
+            s.execute(delete(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.run_id == run_id))
+            s.execute(update(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id,
+                                                  TrackerBoxRow.superseded_by == run_id).values(superseded_by=None))
+            s.execute(delete(RunRow).where(RunRow.id == run_id))
+            s.commit()
+
+    def data_version(self, clip_id: int) -> tuple[int, int, int, int]:
+        """Changes whenever the clip's effective boxes or reviews may have changed (an edit, a
+        run stored or undone, a verdict): a cheap cache key for readers of :meth:`tracks`."""
+        with self._session() as s:
+            e = s.scalar(select(func.max(EditRow.id)).where(EditRow.clip_id == clip_id)) or 0
+            n, r = s.execute(select(func.count(RunRow.id), func.max(RunRow.id)).where(RunRow.clip_id == clip_id)).one()
+            v = s.scalar(select(func.max(ReviewRow.id)).where(ReviewRow.clip_id == clip_id)) or 0
+            nv = s.scalar(select(func.count(ReviewRow.id)).where(ReviewRow.clip_id == clip_id)) or 0
+        return int(e), int(n or 0) * 1_000_000 + int(r or 0), int(v), int(nv)
+
     def runs(self, clip_id: int) -> pd.DataFrame:
         with self._session() as s:
             rows = s.scalars(select(RunRow).where(RunRow.clip_id == clip_id).order_by(RunRow.id)).all()
@@ -517,7 +599,7 @@ class Store:
     # ------------------------------------------------------------ effective boxes
     def _effective(self, clip_id: int, frame: int | None) -> pd.DataFrame:
         with self._session() as s:
-            tq = select(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id)
+            tq = select(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.superseded_by.is_(None))
             newest = (select(EditRow.frame, EditRow.track_id, EditRow.part,
                              func.max(EditRow.revision).label("rev"))
                       .where(EditRow.clip_id == clip_id).group_by(EditRow.frame, EditRow.track_id, EditRow.part))
@@ -531,12 +613,23 @@ class Store:
             tracker = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, _nan(r.score), r.failure, r.occluded,
                         r.state, "tracker", r.camera, _nan(r.X), _nan(r.Y), _nan(r.Z), 0)
                        for r in s.scalars(tq)]
-            edits = [(r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, float("nan"), r.failure, r.occluded, "",
-                      "human", r.camera, _nan(r.X), _nan(r.Y), _nan(r.Z), r.revision, r.deleted)
-                     for r in s.scalars(eq)]
+            # a "restore" revision leaves the tracker's box in effect (its revision still guards stale writes)
+            edits, restored = [], []
+            for r in s.scalars(eq):
+                if r.kind == "restore":
+                    restored.append((r.frame, r.track_id, r.part, r.revision))
+                    continue
+                edits.append((r.frame, r.track_id, r.part, r.x, r.y, r.w, r.h, float("nan"), r.failure, r.occluded,
+                              "", "human" if r.kind == "box" else "tracker", r.camera, _nan(r.X), _nan(r.Y),
+                              _nan(r.Z), r.revision, r.deleted))
         cols = list(COLUMNS) + ["revision"]
         tdf = pd.DataFrame(tracker, columns=cols)
         edf = pd.DataFrame(edits, columns=cols + ["deleted"])
+        if restored:
+            rdf = pd.DataFrame(restored, columns=["frame", "track_id", "part", "rev"])
+            tdf = tdf.merge(rdf, on=["frame", "track_id", "part"], how="left")
+            tdf["revision"] = tdf["rev"].fillna(tdf["revision"]).astype("int64")
+            tdf = tdf.drop(columns="rev")
         if len(edf):
             keys = ["frame", "track_id", "part"]
             tdf = tdf.merge(edf[keys], on=keys, how="left", indicator=True)
@@ -571,44 +664,64 @@ class Store:
     def edit_box(self, clip_id: int, frame: int, track_id: int, part: str, box: Box | None, *,
                  failure: bool | None = None, occluded: float | None = None, expected_revision: int,
                  author: str = "", camera: str | None = None,
-                 xyz: tuple[float, float, float] | None = None) -> int:
+                 xyz: tuple[float, float, float] | None = None, kind: str = "box") -> int:
         """Write a human edit of one box (``box=None`` deletes it); returns the new revision.
 
         ``failure``/``occluded``/``camera`` (stream name) and ``xyz`` (world mm; a tuple of NaN
-        clears it) left as None keep their current values. Refused with
-        :class:`StaleEditError` when the newest revision is not ``expected_revision``.
+        clears it) left as None keep their current values; ``kind`` as in :data:`EDIT_KINDS`.
+        Refused with :class:`StaleEditError` when the newest revision is not ``expected_revision``.
         """
-        check_part(part)
-        _check_edit(frame, track_id, part, box, failure, occluded, xyz)
+        [rev] = self.edit_boxes(clip_id, [dict(frame=frame, track_id=track_id, part=part, box=box, failure=failure,
+                                               occluded=occluded, expected_revision=expected_revision, kind=kind,
+                                               camera=camera, xyz=xyz)],
+                                author=author)
+        return rev
+
+    def edit_boxes(self, clip_id: int, changes: list[dict], author: str = "") -> list[int]:
+        """Write several edits in one transaction (all or none); each change is a dict of
+        :meth:`edit_box`'s arguments (``frame, track_id, part, box, expected_revision`` and
+        optional ``failure, occluded, kind``). Returns the new revisions in order."""
         clip = self.clip(clip_id)
-        if not 0 <= frame < clip.frame_count:
-            raise StoreError(f"frame {frame} is outside clip {clip.name!r} (0..{clip.frame_count - 1})")
+        out = []
         with self._session() as s:
-            current = self._revision(s, clip_id, frame, track_id, part)
-            if current != expected_revision:
-                raise StaleEditError(self._stale_message(clip, frame, track_id, part, current, expected_revision))
-            before = self._current_content(s, clip_id, frame, track_id, part)
-            if box is None:
-                x = y = w = h = 0.0
-                if before is not None:
-                    x, y, w, h = before["x"], before["y"], before["w"], before["h"]
-            else:
-                x, y, w, h = float(box.x), float(box.y), float(box.w), float(box.h)
-            row = EditRow(clip_id=clip_id, frame=frame, track_id=track_id, part=part, revision=current + 1,
-                          x=x, y=y, w=w, h=h,
-                          failure=bool(failure) if failure is not None else bool(before and before["failure"]),
-                          occluded=float(occluded) if occluded is not None else
-                          float(before["occluded"]) if before else 0.0,
-                          deleted=box is None, author=author, **_point(before, camera, xyz))
-            s.add(row)
+            for c in changes:
+                _check_edit(c["frame"], c["track_id"], c["part"], c.get("box"), c.get("failure"), c.get("occluded"),
+                            c.get("xyz"))
+                frame, track_id, part = int(c["frame"]), int(c["track_id"]), check_part(str(c["part"]))
+                kind = c.get("kind", "box")
+                if kind not in EDIT_KINDS:
+                    raise StoreError(f"edit kind must be one of {', '.join(EDIT_KINDS)}, got {kind!r}")
+                if not 0 <= frame < clip.frame_count:
+                    raise StoreError(f"frame {frame} is outside clip {clip.name!r} (0..{clip.frame_count - 1})")
+                current = self._revision(s, clip_id, frame, track_id, part)
+                if current != int(c["expected_revision"]):
+                    s.rollback()
+                    raise StaleEditError(self._stale_message(clip, frame, track_id, part, current,
+                                                             int(c["expected_revision"])))
+                before = self._current_content(s, clip_id, frame, track_id, part)
+                box, failure, occluded = c.get("box"), c.get("failure"), c.get("occluded")
+                if box is None:
+                    x = y = w = h = 0.0
+                    if before is not None:
+                        x, y, w, h = before["x"], before["y"], before["w"], before["h"]
+                else:
+                    x, y, w, h = float(box.x), float(box.y), float(box.w), float(box.h)
+                s.add(EditRow(clip_id=clip_id, frame=frame, track_id=track_id, part=part, revision=current + 1,
+                              x=x, y=y, w=w, h=h,
+                              failure=bool(failure) if failure is not None else bool(before and before["failure"]),
+                              occluded=float(occluded) if occluded is not None else
+                              float(before["occluded"]) if before else 0.0,
+                              deleted=box is None and kind != "restore", author=author, kind=kind,
+                              **_point(before, c.get("camera"), c.get("xyz"))))
+                s.flush()
+                out.append(current + 1)
             try:
                 s.commit()
             except IntegrityError:
                 s.rollback()
-                latest = self._revision(s, clip_id, frame, track_id, part)
-                raise StaleEditError(self._stale_message(clip, frame, track_id, part, latest,
-                                                         expected_revision)) from None
-            return current + 1
+                raise StaleEditError(f"some boxes of {clip.name!r} were changed by someone else meanwhile; "
+                                     "reload the frame and apply your change again") from None
+        return out
 
     @staticmethod
     def _stale_message(clip: Clip, frame: int, track_id: int, part: str, current: int, expected: int) -> str:
@@ -616,16 +729,20 @@ class Store:
                 f"(revision {current}, you had {expected}); reload the frame and apply your change again")
 
     @staticmethod
-    def _current_content(s: Session, clip_id: int, frame: int, track_id: int, part: str) -> dict | None:
+    def _tracker_row(s: Session, clip_id: int, frame: int, track_id: int, part: str):
+        return s.scalar(select(TrackerBoxRow).where(
+            TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame == frame, TrackerBoxRow.track_id == track_id,
+            TrackerBoxRow.part == part, TrackerBoxRow.superseded_by.is_(None)).limit(1))
+
+    @classmethod
+    def _current_content(cls, s: Session, clip_id: int, frame: int, track_id: int, part: str) -> dict | None:
         e = s.scalar(select(EditRow).where(EditRow.clip_id == clip_id, EditRow.frame == frame,
                                            EditRow.track_id == track_id, EditRow.part == part)
                      .order_by(EditRow.revision.desc()).limit(1))
-        if e is not None:
+        if e is not None and e.kind != "restore":
             return dict(x=e.x, y=e.y, w=e.w, h=e.h, failure=e.failure, occluded=e.occluded, deleted=e.deleted,
                         camera=e.camera, X=e.X, Y=e.Y, Z=e.Z)
-        t = s.scalar(select(TrackerBoxRow).where(TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame == frame,
-                                                 TrackerBoxRow.track_id == track_id, TrackerBoxRow.part == part)
-                     .limit(1))
+        t = cls._tracker_row(s, clip_id, frame, track_id, part)
         if t is not None:
             return dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded, deleted=False,
                         camera=t.camera, X=t.X, Y=t.Y, Z=t.Z)
@@ -636,51 +753,53 @@ class Store:
             rows = s.scalars(select(EditRow).where(EditRow.clip_id == clip_id, EditRow.frame == frame,
                                                    EditRow.track_id == track_id, EditRow.part == part)
                              .order_by(EditRow.revision)).all()
-            return pd.DataFrame([dict(revision=r.revision, x=r.x, y=r.y, w=r.w, h=r.h, failure=r.failure,
-                                      occluded=r.occluded, deleted=r.deleted, author=r.author, created=r.created,
-                                      camera=r.camera, X=_nan(r.X), Y=_nan(r.Y), Z=_nan(r.Z))
-                                 for r in rows],
-                                columns=["revision", "x", "y", "w", "h", "failure", "occluded", "deleted", "author",
-                                         "created", "camera", "X", "Y", "Z"])
+            cols = ["revision", "x", "y", "w", "h", "failure", "occluded", "deleted", "kind", "author", "created",
+                    "camera", "X", "Y", "Z"]
+            return pd.DataFrame([{c: _nan(getattr(r, c)) if c in "XYZ" else getattr(r, c) for c in cols}
+                                 for r in rows], columns=cols)
 
     def undo(self, clip_id: int, frame: int, track_id: int, part: str, expected_revision: int,
              author: str = "") -> int:
         """Undo the newest edit by writing the previous revision's content as a new
-        revision (so the undo itself can be undone); with one edit only, the tracker's
-        box comes back (or the box disappears if the edit had added it)."""
+        revision (so the undo itself can be undone); undoing the first edit hands the
+        key back to the tracker (a ``restore`` revision: no longer a correction)."""
+        [rev] = self.undo_many(clip_id, [(frame, track_id, part, expected_revision)], author=author)
+        return rev
+
+    def undo_many(self, clip_id: int, keys: list[tuple[int, int, str, int]], author: str = "") -> list[int]:
+        """:meth:`undo` of several ``(frame, track_id, part, expected_revision)`` keys in one transaction."""
         clip = self.clip(clip_id)
+        out = []
         with self._session() as s:
-            current = self._revision(s, clip_id, frame, track_id, part)
-            if current != expected_revision:
-                raise StaleEditError(self._stale_message(clip, frame, track_id, part, current, expected_revision))
-            if current == 0:
-                raise StoreError(f"nothing to undo for the {part} box of track {track_id} at frame {frame}")
-            prev = s.scalar(select(EditRow).where(EditRow.clip_id == clip_id, EditRow.frame == frame,
-                                                  EditRow.track_id == track_id, EditRow.part == part,
-                                                  EditRow.revision == current - 1))
-            if prev is not None:
-                content = dict(x=prev.x, y=prev.y, w=prev.w, h=prev.h, failure=prev.failure,
-                               occluded=prev.occluded, deleted=prev.deleted, camera=prev.camera,
-                               X=prev.X, Y=prev.Y, Z=prev.Z)
-            else:
-                t = s.scalar(select(TrackerBoxRow).where(
-                    TrackerBoxRow.clip_id == clip_id, TrackerBoxRow.frame == frame,
-                    TrackerBoxRow.track_id == track_id, TrackerBoxRow.part == part).limit(1))
-                if t is not None:
-                    content = dict(x=t.x, y=t.y, w=t.w, h=t.h, failure=t.failure, occluded=t.occluded,
-                                   deleted=False, camera=t.camera, X=t.X, Y=t.Y, Z=t.Z)
+            for frame, track_id, part, expected in keys:
+                current = self._revision(s, clip_id, frame, track_id, part)
+                if current != expected:
+                    s.rollback()
+                    raise StaleEditError(self._stale_message(clip, frame, track_id, part, current, expected))
+                if current == 0:
+                    s.rollback()
+                    raise StoreError(f"nothing to undo for the {part} box of track {track_id} at frame {frame}")
+                prev = s.scalar(select(EditRow).where(EditRow.clip_id == clip_id, EditRow.frame == frame,
+                                                      EditRow.track_id == track_id, EditRow.part == part,
+                                                      EditRow.revision == current - 1))
+                if prev is not None:
+                    content = dict(x=prev.x, y=prev.y, w=prev.w, h=prev.h, failure=prev.failure,
+                                   occluded=prev.occluded, deleted=prev.deleted, kind=prev.kind, camera=prev.camera,
+                                   X=prev.X, Y=prev.Y, Z=prev.Z)
                 else:
-                    content = dict(x=0.0, y=0.0, w=0.0, h=0.0, failure=False, occluded=0.0, deleted=True)
-            s.add(EditRow(clip_id=clip_id, frame=frame, track_id=track_id, part=part, revision=current + 1,
-                          author=author, **content))
+                    content = dict(x=0.0, y=0.0, w=0.0, h=0.0, failure=False, occluded=0.0, deleted=False,
+                                   kind="restore")
+                s.add(EditRow(clip_id=clip_id, frame=frame, track_id=track_id, part=part, revision=current + 1,
+                              author=author, **content))
+                s.flush()
+                out.append(current + 1)
             try:
                 s.commit()
             except IntegrityError:
                 s.rollback()
-                raise StaleEditError(self._stale_message(clip, frame, track_id, part,
-                                                         self._revision(s, clip_id, frame, track_id, part),
-                                                         expected_revision)) from None
-            return current + 1
+                raise StaleEditError(f"some boxes of {clip.name!r} were changed by someone else meanwhile; "
+                                     "reload the frame and undo again") from None
+        return out
 
     def next_track_id(self, clip_id: int) -> int:
         with self._session() as s:
@@ -688,17 +807,104 @@ class Store:
             b = s.scalar(select(func.max(EditRow.track_id)).where(EditRow.clip_id == clip_id)) or 0
             return int(max(a, b)) + 1
 
-    def human_frames(self, clip_id: int) -> list[int]:
-        """Frames that have at least one human edit, ascending."""
+    def edit_state(self, clip_id: int, keys: list[tuple[int, int, str]]) -> list[dict]:
+        """For each key ``(frame, track_id, part)``, the change that would write its human
+        layer back as it is now (what an undo of a later step writes): the newest edit's
+        content and kind, or a ``restore`` when it has none; ``expected_revision`` is its
+        newest revision now."""
+        out = []
         with self._session() as s:
-            return sorted(int(f) for f in s.scalars(select(EditRow.frame).where(EditRow.clip_id == clip_id)
-                                                     .distinct()))
+            for frame, track_id, part in keys:
+                e = s.scalar(select(EditRow).where(EditRow.clip_id == clip_id, EditRow.frame == frame,
+                                                   EditRow.track_id == track_id, EditRow.part == part)
+                             .order_by(EditRow.revision.desc()).limit(1))
+                c = dict(frame=int(frame), track_id=int(track_id), part=str(part), box=None, kind="restore",
+                         expected_revision=int(e.revision) if e is not None else 0)
+                if e is not None and e.kind != "restore":
+                    c.update(kind=e.kind, failure=bool(e.failure), occluded=float(e.occluded), camera=e.camera,
+                             xyz=(_nan(e.X), _nan(e.Y), _nan(e.Z)), box=None if e.deleted else Box(e.x, e.y, e.w, e.h))
+                out.append(c)
+        return out
+
+    def revisions(self, clip_id: int) -> dict[tuple[int, int, str], int]:
+        """The newest revision of every edited key ``(frame, track_id, part)`` of a clip."""
+        with self._session() as s:
+            rows = s.execute(select(EditRow.frame, EditRow.track_id, EditRow.part, func.max(EditRow.revision))
+                             .where(EditRow.clip_id == clip_id)
+                             .group_by(EditRow.frame, EditRow.track_id, EditRow.part)).all()
+        return {(int(f), int(t), str(p)): int(r) for f, t, p, r in rows}
+
+    def keyframes(self, clip_id: int) -> pd.DataFrame:
+        """The human boxes in effect (``frame, track_id, part`` and the box; deletions
+        included with ``deleted``): the corrected keys, which are the keyframes of track mode."""
+        with self._session() as s:
+            newest = (select(EditRow.frame, EditRow.track_id, EditRow.part, func.max(EditRow.revision).label("rev"))
+                      .where(EditRow.clip_id == clip_id).group_by(EditRow.frame, EditRow.track_id, EditRow.part)
+                      .subquery())
+            rows = s.scalars(select(EditRow).join(
+                newest, (EditRow.clip_id == clip_id) & (EditRow.frame == newest.c.frame)
+                & (EditRow.track_id == newest.c.track_id) & (EditRow.part == newest.c.part)
+                & (EditRow.revision == newest.c.rev)).where(EditRow.kind == "box")).all()
+            cols = ["frame", "track_id", "part", "x", "y", "w", "h", "failure", "occluded", "deleted", "revision"]
+            df = pd.DataFrame([{c: getattr(r, c) for c in cols} for r in rows], columns=cols)
+        return df.sort_values(["track_id", "part", "frame"]).reset_index(drop=True)
+
+    def human_frames(self, clip_id: int) -> list[int]:
+        """Frames with at least one human correction in effect (an undone edit is none), ascending."""
+        return sorted({int(f) for f in self.keyframes(clip_id).frame})
 
     def progress(self, clip_id: int) -> dict:
         clip = self.clip(clip_id)
         corrected = len(self.human_frames(clip_id))
         frames = clip.frame_count
-        return dict(frames=frames, corrected_frames=corrected, fraction=corrected / frames if frames else 0.0)
+        accepted = len(self.accepted_frames(clip_id))
+        return dict(frames=frames, corrected_frames=corrected, fraction=corrected / frames if frames else 0.0,
+                    accepted_frames=accepted, accepted_fraction=accepted / frames if frames else 0.0)
+
+    # ------------------------------------------------------------------- review
+    def review(self, clip_id: int, track_id: int, start: int, stop: int, accepted: bool, author: str = "") -> int:
+        """Accept or reject frames ``start..stop`` (inclusive) of one track; returns the verdict's id."""
+        clip = self.clip(clip_id)
+        start, stop = int(start), int(stop)
+        if not 0 <= start <= stop < clip.frame_count:
+            raise StoreError(f"frames {start}..{stop} are not a range of clip {clip.name!r} "
+                             f"(0..{clip.frame_count - 1})")
+        with self._session() as s:
+            row = ReviewRow(clip_id=clip_id, track_id=int(track_id), start=start, stop=stop, accepted=bool(accepted),
+                            author=author)
+            s.add(row)
+            s.commit()
+            return row.id
+
+    def undo_review(self, clip_id: int, review_id: int) -> None:
+        with self._session() as s:
+            s.execute(delete(ReviewRow).where(ReviewRow.clip_id == clip_id, ReviewRow.id == review_id))
+            s.commit()
+
+    def reviews(self, clip_id: int) -> pd.DataFrame:
+        with self._session() as s:
+            rows = s.scalars(select(ReviewRow).where(ReviewRow.clip_id == clip_id).order_by(ReviewRow.id)).all()
+            cols = ["id", "track_id", "start", "stop", "accepted", "author", "created"]
+            return pd.DataFrame([{c: getattr(r, c) for c in cols} for r in rows], columns=cols)
+
+    def _verdicts(self, clip_id: int) -> dict[tuple[int, int], bool]:
+        """(frame, track_id) -> the newest verdict covering it."""
+        verdict: dict[tuple[int, int], bool] = {}
+        for r in self.reviews(clip_id).itertuples(index=False):  # oldest first: newer verdicts win
+            for f in range(int(r.start), int(r.stop) + 1):
+                verdict[(f, int(r.track_id))] = bool(r.accepted)
+        return verdict
+
+    def accepted(self, clip_id: int) -> pd.DataFrame:
+        """``frame, track_id`` pairs whose newest covering verdict is an acceptance."""
+        keys = sorted(k for k, ok in self._verdicts(clip_id).items() if ok)
+        return pd.DataFrame(keys, columns=["frame", "track_id"], dtype="int64")
+
+    def accepted_frames(self, clip_id: int) -> list[int]:
+        """Frames where at least one track is accepted and none is rejected."""
+        verdict = self._verdicts(clip_id)
+        rejected = {f for (f, _), ok in verdict.items() if not ok}
+        return sorted({f for (f, _), ok in verdict.items() if ok} - rejected)
 
     # ----------------------------------------------------------------- occluders
     def set_occluders(self, clip_id: int, boxes: list[Box]) -> None:

@@ -10,6 +10,7 @@ A take folder (documented in docs/formats.md, "Takes")::
       cam0.mp4 ...        colour video per stream
       cam0_depth/         optional depth per stream: 16-bit PNGs in mm (000000.png ...), or
       cam0_depth.npy|npz  a (T, H, W) stack in mm; 0 means unmeasured
+      cam0_background.png optional: the empty scene seen by the stream (for fixed background subtraction)
 
 A stream's depth may instead come from a calibrated stereo pair (:mod:`partlab.labelling.stereo`):
 ``{"name": "cam0", "color": "left.mp4", "stereo": {"left": "left.mp4", "right": "right.mp4",
@@ -173,6 +174,20 @@ class Take:
     @property
     def frame_count(self) -> int:
         return self.streams_[0].frame_count
+
+    @property
+    def backgrounds(self) -> dict[str, np.ndarray]:
+        """Per stream, the empty-scene image ``<stream>_background.png`` beside the take's videos."""
+        out = {}
+        if self.path.is_dir():
+            for s in self.streams_:
+                f = self.path / f"{s.name}_background.png"
+                if f.is_file():
+                    img = cv2.imread(str(f), cv2.IMREAD_COLOR)
+                    if img is None:
+                        raise TakeError(f"{f}: cannot read this background image")
+                    out[s.name] = img
+        return out
 
     @property
     def has_depth(self) -> bool:

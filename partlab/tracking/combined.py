@@ -5,6 +5,14 @@ of the body person whose box holds its head (:mod:`partlab.tracking.identity`), 
 limb people get ids from :data:`LIMB_ID_OFFSET` on, so the two never share an id. A person's head
 is written once per frame (the body tracker's where both have it). The limbs' join events name
 the tracks as written.
+
+Found automatically, heads and hands are written only on people (issue 13): when the body tracker
+finds people in the clip, a limb row is kept when its box's centre lies inside a body person box
+of the same frame, a head's in the top :data:`HEAD_TOP` of it (skin-coloured walls, grass and
+parked cars move in a real background model's foreground now and then, but the body tracker starts
+no person there). A clip where the body tracker finds nobody (a person seated at a desk, whom its
+walker detection does not start) keeps the limbs' own rows; events of limb tracks no longer
+written are dropped with them.
 """
 
 from __future__ import annotations
@@ -20,6 +28,27 @@ from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
 #: limb people not matched to a body person get ids from here
 LIMB_ID_OFFSET = 100000
+#: a head lies in the top part of its person's box: the top third, plus a margin for a box that
+#: reaches a little above the head or a person who bends
+HEAD_TOP = 0.4
+
+
+def on_people(limbs: pd.DataFrame, body: pd.DataFrame, head_top: float = HEAD_TOP) -> pd.DataFrame:
+    """The limb rows whose centre lies inside some body ``person`` box of the same frame (a head's
+    within the top ``head_top`` of it)."""
+    if limbs.empty:
+        return limbs
+    people = body[body["part"] == "person"][["frame", "x", "y", "w", "h"]]
+    if people.empty:
+        return limbs.iloc[:0]
+    lim = limbs.reset_index(drop=True)
+    m = lim[["frame", "part", "x", "y", "w", "h"]].reset_index().merge(people, on="frame", suffixes=("", "_p"))
+    cx, cy = m["x"] + m["w"] / 2, m["y"] + m["h"] / 2
+    top = np.where(m["part"] == "head", head_top, 1.0)
+    inside = (cx >= m["x_p"]) & (cx <= m["x_p"] + m["w_p"]) & (cy >= m["y_p"]) & (cy <= m["y_p"] + top * m["h_p"])
+    keep = np.zeros(len(lim), bool)
+    keep[m.loc[inside.to_numpy(), "index"].to_numpy()] = True
+    return lim[keep]
 
 
 class Combined:
@@ -39,13 +68,18 @@ class Combined:
         return body + limbs
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
-        body = records_to_frame(self._body_rows) if self._body_rows else empty_tracks()
+        body = self.body.table(self._body_rows)
         limbs = records_to_frame(self._limb_rows) if self._limb_rows else empty_tracks()
+        if not self.from_init and (body["part"] == "person").any():
+            limbs = on_people(limbs, body)
         mapping = {} if self.from_init else match_limb_people(body, limbs)
         offset = 0 if self.from_init else LIMB_ID_OFFSET
         events = self.limbs.events
         if events is not None and len(events):
-            events = events.copy()
+            written = set(limbs["track_id"])
+            kept = events["track_id_a"].isin(written) & (events["track_id_b"].isna()
+                                                          | events["track_id_b"].isin(written))
+            events = events[kept].copy()
             for col in ("track_id_a", "track_id_b"):
                 events[col] = remap_ids(events[col], mapping, offset)
         self.events = events

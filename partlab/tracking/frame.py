@@ -85,3 +85,37 @@ class TakeSource(Protocol):
     def frames(self, start: int = 0, stop: int | None = None) -> Iterator[FrameSet]: ...
 
     def close(self) -> None: ...
+
+
+class MemoryTake:
+    """A one-stream :class:`TakeSource` over frames already in memory (a list or a ``(T, H, W, 3)``
+    array), e.g. decoded image folders in benchmarks or frames a test draws."""
+
+    def __init__(self, frames, fps: float = 25.0, stream: str = DEFAULT_STREAM):
+        self._frames = frames
+        self._fps = float(fps)
+        self._stream = stream
+
+    @property
+    def fps(self) -> float:
+        return self._fps
+
+    @property
+    def frame_count(self) -> int:
+        return len(self._frames)
+
+    @property
+    def streams(self) -> tuple[str, ...]:
+        return (self._stream,)
+
+    @property
+    def cameras(self) -> Mapping[str, Camera | None]:
+        return {self._stream: None}
+
+    def frames(self, start: int = 0, stop: int | None = None) -> Iterator[FrameSet]:
+        stop = len(self._frames) if stop is None else min(stop, len(self._frames))
+        for i in range(start, stop):
+            yield FrameSet.single(i, self._frames[i], stream=self._stream)
+
+    def close(self) -> None:
+        pass

@@ -31,7 +31,9 @@ class TrackContext:
     ``init``: tracks table of the boxes to start from (None: find people automatically);
     ``occluders``: fixed regions that can hide people; ``fps``: frames per second of the take;
     ``cameras``: the take's calibration per stream (None where a stream has none);
-    ``failure_detector``: a :class:`FailureDetector` or None.
+    ``failure_detector``: a :class:`FailureDetector` or None; ``backgrounds``: per stream an
+    empty-scene image ``(H, W, 3) uint8`` when the take has one (a take's
+    ``<stream>_background.png``), for trackers that subtract a fixed background.
     """
 
     init: pd.DataFrame | None = None
@@ -39,6 +41,7 @@ class TrackContext:
     fps: float = 25.0
     cameras: Mapping[str, Camera | None] = field(default_factory=dict)
     failure_detector: Any = None
+    backgrounds: Mapping[str, np.ndarray] = field(default_factory=dict)
 
 
 class Tracker(Protocol):
@@ -83,6 +86,9 @@ class SingleView:
         return self.tracker.step(frames.index, view.color, foreground.get(view.stream))
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
+        finish = getattr(self.tracker, "finish", None)  # e.g. rows of lost tracks withdrawn
+        if finish is not None:
+            records = finish(records)
         return records_to_frame(records) if records else empty_tracks()
 
 

@@ -104,7 +104,8 @@ def params_class(key: str) -> type:
 register_parameters(ParameterEntry("body", "partlab.tracking.body.params:BodyParams", rng_slot=0))
 register_parameters(ParameterEntry("limbs", "partlab.tracking.limbs.params:LimbParams", rng_slot=1))
 register_parameters(ParameterEntry("activities", "partlab.tracking.activities.params:ActivityParams", rng_slot=9))
-register_parameters(ParameterEntry("depth", "partlab.tracking.depth.params:DepthParams", rng_slot=16))  # 16: the issue number, clear of the other trackers' slots
+# slots clear of each other: 16 the depth tracker's issue number
+register_parameters(ParameterEntry("depth", "partlab.tracking.depth.params:DepthParams", rng_slot=16))
 
 register(TrackerEntry(
     "body", "head, torso and hip-leg of every person, plus the person box (Zhao & Lee)",
@@ -125,3 +126,18 @@ register(TrackerEntry(
     "partlab.tracking.depth:build", ("depth",),
     ("head", "left_hand", "right_hand", "torso", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow"),
     needs=frozenset({"color", "depth"}), foreground=False))
+
+# 17: the top-view tracker's issue number
+register_parameters(ParameterEntry("topview", "partlab.tracking.topview.params:TopViewParams", rng_slot=17))
+register(TrackerEntry(
+    "topview", "3D head, shoulders, elbows and hands of several people seen from above by a depth camera "
+    "(Migniot & Ababsa)", "partlab.tracking.topview:build", ("topview",),
+    ("head", "right_shoulder", "left_shoulder", "right_elbow", "left_elbow", "right_hand", "left_hand"),
+    needs=frozenset({"depth", "calibration"}), foreground=False))
+
+# slot 14 (the issue that added it): far from the slots the other trackers take in order
+register_parameters(ParameterEntry("limbs3d", "partlab.tracking.limbs3d.params:Limbs3DParams", rng_slot=14))
+register(TrackerEntry(
+    "limbs3d", "heads and hands in 3D from two or more calibrated cameras (candidates from pairs of views)",
+    "partlab.tracking.limbs3d:build", ("limbs3d",), ("head", "left_hand", "right_hand"),
+    needs=frozenset({"color", "calibration"}), min_streams=2))

@@ -155,7 +155,7 @@ def track(take: TakeSource, tracker: str = "body", *, init: pd.DataFrame | None 
         init = init[init["frame"] >= start]
     detector = failure_detector if failure_detector is not None else getattr(model, "failure_detector", None)
     context = TrackContext(init=init, occluders=tuple(occluders), fps=take.fps, cameras=dict(take.cameras),
-                           failure_detector=detector)
+                           failure_detector=detector, backgrounds=dict(getattr(take, "backgrounds", None) or {}))
     built = build_tracker(tracker, model=model, seed=seed, context=context)
     body_params = model_params(model, "body")  # the background model's settings
     background = (lambda stream: BackgroundModel(body_params)) if entry.foreground else None

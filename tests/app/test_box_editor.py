@@ -7,7 +7,9 @@ import base64
 import cv2
 import numpy as np
 
-from partlab.app.box_editor import PALETTE, boxes_payload, encode_image, track_colour
+from partlab.app.box_editor import PALETTE, encode_image, pack_boxes, track_colour
+from partlab.tracking.core.box import Box
+from partlab.tracking.parts import PART_NAMES
 
 
 def test_frame_is_sent_as_a_jpeg_of_the_same_size(boxes):
@@ -20,9 +22,12 @@ def test_frame_is_sent_as_a_jpeg_of_the_same_size(boxes):
     assert back[15, 35, 2] > 200 and back[15, 35, 0] < 60 and back[50, 50].max() < 10
 
 
-def test_boxes_carry_revision_flags_and_track_colour(store, tracked_clip):
+def test_boxes_are_packed_by_frame_with_revision_and_flags(store, tracked_clip):
     _, clip = tracked_clip
-    df = store.frame_boxes(clip.id, 2)
-    [person, head] = sorted(boxes_payload(df), key=lambda b: b["part"] != "person")
-    assert (person["x"], person["w"], person["revision"], person["failure"]) == (16.0, 14.0, 0, False)
-    assert head["colour"] == track_colour(1) == PALETTE[1] and track_colour(11) == PALETTE[1]
+    store.edit_box(clip.id, 2, 1, "head", Box(20, 21, 8, 10), failure=True, expected_revision=0)
+    packed = pack_boxes(store.tracks(clip.id))
+    assert sorted(packed) == list(range(12))
+    person, head = sorted(packed[2], key=lambda r: r[1])  # [track, part index, x, y, w, h, flags, occluded, rev]
+    assert person == [1, PART_NAMES.index("person"), 16.0, 20.0, 14.0, 44.0, 0, 0.0, 0]
+    assert head == [1, PART_NAMES.index("head"), 20.0, 21.0, 8.0, 10.0, 1 + 2, 0.0, 1]  # failure, human
+    assert track_colour(1) == PALETTE[1] and track_colour(11) == PALETTE[1]

@@ -39,7 +39,8 @@ def _free_port() -> int:
 @pytest.fixture
 def server(tmp_path):
     port = _free_port()
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    # no demo project: tests/app/test_demo.py covers it, and rendering it would slow every first page
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), PARTLAB_DEMO="0")
     log = open(tmp_path / "server.log", "w")
     proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=log,
                             stderr=subprocess.STDOUT)
@@ -253,3 +254,212 @@ def test_every_page_has_an_address_that_opens_it(server, page):
         page.locator("h1", has_text=heading).wait_for()
         page.get_by_role("link", name="Correct").wait_for()  # the page links are drawn
         assert page.get_by_text("Page not found").count() == 0, path
+
+
+# ----------------------------------------------------------------------------- the Correct page as a tool
+W768, H576, N768 = 768, 576, 90
+
+
+def _people_clip(tmp_path):
+    """A 768x576 clip (textured ground, so its JPEGs weigh what a real frame's do) with three
+    walking people; track 1's head is a 15x7 px box, the size of a PETS09 head."""
+    import numpy as np
+
+    from partlab.labelling.video import write_video
+
+    rng = np.random.default_rng(3)
+    ground = (rng.integers(60, 140, (H576 // 4, W768 // 4, 3), dtype=np.uint8).repeat(4, 0).repeat(4, 1))
+    frames, rows = [], []
+    for f in range(N768):
+        img = ground.copy()
+        for t, (x0, y0, vx) in {1: (100, 200, 2), 2: (400, 260, -1), 3: (520, 150, 1)}.items():
+            x = x0 + vx * f
+            img[y0:y0 + 80, x:x + 32] = (40 + 50 * t, 90, 200 - 40 * t)
+            img[y0:y0 + 7, x + 9:x + 24] = (150, 170, 230)
+            rows += [dict(frame=f, track_id=t, part="person", x=x, y=y0, w=32, h=80),
+                     dict(frame=f, track_id=t, part="head", x=x + 9, y=y0, w=15, h=7),
+                     dict(frame=f, track_id=t, part="torso", x=x + 2, y=y0 + 8, w=28, h=32),
+                     dict(frame=f, track_id=t, part="hipleg", x=x + 1, y=y0 + 40, w=30, h=40)]
+        frames.append(img)
+    import pandas as pd
+
+    return write_video(tmp_path / "people.mp4", frames, fps=10.0), pd.DataFrame(rows)
+
+
+@pytest.fixture
+def quiet_server(server):
+    """The app without the demo project (nothing renders or tracks while we measure)."""
+    return server
+
+
+def _editor(page, expr: str):
+    return page.evaluate(f"() => {{ const e = window.partlabEditor; return {expr}; }}")
+
+
+def _focus_editor(page):
+    page.locator(".pl-frame").click()  # the frame label: focuses the editor without touching a box
+
+
+def _streamlit_select(page, label: str, option: str):
+    """Pick ``option`` in the Streamlit selectbox labelled ``label`` (again if a rerun closed it)."""
+    page.locator('[data-testid="stStatusWidget"]').wait_for(state="detached", timeout=60_000)
+    box = page.locator('[data-testid="stSelectbox"]').filter(has=page.get_by_text(label, exact=True)).first
+    for _ in range(5):
+        box.click()
+        choice = page.get_by_role("listbox").get_by_role("option", name=option, exact=True)
+        try:
+            choice.click(timeout=10_000)
+            return
+        except playwright.Error:
+            page.keyboard.press("Escape")
+            page.wait_for_timeout(500)
+    raise AssertionError(f"could not pick {option!r} in {label!r}")
+
+
+def test_correct_page_steps_plays_zooms_and_edits_tracks_from_the_browser(quiet_server, store, tmp_path):
+    import statistics
+
+    from partlab.labelling import formats
+
+    url, _ = quiet_server
+    clip_file, boxes = _people_clip(tmp_path)
+    project = store.create_project("people")
+    clip = store.add_clip(project.id, clip_file)
+    store.save_tracker_run(clip.id, boxes, tracker="import")
+    with playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        page = browser.new_page(viewport={"width": 1440, "height": 900})
+        page.set_default_timeout(60_000)
+        try:
+            _run_correct_page(page, url, store, clip, tmp_path, statistics, formats)
+        finally:
+            try:
+                page.screenshot(path=str(tmp_path / "last.png"), full_page=True)
+            except playwright.Error:
+                pass
+            browser.close()
+
+
+def _run_correct_page(page, url, store, clip, tmp_path, statistics, formats):
+    page.goto(url + "/correct")
+    page.wait_for_function("() => window.partlabEditor && window.partlabEditor.stats.ready === 0", timeout=90_000)
+    # the whole frame is above the fold at 1440x900
+    vp = page.locator(".pl-viewport").bounding_box()
+    assert vp["y"] + vp["height"] <= 900 and vp["width"] > 600, vp
+    page.wait_for_function("() => window.partlabEditor.frames.size >= 40", timeout=60_000)
+    _focus_editor(page)
+
+    # (1) stepping from the frame cache: the new frame and its boxes on screen, 20 steps
+    wall = []
+    for i in range(1, 21):
+        t = time.perf_counter()
+        page.keyboard.press("ArrowRight")
+        page.wait_for_function(f"() => window.partlabEditor.stats.ready === {i}", polling="raf")
+        wall.append(1000 * (time.perf_counter() - t))
+        page.wait_for_timeout(60)
+    shown = _editor(page, "e.stats.shown.map((x) => x[1])")
+    assert len(shown) == 20 and _editor(page, "e.cur") == 20
+    assert len(page.locator('rect.pl-box[data-track="2"]').all()) == 4  # the boxes of the new frame are drawn
+    print(f"\nframe step 768x576: key to frame shown median {statistics.median(shown):.1f} ms "
+          f"(max {max(shown):.0f}), through playwright median {statistics.median(wall):.1f} ms (max {max(wall):.0f})")
+
+    # Play at 25 frames/s from the cache
+    page.select_option(".pl-speed", "25")
+    page.wait_for_function("() => window.partlabEditor.frames.size >= 70", timeout=60_000)
+    _focus_editor(page)
+    page.keyboard.press(" ")
+    page.wait_for_timeout(3000)
+    page.keyboard.press(" ")
+    played, ms, stalls = _editor(page, "[e.stats.played, e.stats.playMs, e.stats.stalls]")
+    assert played > 5
+    print(f"play 768x576 at 25 fps asked: {1000 * played / ms:.1f} frames/s over {played} frames "
+          f"({stalls} animation frames waited for the cache)")
+
+    # (2) zoom 4x on the 15x7 px head of track 1 and resize it with the mouse
+    frame = _editor(page, "e.cur")
+    head = page.locator('rect.pl-box[data-part="head"][data-track="1"]')
+    bb = _wait_for(head.bounding_box, what="the head box")  # the editor redraws its boxes: wait for them
+    page.mouse.click(bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2)
+    for _ in range(12):
+        if _editor(page, "e.zoom") >= 4:
+            break
+        bb = _wait_for(head.bounding_box, what="the head box")
+        page.mouse.move(bb["x"] + bb["width"] / 2, bb["y"] + bb["height"] / 2)
+        page.mouse.wheel(0, -120)
+        page.wait_for_timeout(100)
+    zoom = _editor(page, "e.zoom")
+    assert zoom >= 4
+    bb = _wait_for(head.bounding_box, what="the head box")
+    assert bb["width"] >= 4 * 15 - 1 and bb["height"] >= 4 * 7 - 1
+    se = _wait_for(page.locator('rect.pl-handle[data-handle="se"]').bounding_box, what="the head's corner handle")
+    sx, sy = se["x"] + se["width"] / 2, se["y"] + se["height"] / 2
+    page.mouse.move(sx, sy)
+    page.mouse.down()
+    page.mouse.move(sx + 10, sy + 6, steps=3)
+    page.mouse.move(sx + 20, sy + 12, steps=3)
+    page.mouse.up()
+    truth = store.frame_boxes(clip.id, frame).set_index(["track_id", "part"]).loc[(1, "head")]
+
+    def resized():
+        row = store.frame_boxes(clip.id, frame).set_index(["track_id", "part"]).loc[(1, "head")]
+        return [row] if row.source == "human" else None
+
+    [row] = _wait_for(resized, what="the resized head in the store")
+    assert (row.x, row.y) == (truth.x, truth.y)
+    assert row.w - truth.w == pytest.approx(20 / zoom, abs=0.3) and row.h - truth.h == pytest.approx(12 / zoom, abs=0.3)
+    person = store.frame_boxes(clip.id, frame).set_index(["track_id", "part"]).loc[(1, "person")]
+    assert person.x + person.w >= row.x + row.w - 0.01  # the person box grew with its head
+    page.keyboard.press("0")  # fit again
+
+    # (4) merge, split and delete from a frame on, each with undo and redo from the editor's keys
+    def ids(f):
+        return sorted(set(store.frame_boxes(clip.id, f).track_id))
+
+    def operate(track, op, other=None):
+        page.get_by_role("tab", name="Tracks").click()
+        _streamlit_select(page, "Track", f"#{track}")
+        _streamlit_select(page, "Operation", op)
+        if other is not None:
+            field = page.get_by_label("Other / new id")
+            field.fill(str(other))
+            field.press("Enter")
+        page.get_by_role("button", name="Apply").click()
+        page.get_by_text("Done: ").first.wait_for()
+        page.locator('[data-testid="stStatusWidget"]').wait_for(state="detached", timeout=60_000)
+
+    def keys(combo):
+        _focus_editor(page)
+        page.keyboard.press(combo)
+
+    operate(3, "merge into track", 2)
+    _wait_for(lambda: ids(frame) == [1, 2], what="track 3 merged into 2")
+    keys("Control+z")
+    _wait_for(lambda: ids(frame) == [1, 2, 3], what="the merge undone")
+    keys("Control+y")
+    _wait_for(lambda: ids(frame) == [1, 2], what="the merge redone")
+    operate(1, "split at this frame")
+    _wait_for(lambda: ids(frame) == [2, 4] and ids(frame - 1) == [1, 2], what="track 1 split at the frame")
+    keys("Control+z")
+    _wait_for(lambda: ids(frame) == [1, 2], what="the split undone")
+    keys("Control+y")
+    _wait_for(lambda: ids(frame) == [2, 4], what="the split redone")
+    operate(2, "delete from this frame on")
+    _wait_for(lambda: ids(frame) == [4] and ids(frame - 1) == [1, 2], what="track 2 deleted from the frame on")
+    keys("Control+z")
+    _wait_for(lambda: ids(frame) == [2, 4], what="the deletion undone")
+    keys("Control+y")
+    _wait_for(lambda: ids(frame) == [4], what="the deletion redone")
+
+    # the export reflects the three operations
+    out = formats.export_clip(store, clip.id, "mot", tmp_path / "mot", frames=False)
+    gt = next(out.rglob("gt.txt"))
+    import pandas as pd
+
+    mot = pd.read_csv(gt, header=None).iloc[:, :2].set_axis(["frame", "id"], axis=1)
+    # MOT frames are 1-based, one file per part, ids numbered by the exporter
+    before, after = set(mot[mot.frame == frame].id), set(mot[mot.frame == frame + 1].id)
+    assert len(before) == 2 and len(after) == 1 and not after & before, (before, after)  # #1, #2 | #4
+    assert not store.human_frames(clip.id) == []  # the resized head is a correction
+
+    if os.environ.get("PARTLAB_SCREENSHOT") == "1":
+        page.screenshot(path=str(ROOT / "docs" / "correct.png"))

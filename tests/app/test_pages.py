@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
 from streamlit.testing.v1 import AppTest
 
 from partlab.app import jobs
@@ -79,16 +80,25 @@ def test_track_page_runs_the_tracker_in_the_background_and_stores_the_run(store,
     assert job.result["boxes"] == len(store.tracks(clip.id))
 
 
-def test_correct_page_shows_the_frame_with_its_boxes(store, tracked_clip):
+def test_correct_page_shows_its_counts_track_list_and_retrack_window(store, tracked_clip):
     project, clip = tracked_clip
-    store.edit_box(clip.id, 4, 1, "head", None, expected_revision=0)  # one human correction
-    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 4})
+    store.edit_box(clip.id, 4, 1, "head", Box(22, 20, 8, 10), expected_revision=0)  # one human correction
+    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 6})
     assert not at.exception
-    assert at.slider[0].value == 4
-    assert any("Frame 4 of 11 · 1 corrected frames (8.3%)" in c for c in texts(at, "caption"))
-    at.button[1].click().run()  # the page's "next frame" button
-    assert at.session_state[f"frame:{clip.id}"] == 5 and at.slider[0].value == 5
-    assert any("Runs the tracker from the boxes of frame 5 to the end of the clip" in m for m in texts(at, "markdown"))
+    assert any("1 corrected · 0 accepted of 12 frames" in c for c in texts(at, "caption"))
+    table = at.dataframe[0].value
+    assert table.loc[0, "track"] == 1 and (table.loc[0, "frames"], table.loc[0, "keyframes"]) == (12, 1)
+    # re-track from frame 6 starts at the keyframe before it (4) and runs to the end for track 1 only
+    assert any("from frame 4 (a keyframe) to the end of the clip for tracks #1" in m for m in texts(at, "markdown"))
+
+
+def test_names_are_shown_as_text_not_markdown(store):
+    at = page("projects")
+    at.text_input[0].input("**big** :red[x]")
+    at.button[0].click().run()
+    escaped = "\\*\\*big\\*\\* \\:red\\[x\\]"  # what Markdown shows as **big** :red[x]
+    assert texts(at, "success") == [f"Created project '{escaped}'."]
+    assert [h.value for h in at.subheader] == [f"Project: {escaped}"]
 
 
 def test_evaluate_page_plots_trajectories(store, tracked_clip):
@@ -131,31 +141,39 @@ def test_export_page_builds_an_archive_and_marks_clips_exported(store, tracked_c
     assert store.clip(clip.id).exported
 
 
-def test_retrack_from_a_fix_stops_at_the_next_corrected_frame(store, tracked_clip, boxes):
+def test_retrack_runs_between_keyframes_keeps_other_tracks_and_undoes_as_one_step(store, tracked_clip, boxes):
     project, clip = tracked_clip
+    other = boxes.query("part == 'person'").assign(track_id=2, y=2.0)  # a second person, never asked about
+    store.save_tracker_run(clip.id, other, tracker="import")
     head = boxes[(boxes.frame == 3) & (boxes.part == "head")].iloc[0]
     store.edit_box(clip.id, 3, 1, "head", Box(head.x + 1, head.y, head.w, head.h), expected_revision=0)
     store.edit_box(clip.id, 8, 1, "head", Box(70, 20, 8, 10), expected_revision=0)
     before = store.tracks(clip.id)
-    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 3})
-    assert any("to frame 8 (the next corrected frame)" in m for m in texts(at, "markdown"))
-    [go] = [b for b in at.button if b.label == "Re-track from here"]
+    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 5})
+    at.selectbox(key=f"rt_tracks:{clip.id}").set_value("#1").run()
+    assert any("from frame 3 (a keyframe) to frame 8 (the next keyframe) for tracks #1" in m
+               for m in texts(at, "markdown"))
+    [go] = [b for b in at.button if b.label == "Re-track"]
     go.click().run()
     [job] = jobs.jobs("track", clip_id=clip.id)
     jobs.wait(job.id, 120)
     assert job.status == "done", job.error
-    assert (job.result["start"], job.result["stop"]) == (3, 8)
+    assert (job.result["start"], job.result["stop"], job.result["track_ids"]) == (3, 8, [1])
     after = store.tracks(clip.id)
-    cols = ["frame", "part", "x", "y", "source"]
+    cols = ["frame", "track_id", "part", "x", "y", "source"]
 
-    def outside(df):  # frames before the fix and from the next corrected frame on
-        return df[(df.frame < 3) | (df.frame >= 8)].reset_index(drop=True)[cols]
+    def kept(df):  # frames outside the window, and track 2 everywhere
+        return df[(df.frame < 3) | (df.frame >= 8) | (df.track_id == 2)].reset_index(drop=True)[cols]
 
-    assert outside(after).equals(outside(before))
+    assert kept(after).equals(kept(before))
     fixed = after[(after.frame == 3) & (after.part == "head")].iloc[0]
     assert (fixed.source, fixed.x) == ("human", head.x + 1)  # the fix itself is never overwritten
-    assert set(after[(after.frame > 3) & (after.frame < 8)].source) == {"tracker"}
-    assert store.runs(clip.id).start_frame.tolist() == [0, 3]
+    assert set(after[(after.frame > 3) & (after.frame < 8) & (after.track_id == 1)].source) == {"tracker"}
+    # one step back: the boxes the run replaced return
+    at.run()
+    [undo] = [b for b in at.button if b.label.startswith("Undo the newest tracker run")]
+    undo.click().run()
+    pd.testing.assert_frame_equal(store.tracks(clip.id), before)
 
 
 def test_evaluate_page_compares_two_runs_against_the_truth(store, tracked_clip, boxes, tmp_path):
@@ -180,11 +198,3 @@ def test_pages_without_a_project_say_what_to_do_first():
         at = page(name)
         assert not at.exception, name
         assert any("No project yet" in i for i in texts(at, "info")), name
-
-
-def test_play_steps_through_the_frames_to_the_end(store, tracked_clip):
-    project, clip = tracked_clip
-    at = page("correct", project_id=project.id, clip_id=clip.id, **{f"frame:{clip.id}": 8})
-    at.toggle(key=f"play:{clip.id}").set_value(True).run()
-    assert not at.exception
-    assert at.session_state[f"frame:{clip.id}"] == 11 and at.slider[0].value == 11

@@ -189,3 +189,56 @@ def test_hota_known_by_hand():
     assert m.loc["head", "assa"] == pytest.approx(0.5)
     assert m.loc["head", "hota"] == pytest.approx(np.sqrt(0.5))
     assert evaluate(truth, truth).mot.loc["overall", "hota"] == pytest.approx(1.0)
+
+
+def _rows(rows):
+    return pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def test_count_edits_moves_draws_and_deletes_once_each():
+    from partlab.labelling.evaluation import count_edits
+
+    truth = _rows([(0, 1, "person", 0, 0, 10, 20), (0, 2, "person", 50, 0, 10, 20),
+                   (1, 1, "person", 1, 0, 10, 20), (1, 2, "person", 51, 0, 10, 20)])
+    props = _rows([(0, 7, "person", 0, 0, 10, 20),      # right (ids play no part)
+                   (0, 8, "person", 56, 0, 10, 20),     # IoU 4/16 = 0.25: moved
+                   (1, 7, "person", 1, 0, 10, 20),      # right; track 2 missing at frame 1: drawn
+                   (1, 9, "person", 200, 0, 10, 20),    # on nothing: pairs with the missing box, moved
+                   (2, 9, "person", 200, 0, 10, 20)])   # a frame without truth: deleted
+    e = count_edits(truth, props, keyframes=3)
+    assert (e.moved, e.drawn, e.deleted, e.keyframes) == (2, 0, 1, 3)
+    assert e.edits == 6 and e.truth_boxes == 4 and e.per_100 == 150.0
+
+
+def test_interpolation_between_keyframes_meets_them_and_is_linear():
+    from partlab.labelling.evaluation import count_edits, interpolate_keyframes, keyframes_of
+
+    frames = np.arange(0, 31)
+    # walks right at 2 px/frame for 20 frames, then stops: keyframes every 25 miss the stop
+    x = np.where(frames < 20, 2.0 * frames, 40.0)
+    truth = _rows([(int(f), 1, "person", float(v), 0.0, 10.0, 20.0) for f, v in zip(frames, x)])
+    keys = keyframes_of(truth, 25)
+    assert keys["frame"].tolist() == [0, 25, 30]
+    interp = interpolate_keyframes(keys)
+    assert len(interp) == 31 and interp.set_index("frame").loc[12, "x"] == pytest.approx(40 * 12 / 25)
+    e = count_edits(truth, interp, keyframes=len(keys))
+    # interpolated x = 1.6 f against 2 f: IoU >= 0.5 needs |dx| <= 10/3, i.e. 0.4 f <= 3.33 up to f = 8;
+    # after the stop (f >= 20) the truth stays at 40 against 1.6 f: right from f = 23 on
+    wrong = [f for f in range(31) if abs(interp.set_index("frame").loc[f, "x"] - x[f]) > 10 / 3]
+    assert e.moved == len(wrong) and e.edits == len(wrong) + 3
+    assert 0 < len(wrong) < 20
+
+
+def test_ids_agree_on_a_run_from_init_with_a_loose_start_and_a_track_gone():
+    from partlab.labelling.evaluation import ids_agree
+
+    truth = _rows([(f, k, "person", 100.0 * k + f, 0, 20, 40) for k in range(1, 6) for f in range(5)])
+    run = truth[truth.track_id != 5].copy()  # track 5 ended early (withdrawn)
+    run.loc[run.track_id == 2, "w"] = 50.0   # the tracker's own person box: IoU 0.4 with the drawn one
+    assert ids_agree(truth, run)
+    assert match_tracks(truth, run)[0] == "track_id"
+    shuffled = run.assign(track_id=run["track_id"].map({1: 3, 2: 4, 3: 1, 4: 2}))
+    assert not ids_agree(truth, shuffled)  # automatic numbering: same numbers, other people
+    assert match_tracks(truth, shuffled)[0] == "iou"
+    few = truth[truth.track_id <= 3]  # 3 of 5 truth tracks: not enough to call the ids the same
+    assert not ids_agree(truth, few)

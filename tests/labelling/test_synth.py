@@ -123,7 +123,7 @@ def test_same_seed_same_scene_other_seed_other_scene():
     assert min(gaps) > 70  # clearly different shirts (BGR distance)
 
 
-@pytest.mark.parametrize("name", SCENARIOS)
+@pytest.mark.parametrize("name", [s for s in SCENARIOS if s != "random"])  # random: its own tests
 def test_every_scenario_renders_valid_truth(name, tmp_path):
     out = render_scenario(name, tmp_path / name, seed=3, n_frames=12, width=240, height=160)
     truth = read_tracks_csv(out / "truth.csv")
@@ -296,3 +296,31 @@ def test_left_hand_is_the_persons_own_left():
     assert left - right > 30
     left, right = hand_x(np.pi / 2)  # facing away: on the image left
     assert right - left > 30
+
+
+def test_random_scenario_varies_people_camera_and_looks():
+    from partlab.labelling.synth.scene import RANDOM_SIZES, make_scene, random_size
+
+    counts, heights, sizes = set(), [], set()
+    for seed in range(6):
+        w, h = random_size(seed)
+        sizes.add((w, h))
+        scene = make_scene("random", seed=seed, n_frames=3, width=w, height=h)
+        person = scene.truth[scene.truth["part"] == "person"]
+        counts.add(person["track_id"].nunique())
+        heights.extend((person["h"] / h).tolist())
+        assert scene.frames.shape[1:3] == (h, w)
+        assert {"head", "torso", "hipleg"} <= set(scene.truth["part"])
+    assert sizes <= set(RANDOM_SIZES) and len(sizes) >= 2
+    assert len(counts) >= 3 and max(counts) <= 12 and min(counts) >= 1
+    assert min(heights) < 0.3 < max(heights)  # people of clearly different sizes in the frame
+
+
+def test_random_appearances_cover_any_number_and_vary_proportions():
+    from partlab.labelling.synth.appearance import random_appearances
+
+    apps = random_appearances(np.random.default_rng(3), 12)
+    assert len(apps) == 12
+    girth = [a.girth for a in apps]
+    assert max(girth) - min(girth) > 0.2 and all(0.8 <= g <= 1.3 for g in girth)
+    assert len({a.shirt for a in apps}) == 12

@@ -45,3 +45,21 @@ def test_merged_table_has_one_head_per_person_and_frame():
     p2 = out[(out.track_id == 2) & (out.part == "head")]
     assert len(p2) == 30 and (p2[p2.frame >= 20].w == 14).all()
     assert len(out[(out.track_id == 2) & (out.part == "left_hand")]) == 30
+
+
+def test_automatic_limb_rows_are_kept_only_on_people():
+    import pandas as pd
+
+    from partlab.tracking.combined import on_people
+
+    body = pd.DataFrame([(0, 1, "person", 100, 50, 40, 120), (1, 1, "person", 104, 50, 40, 120)],
+                        columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+    limbs = pd.DataFrame([
+        (0, 7, "head", 110, 55, 16, 16),        # top of the person: kept
+        (0, 7, "left_hand", 100, 110, 10, 10),  # inside the box: kept
+        (0, 8, "head", 112, 120, 16, 16),       # centre 128 below the top 0.4 (50 + 48 = 98): dropped
+        (1, 9, "head", 400, 60, 16, 16),        # on a wall, nobody there: dropped
+        (2, 7, "head", 110, 55, 16, 16),        # a frame without people: dropped
+    ], columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+    kept = on_people(limbs, body)
+    assert list(zip(kept.frame, kept.part, kept.track_id)) == [(0, "head", 7), (0, "left_hand", 7)]

@@ -1,9 +1,11 @@
 """The box editor: a bidirectional Streamlit component (components v2) in plain HTML/JS/CSS.
 
-The browser side (``editor.js``) draws the frame with every box in its track's colour,
-lets the user move, resize, add and delete boxes and toggle the failure/occluded flags
-(keyboard: arrows or A/D frame, N/Tab next track, F failure, O occluded, Delete,
-Ctrl+Z/Ctrl+Y), and sends each action as an event. This wrapper returns only the
+The browser side (``editor.js``) keeps a cache of JPEG frames and their boxes, which it
+asks for in chunks around the shown frame and ahead while playing (the state value
+``view``), so stepping and playing do not wait for a rerun. It draws the frame with every
+box in its track's colour, zooms and pans, shows labels on hover or for all boxes, hides
+parts and tracks, draws a timeline per track, lets the user move, resize, add and delete
+boxes and toggle the failure/occluded flags, and sends each action as an event. This wrapper returns only the
 events Python has not seen yet (their ``seq`` is above the last applied one, kept in
 session state), so a rerun never applies an edit twice and an action made while
 Python was busy is re-sent until acknowledged.
@@ -17,6 +19,7 @@ Events (dicts): ``{"kind": "edit", "frame", "track_id", "part", "box": [x, y, w,
 from __future__ import annotations
 
 import base64
+from collections.abc import Callable
 from functools import lru_cache
 from pathlib import Path
 
@@ -58,14 +61,21 @@ def encode_image(image: np.ndarray, quality: int = 85) -> str:
     return "data:image/jpeg;base64," + base64.b64encode(buf.tobytes()).decode("ascii")
 
 
-def boxes_payload(boxes: pd.DataFrame) -> list[dict]:
-    """Rows of a tracks frame (one video frame) as the editor's box dicts."""
-    out = []
-    for r in boxes.itertuples(index=False):
-        out.append(dict(track_id=int(r.track_id), part=str(r.part), x=float(r.x), y=float(r.y), w=float(r.w),
-                        h=float(r.h), failure=bool(r.failure), occluded=float(r.occluded),
-                        revision=int(getattr(r, "revision", 0)), source=str(getattr(r, "source", "")),
-                        colour=track_colour(int(r.track_id))))
+def pack_boxes(boxes: pd.DataFrame, parts: tuple[str, ...] = PART_NAMES) -> dict[int, list[list]]:
+    """Rows of a tracks frame as the editor's compact boxes by frame: ``[track_id, part
+    index, x, y, w, h, flags, occluded, revision]`` with flags 1 = failure, 2 = human (a keyframe)."""
+    if not len(boxes):
+        return {}
+    index = {p: i for i, p in enumerate(parts)}
+    flags = boxes["failure"].astype(bool).to_numpy().astype(int) + 2 * (boxes["source"] == "human").to_numpy()
+    rev = boxes["revision"].to_numpy() if "revision" in boxes else np.zeros(len(boxes), int)
+    cols = zip(boxes["frame"].to_numpy().tolist(), boxes["track_id"].to_numpy().tolist(),
+               boxes["part"].map(index).fillna(-1).astype(int).tolist(),
+               *(boxes[c].to_numpy(float).tolist() for c in ("x", "y", "w", "h")),  # exact: a move keeps the size
+               flags.tolist(), np.round(boxes["occluded"].to_numpy(float), 3).tolist(), rev.tolist())
+    out: dict[int, list[list]] = {}
+    for f, t, p, x, y, w, h, fl, o, r in cols:
+        out.setdefault(int(f), []).append([int(t), p, x, y, w, h, int(fl), o, int(r)])
     return out
 
 
@@ -83,6 +93,14 @@ def _new_events(raw, key: str) -> list[dict]:
     return events
 
 
+def _value(key: str) -> dict:
+    try:
+        value = st.session_state[key]
+    except (KeyError, AttributeError):
+        return {}
+    return value if isinstance(value, dict) or hasattr(value, "get") else {}
+
+
 def pending_events(key: str) -> list[dict]:
     """The editor's new events, read *before* it is drawn in this run.
 
@@ -90,33 +108,61 @@ def pending_events(key: str) -> list[dict]:
     start of the run it caused, so the page can apply them and draw the editor with
     the result at once, instead of drawing stale boxes and rerunning.
     """
-    try:
-        value = st.session_state[key]
-    except (KeyError, AttributeError):
-        return []
-    raw = value.get("events") if isinstance(value, dict) else None
-    return _new_events(raw, key)
+    return _new_events(_value(key).get("events"), key)
 
 
-def box_editor(image: np.ndarray, boxes: pd.DataFrame | list[dict], *, key: str, frame: int, frame_count: int,
-               tracks: list[int] | None = None, next_track_id: int = 1, parts: tuple[str, ...] = PART_NAMES,
-               mode: str = "boxes", width: int | str = "stretch") -> list[dict]:
+def view(key: str) -> dict:
+    """What the editor shows and asks for: ``{frame, lo, hi, blo, bhi, req}`` (frames
+    ``lo..hi-1`` and the boxes of ``blo..bhi-1`` to send), ``{}`` before its first report."""
+    v = _value(key).get("view")
+    return dict(v) if isinstance(v, dict) or hasattr(v, "get") else {}
+
+
+MAX_CHUNK = 48  # frames sent in one run at most (about 3 MB of JPEG at 768x576)
+
+
+def box_editor(*, key: str, width: int, height: int, frame_count: int, fps: float,
+               frame_url: Callable[[int], str], boxes_by_frame: dict[int, list[list]], version, jump: dict,
+               tracks: list[dict], next_track_id: int = 1, parts: tuple[str, ...] = PART_NAMES,
+               used_parts: list[str] | None = None, timeline: dict | None = None, mode: str = "boxes",
+               occluders: list[dict] | None = None, component_width: int | str = "stretch") -> list[dict]:
     """Show the editor and return the new events not yet taken by :func:`pending_events`.
 
-    ``boxes``: the frame's effective boxes (tracks CSV columns + ``revision``), or dicts
-    ``{x, y, w, h}`` for ``mode="occluders"``.
+    ``frame_url(i)``: frame ``i`` as a JPEG data URL; ``boxes_by_frame``: :func:`pack_boxes`
+    of the clip's effective boxes (of ``version``); ``jump``: ``{seq, frame}``, a new ``seq``
+    makes the editor show ``frame``; ``tracks``: ``[{id, colour, state}]``; ``timeline``:
+    ``{tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged}``.
     """
     if mode not in ("boxes", "occluders"):
         raise ValueError(f"mode must be 'boxes' or 'occluders', got {mode!r}")
-    if isinstance(boxes, pd.DataFrame):
-        payload = boxes_payload(boxes)
-    else:
-        payload = [dict(track_id=i, part="occluder", failure=False, occluded=0, revision=0, colour="#000",
-                        **{k: float(b[k]) for k in ("x", "y", "w", "h")}) for i, b in enumerate(boxes)]
+    v = view(key)
+    req, version = int(v.get("req", 0)), str(version)
+    served_key = f"{key}:served"
+    sent = st.session_state.get(served_key)
+    st.session_state[served_key] = (req, version)
+    lo, hi = int(v.get("lo", 0)), int(v.get("hi", 0))
+    blo, bhi = int(v.get("blo", 0)), int(v.get("bhi", 0))
+    if not v:  # before the editor's first request: the frame to show, a few after it and their boxes
+        lo = int(jump.get("frame", 0))
+        hi, blo, bhi = lo + 8, lo - 10, lo + 120
+    elif sent is not None and sent[0] == req:  # answered by an earlier run: no frames again
+        lo = hi = 0
+        if sent[1] == version:
+            blo = bhi = 0
+    if v and (sent is None or sent[1] != version):  # boxes changed: those around the shown frame again
+        f = int(v.get("frame", jump.get("frame", 0)))
+        blo, bhi = (min(blo, f - 10), max(bhi, f + 60)) if bhi > blo else (f - 10, f + 60)
+    lo, hi = max(0, lo), min(frame_count, hi, max(lo, 0) + MAX_CHUNK)
+    blo, bhi = max(0, blo), min(frame_count, bhi)
+    chunk = dict(req=req, lo=lo, frames=[frame_url(i) for i in range(lo, hi)], blo=blo, bhi=bhi,
+                 version=str(version),
+                 boxes={str(f): boxes_by_frame.get(f, []) for f in range(blo, bhi) if f in boxes_by_frame})
     done = int(st.session_state.get(applied_key(key), 0))
-    data = dict(image=encode_image(image), width=int(image.shape[1]), height=int(image.shape[0]), frame=int(frame),
-                frame_count=int(frame_count), boxes=payload, parts=list(parts),
-                tracks=sorted(int(t) for t in (tracks or [])), next_track_id=int(next_track_id), mode=mode,
-                applied_seq=done)
-    result = _component()(key=key, data=data, width=width, on_events_change=lambda: None)
+    data = dict(width=int(width), height=int(height), frame_count=int(frame_count), fps=float(fps),
+                parts=list(parts), used_parts=list(used_parts or parts), tracks=tracks,
+                colours={str(t["id"]): t["colour"] for t in tracks}, next_track_id=int(next_track_id), mode=mode,
+                applied_seq=done, version=str(version), jump=dict(jump), chunk=chunk, timeline=timeline or {},
+                occluders=occluders or [])
+    result = _component()(key=key, data=data, width=component_width, on_events_change=lambda: None,
+                          on_view_change=lambda: None)
     return _new_events(result.get("events"), key)

@@ -1,49 +1,78 @@
 // partlab box editor: a Streamlit components-v2 component (plain JS, no build).
 //
-// Python sends `data` = {image, width, height, frame, frame_count, boxes, parts, tracks,
-// next_track_id, mode, applied_seq}; boxes are {track_id, part, x, y, w, h, failure,
-// occluded, revision, colour}. Every user action becomes an event {seq, kind, ...};
-// pending events are sent together as the trigger value "events" until Python
-// reports them applied (data.applied_seq), so an action made while Python is busy
-// is never dropped. Text from the user or the data is only ever set through
-// textContent, never parsed as HTML.
+// The browser keeps a frame cache: Python sends JPEG frames and the boxes of frames in
+// chunks the editor asks for (the state value "view": {frame, lo, hi, blo, bhi, req}),
+// around the shown frame and ahead of it while playing, so stepping and playing never wait
+// for a Streamlit rerun. Python's data: {width, height, frame_count, fps, parts, tracks,
+// next_track_id, mode, applied_seq, version, jump: {seq, frame}, chunk: {req, lo, frames,
+// blo, bhi, boxes: {frame: [[track, part index, x, y, w, h, flags, occluded, revision]]}},
+// timeline: {tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged}}; flags: 1
+// failure, 2 human (a keyframe). `version` changes whenever stored boxes change; cached
+// boxes of another version are asked for again. Every user action becomes an event {seq,
+// kind, ...} sent as the trigger value "events" until Python reports it applied
+// (applied_seq). Text from the user or the data is only ever set through textContent.
 
 const SVG_NS = "http://www.w3.org/2000/svg";
-const HANDLE_PX = 4; // handle half-size in screen pixels (small: heads can be 10 px wide)
-const MIN_SIZE = 3;  // smallest box side in image pixels
+const HANDLE_PX = 5;   // handle half-size in screen pixels, whatever the zoom
+const GRAB_PX = 9;     // grab distance of a handle in screen pixels
+const MIN_SIZE = 2;    // smallest box side in image pixels
+const BEHIND = 10, AHEAD = 40, PLAY_AHEAD = 80, CHUNK = 24, BOX_WINDOW = 120;
+const DECODE_BEHIND = 15, DECODE_AHEAD = 60; // decoded frames kept: 75 x 1.7 MB at 768x576
 const INSTANCES = new WeakMap();
+const SHORT = { hipleg: "hip-leg", left_hand: "L hand", right_hand: "R hand" };
 
 function el(name, attrs) {
   const node = document.createElementNS(SVG_NS, name);
   for (const [k, v] of Object.entries(attrs || {})) node.setAttribute(k, String(v));
   return node;
 }
-
 function keyOf(b) { return b.track_id + ":" + b.part; }
-
-// the store keeps the occluded fraction (trackers estimate it); the flag is "at least half hidden"
 function isOccluded(b) { return Number(b.occluded || 0) >= 0.5; }
-
-const SHORT = { hipleg: "hip-leg", left_hand: "L hand", right_hand: "R hand" };
 
 class Editor {
   constructor(root) {
-    this.root = root.querySelector(".pl-editor");
-    this.img = root.querySelector(".pl-image");
-    this.stage = root.querySelector(".pl-stage");
-    this.svg = root.querySelector(".pl-overlay");
-    this.frameLabel = root.querySelector(".pl-frame");
-    this.status = root.querySelector(".pl-status");
-    this.addPart = root.querySelector(".pl-add-part");
-    this.addTrack = root.querySelector(".pl-add-track");
+    const q = (s) => root.querySelector(s);
+    this.root = q(".pl-editor");
+    this.viewport = q(".pl-viewport");
+    this.stage = q(".pl-stage");
+    this.canvas = q(".pl-image");
+    this.svg = q(".pl-overlay");
+    this.loading = q(".pl-loading");
+    this.frameLabel = q(".pl-frame");
+    this.zoomLabel = q(".pl-zoom");
+    this.status = q(".pl-status");
+    this.addPart = q(".pl-add-part");
+    this.addTrack = q(".pl-add-track");
+    this.speed = q(".pl-speed");
+    this.timeline = q(".pl-timeline");
+    this.partsBox = q(".pl-parts");
+    this.tracksBox = q(".pl-tracks");
     this.data = null;
-    this.viewFrame = 0;
-    this.boxes = [];
-    this.selected = null;   // "track:part" of the selected box
-    this.pending = [];      // events not yet applied by Python
+    this.frames = new Map();   // frame -> decoded image (ImageBitmap or HTMLImageElement)
+    this.boxes = new Map();    // frame -> box list of `this.version`
+    this.version = null;
+    this.cur = 0;              // the frame shown
+    this.shown = [];           // its boxes (the same objects as in this.boxes)
+    this.selected = null;
+    this.hover = null;
+    this.hiddenTracks = new Set();
+    this.hiddenParts = new Set();
+    this.labelsAll = false;
+    this.drawMode = false;
+    this.fill = true;
+    this.pending = [];
     this.seq = 0;
+    this.req = 0;
+    this.inflight = null;      // {req, lo, hi, blo, bhi, t}
+    this.jumpSeq = null;
     this.drag = null;
+    this.pan = null;
+    this.zoom = 1; this.ox = 0; this.oy = 0; this.fitted = false;
+    this.playing = false;
+    this.stats = { steps: [], shown: [], played: 0, playStart: 0, playMs: 0, stalls: 0, keyAt: null, ready: -1 };
     this.setTrigger = null;
+    this.setState = null;
+    this.syncTimer = null;
     this.bind();
   }
 
@@ -51,29 +80,93 @@ class Editor {
   update(data) {
     const first = this.data === null;
     this.data = data || {};
-    const applied = Number(this.data.applied_seq || 0);
+    const d = this.data;
+    const applied = Number(d.applied_seq || 0);
     this.seq = Math.max(this.seq, applied);
     this.pending = this.pending.filter((e) => e.seq > applied);
-    // the frame being asked for: the newest frame request Python has not answered yet, else Python's frame
-    const asked = this.pending.filter((e) => e.kind === "frame");
-    this.viewFrame = asked.length ? asked[asked.length - 1].target : this.data.frame;
-    if (this.img.getAttribute("src") !== this.data.image) this.img.setAttribute("src", this.data.image || "");
-    this.svg.setAttribute("viewBox", `0 0 ${this.data.width || 1} ${this.data.height || 1}`);
-    this.boxes = (this.data.boxes || []).map((b) => ({ ...b }));
-    if (this.selected && !this.boxes.some((b) => keyOf(b) === this.selected)) this.selected = null;
-    this.fillSelect(this.addPart, (this.data.parts || []).map((p) => [p, p]), this.addPart.value);
-    const tracks = (this.data.tracks || []).map((t) => [String(t), "#" + t]);
-    tracks.push(["new", `new (#${this.data.next_track_id})`]);
+    if (d.version !== this.version) { this.version = d.version; this.boxes.clear(); }
+    this.merge(d.chunk);
+    const partNames = d.parts || [];
+    this.fillSelect(this.addPart, partNames.map((p) => [p, p]), this.addPart.value);
+    const tracks = (d.tracks || []).map((t) => [String(t.id), "#" + t.id]);
+    tracks.push(["new", `new #${d.next_track_id}`]);
     this.fillSelect(this.addTrack, tracks, this.addTrack.value || "new");
-    const occl = this.data.mode === "occluders";
-    this.root.querySelector(".pl-add").style.display = occl ? "none" : "";
-    for (const act of ["track", "failure", "occluded", "undo", "redo"]) {
+    const fps = Math.round(d.fps || 10);
+    const speeds = [...new Set([fps, 15, 25, 30])].sort((a, b) => a - b).map((v) => [String(v), `${v} fps`]);
+    this.fillSelect(this.speed, speeds, this.speed.value || String(fps));
+    const occl = d.mode === "occluders";
+    for (const sel of [".pl-add", ".pl-legend", ".pl-timeline"]) this.root.querySelector(sel).style.display = occl ? "none" : "";
+    for (const act of ["track", "failure", "occluded", "undo", "redo", "flag", "keyframe", "fill", "labels"]) {
       this.root.querySelector(`[data-act="${act}"]`).style.display = occl ? "none" : "";
     }
-    this.showFrameLabel();
-    if (first) this.setStatus(occl ? "draw occluder regions; drag to move, Delete removes" :
-      "click a box to select it; drag to move, corners to resize, empty area to draw a new box");
-    this.render();
+    this.legend();
+    if (first) {
+      this.setStatus(occl ? "draw occluder regions; drag to move, Delete removes" :
+        "click a box to select it; drag to move, corners to resize; B or Shift+drag draws a new box; wheel zooms, right-drag pans");
+      this.layout();
+    }
+    const jump = d.jump || { seq: 0, frame: 0 };
+    if (jump.seq !== this.jumpSeq) { this.jumpSeq = jump.seq; this.show(jump.frame, false); }
+    else this.show(this.cur, false);
+    this.buttons();
+  }
+
+  merge(chunk) {
+    if (!chunk) return;
+    if (this.inflight && chunk.req >= this.inflight.req) this.inflight = null;
+    (chunk.frames || []).forEach((url, i) => {
+      const f = chunk.lo + i;
+      if (url && !this.frames.has(f)) this.frames.set(f, { url, bmp: null, decoding: false });
+    });
+    this.decodeAround();
+    if (chunk.version === this.version) {
+      for (const [f, rows] of Object.entries(chunk.boxes || {})) {
+        if (!this.boxes.has(Number(f)) || !this.dirty(Number(f))) this.boxes.set(Number(f), rows.map((r) => this.unpack(r)));
+      }
+      for (let f = chunk.blo; f < chunk.bhi; f++) if (!this.boxes.has(f)) this.boxes.set(f, []);
+    }
+    // JPEGs are kept for 1500 frames (about 150 MB at 768x576), the farthest go first
+    if (this.frames.size > 1500) {
+      const far = [...this.frames.keys()].sort((a, b) => Math.abs(b - this.cur) - Math.abs(a - this.cur));
+      for (const f of far.slice(0, this.frames.size - 1200)) { const e = this.frames.get(f); if (e.bmp) e.bmp.close(); this.frames.delete(f); }
+    }
+  }
+
+  // decoded bitmaps (drawn in a millisecond; decoding a JPEG on the main thread costs far more)
+  // are kept for the frames near the shown one and decoded off the main thread
+  decodeAround() {
+    const lo = this.cur - DECODE_BEHIND, hi = this.cur + DECODE_AHEAD;
+    for (const [f, e] of this.frames) {
+      if ((f < lo || f >= hi) && e.bmp) { e.bmp.close(); e.bmp = null; }
+    }
+    let started = 0;
+    for (let f = this.cur; f < hi && started < 8; f++) started += this.decode(f);
+    for (let f = this.cur - 1; f >= lo && started < 8; f--) started += this.decode(f);
+  }
+
+  decode(f) {
+    const e = this.frames.get(f);
+    if (!e || e.bmp || e.decoding) return 0;
+    e.decoding = true;
+    fetch(e.url).then((r) => r.blob()).then((b) => createImageBitmap(b)).then((bmp) => {
+      e.decoding = false;
+      if (this.frames.get(f) !== e || f < this.cur - DECODE_BEHIND || f >= this.cur + DECODE_AHEAD) { bmp.close(); return; }
+      e.bmp = bmp;
+      if (f === this.cur) this.draw();
+      this.decodeAround();
+    }, () => { e.decoding = false; });
+    return 1;
+  }
+
+  ready(f) { const e = this.frames.get(f); return !!(e && e.bmp); }
+
+  dirty(f) { return this.pending.some((e) => e.frame === f && (e.kind === "edit" || e.kind === "delete")); }
+
+  unpack(r) {
+    const parts = this.data.parts || [];
+    const colour = (this.data.colours || {})[r[0]] || "#4e79a7";
+    return { track_id: r[0], part: parts[r[1]] || String(r[1]), x: r[2], y: r[3], w: r[4], h: r[5],
+      failure: !!(r[6] & 1), human: !!(r[6] & 2), occluded: r[7], revision: r[8], colour };
   }
 
   fillSelect(select, options, keep) {
@@ -91,57 +184,216 @@ class Editor {
     if (keep && options.some(([v]) => v === keep)) select.value = keep;
   }
 
-  // ------------------------------------------------------------ drawing
-  layout() {
-    // the whole frame fits the column and 72% of the window height, small frames are scaled up
-    const W = this.data.width || 1, H = this.data.height || 1;
-    const cw = this.root.clientWidth || W;
-    let w = cw, h = (cw * H) / W;
-    const maxH = Math.max(200, window.innerHeight * 0.72);
-    if (h > maxH) { h = maxH; w = (h * W) / H; }
-    this.stage.style.width = `${w}px`;
-    this.stage.style.height = `${h}px`;
+  // ------------------------------------------------------------ the frame cache
+  show(f, user) {
+    const last = Math.max(0, (this.data.frame_count || 1) - 1);
+    f = Math.min(Math.max(Number(f) || 0, 0), last);
+    const changed = f !== this.cur;
+    this.cur = f;
+    if (changed && this.selected) {
+      // keep the selection on the same track and part when it exists in the new frame
+      const still = (this.boxes.get(f) || []).some((b) => keyOf(b) === this.selected);
+      if (!still) this.selected = null;
+    }
+    if (changed) this.drawn = null;
+    this.draw();
+    this.decodeAround();
+    this.ensure();
+    if (user) this.scheduleSync();
   }
 
-  render() {
+  draw() {
     if (!this.data) return;
-    this.layout();
-    const svg = this.svg;
-    while (svg.firstChild) svg.removeChild(svg.firstChild);
-    const font = 11 * this.scale(); // 11 screen pixels, whatever the zoom
-    const occl = this.data.mode === "occluders";
-    for (const b of this.boxes) {
-      const sel = keyOf(b) === this.selected;
-      const cls = occl ? "pl-occluder" : ["pl-box", b.failure ? "pl-failure" : "", isOccluded(b) ? "pl-occluded" : "",
-        sel ? "pl-selected" : ""].join(" ");
-      const rect = el("rect", { x: b.x, y: b.y, width: b.w, height: b.h, class: cls,
-        "data-track": b.track_id, "data-part": b.part });
-      if (!occl) { rect.setAttribute("stroke", b.colour || "#0f0"); rect.setAttribute("fill", b.colour || "#0f0"); }
-      if (sel && occl) rect.setAttribute("stroke", "#ff0");
-      svg.appendChild(rect);
-      if (!occl) {
-        // the person's label above its box, a part's inside its top-left corner (parts sit inside the person)
-        const above = b.part === "person";
-        const ly = above ? Math.max(font, b.y - font * 0.3) : b.y + font;
-        const label = el("text", { x: b.x + font * 0.2, y: ly, class: "pl-label", "font-size": font,
-          "stroke-width": font * 0.18 });
-        const flags = `${b.failure ? " FAIL" : ""}${isOccluded(b) ? " occl" : ""}`;
-        label.textContent = above ? `#${b.track_id} person${flags}` : `${SHORT[b.part] || b.part}${flags}`;
-        svg.appendChild(label);
-      }
-      if (sel) this.drawHandles(b);
+    const ready = this.ready(this.cur);
+    if (ready && this.drawn !== this.cur) {
+      this.canvas.getContext("2d").drawImage(this.frames.get(this.cur).bmp, 0, 0, this.canvas.width, this.canvas.height);
+      this.drawn = this.cur;
+    }
+    this.shown = this.boxes.get(this.cur) || [];
+    const haveBoxes = this.boxes.has(this.cur) || this.data.mode === "occluders";
+    if (this.data.mode === "occluders") this.shown = this.occluderBoxes();
+    this.loading.textContent = ready ? (haveBoxes ? "" : "loading boxes...") : `loading frame ${this.cur}...`;
+    this.stats.ready = ready && haveBoxes ? this.cur : -1;
+    this.showFrameLabel();
+    this.render();
+    this.drawTimeline();
+    if (ready && haveBoxes && this.stats.keyAt) {
+      // key press to the frame on screen: measured at the animation frame after the one that paints it
+      const t0 = this.stats.keyAt, f = this.cur;
+      this.stats.keyAt = null;
+      requestAnimationFrame(() => requestAnimationFrame(() => {
+        const ms = performance.now() - t0;
+        this.stats.shown.push([f, ms]);
+      }));
     }
   }
 
-  scale() {
-    const r = this.svg.getBoundingClientRect();
-    return r.width > 0 ? (this.data.width || 1) / r.width : 1;
+  occluderBoxes() {
+    if (!this.occl) this.occl = (this.data.occluders || []).map((b, i) => ({ ...b, track_id: i, part: "occluder" }));
+    return this.occl;
+  }
+
+  // which frames and boxes to ask Python for next
+  ensure() {
+    if (!this.data || !this.setState) return;
+    const n = this.data.frame_count || 0;
+    const ahead = this.playing ? PLAY_AHEAD : AHEAD;
+    const lo = Math.max(0, this.cur - BEHIND), hi = Math.min(n, this.cur + ahead);
+    let first = -1;
+    for (let f = this.cur; f < hi && first < 0; f++) if (!this.frames.has(f)) first = f;
+    for (let f = this.cur - 1; f >= lo && first < 0; f--) if (!this.frames.has(f)) first = f;
+    let bfirst = -1;
+    for (let f = this.cur; f < hi && bfirst < 0; f++) if (!this.boxes.has(f)) bfirst = f;
+    for (let f = this.cur - 1; f >= lo && bfirst < 0; f--) if (!this.boxes.has(f)) bfirst = f;
+    if (first < 0 && bfirst < 0) return;
+    const now = performance.now();
+    if (this.inflight && now - this.inflight.t < 2500) {
+      const i = this.inflight;
+      const coveredF = first < 0 || (first >= i.lo && first < i.hi);
+      const coveredB = bfirst < 0 || (bfirst >= i.blo && bfirst < i.bhi);
+      if (coveredF && coveredB) return;
+    }
+    let flo = 0, fhi = 0;
+    if (first >= 0) {
+      flo = first;
+      fhi = flo;
+      while (fhi < n && fhi - flo < CHUNK && !this.frames.has(fhi)) fhi++;
+    }
+    let blo = 0, bhi = 0;
+    if (bfirst >= 0) { blo = Math.max(0, Math.min(bfirst, this.cur - BEHIND)); bhi = Math.min(n, blo + BOX_WINDOW); }
+    this.inflight = { req: ++this.req, lo: flo, hi: fhi, blo, bhi, t: now };
+    this.setState("view", { frame: this.cur, lo: flo, hi: fhi, blo, bhi, req: this.req });
+  }
+
+  scheduleSync() {
+    // Python learns the shown frame once stepping pauses (no rerun per step)
+    clearTimeout(this.syncTimer);
+    this.syncTimer = setTimeout(() => {
+      if (this.playing || !this.setState) return;
+      const i = this.inflight || { lo: 0, hi: 0, blo: 0, bhi: 0 };
+      this.setState("view", { frame: this.cur, lo: i.lo, hi: i.hi, blo: i.blo, bhi: i.bhi, req: this.inflight ? this.inflight.req : this.req });
+    }, 400);
+  }
+
+  step(delta, user = true) {
+    const t0 = performance.now();
+    this.show(this.cur + delta, user);
+    this.stats.steps.push(performance.now() - t0);
+  }
+
+  // ------------------------------------------------------------ play
+  togglePlay() {
+    this.playing = !this.playing;
+    this.buttons();
+    if (!this.playing) { this.scheduleSync(); return; }
+    const fps = Number(this.speed.value) || this.data.fps || 10;
+    const interval = 1000 / fps;
+    let next = performance.now() + interval;
+    this.stats.played = 0; this.stats.stalls = 0; this.stats.playStart = performance.now();
+    const tick = (now) => {
+      if (!this.playing) return;
+      if (now >= next - 1) {
+        const last = (this.data.frame_count || 1) - 1;
+        if (this.cur >= last) { this.playing = false; this.buttons(); this.scheduleSync(); return; }
+        if (this.ready(this.cur + 1) && this.boxes.has(this.cur + 1)) {
+          this.show(this.cur + 1, false);
+          this.stats.played++;
+          this.stats.playMs = performance.now() - this.stats.playStart;
+          next = Math.max(next + interval, now - interval);
+        } else { this.stats.stalls++; this.ensure(); }
+      }
+      requestAnimationFrame(tick);
+    };
+    this.ensure();
+    requestAnimationFrame(tick);
+  }
+
+  // ------------------------------------------------------------ zoom and pan
+  layout() {
+    const W = this.data.width || 1, H = this.data.height || 1;
+    if (this.canvas.width !== W || this.canvas.height !== H) { this.canvas.width = W; this.canvas.height = H; this.drawn = null; }
+    this.svg.setAttribute("viewBox", `0 0 ${W} ${H}`);
+    const cw = Math.max(200, this.viewport.clientWidth || this.root.clientWidth - 160);
+    // the whole frame above the fold: the viewport ends ~110 px (timeline, status) above the window's bottom
+    const top = this.viewport.getBoundingClientRect().top + window.scrollY;
+    const room = Math.max(220, window.innerHeight - top - 110);
+    const vh = Math.min(room, (cw * H) / W);
+    this.viewport.style.height = `${Math.round(vh)}px`;
+    this.vw = cw; this.vh = vh;
+    if (!this.fitted) this.fit();
+    this.applyView();
+  }
+
+  fit() {
+    const W = this.data.width || 1, H = this.data.height || 1;
+    this.zoom = Math.min(this.vw / W, this.vh / H);
+    this.ox = (this.vw - W * this.zoom) / 2; this.oy = (this.vh - H * this.zoom) / 2;
+    this.fitted = true;
+    this.applyView();
+  }
+
+  zoomAt(factor, sx, sy) {
+    const z = Math.min(Math.max(this.zoom * factor, 0.1), 32);
+    // keep the image point under (sx, sy) where it is
+    const ix = (sx - this.ox) / this.zoom, iy = (sy - this.oy) / this.zoom;
+    this.zoom = z;
+    this.ox = sx - ix * z; this.oy = sy - iy * z;
+    this.applyView();
+  }
+
+  applyView() {
+    const W = this.data.width || 1, H = this.data.height || 1;
+    this.stage.style.width = `${W * this.zoom}px`;
+    this.stage.style.height = `${H * this.zoom}px`;
+    this.stage.style.transform = `translate(${this.ox}px, ${this.oy}px)`;
+    this.zoomLabel.textContent = `${(this.zoom * 100).toFixed(0)}%`;
+    this.render();
+  }
+
+  // ------------------------------------------------------------ drawing
+  visible(b) { return !this.hiddenTracks.has(b.track_id) && !this.hiddenParts.has(b.part); }
+
+  render() {
+    if (!this.data) return;
+    const svg = this.svg;
+    while (svg.firstChild) svg.removeChild(svg.firstChild);
+    const u = 1 / this.zoom; // image pixels per screen pixel
+    const font = 11 * u;
+    const occl = this.data.mode === "occluders";
+    let sel = null;
+    for (const b of this.shown) {
+      if (!occl && !this.visible(b)) continue;
+      const isSel = keyOf(b) === this.selected;
+      if (isSel) sel = b;
+      const cls = occl ? "pl-occluder" : ["pl-box", b.failure ? "pl-failure" : "", isOccluded(b) ? "pl-occluded" : "",
+        b.human ? "pl-keyframe" : "", isSel ? "pl-selected" : ""].join(" ");
+      const rect = el("rect", { x: b.x, y: b.y, width: b.w, height: b.h, class: cls,
+        "data-track": b.track_id, "data-part": b.part });
+      if (!occl) { rect.setAttribute("stroke", b.colour); rect.setAttribute("fill", b.colour); }
+      if (isSel && occl) rect.setAttribute("stroke", "#ff0");
+      svg.appendChild(rect);
+    }
+    if (!occl) {
+      // labels: on every box with "labels: all", else on the hovered and the selected box only, above the box
+      for (const b of this.shown) {
+        if (!this.visible(b)) continue;
+        const k = keyOf(b);
+        if (!this.labelsAll && k !== this.selected && k !== this.hover) continue;
+        const flags = `${b.failure ? " FAIL" : ""}${isOccluded(b) ? " occl" : ""}${b.human ? " key" : ""}`;
+        const label = el("text", { x: b.x, y: Math.max(font, b.y - 2 * u), class: "pl-label", "font-size": font,
+          "stroke-width": font * 0.2, "data-label": k });
+        label.textContent = `#${b.track_id} ${SHORT[b.part] || b.part}${flags}`;
+        svg.appendChild(label);
+      }
+    }
+    if (sel) this.drawHandles(sel);
   }
 
   drawHandles(b) {
-    const s = HANDLE_PX * this.scale();
+    const s = HANDLE_PX / this.zoom;
     for (const [name, x, y] of this.corners(b)) {
-      this.svg.appendChild(el("rect", { x: x - s, y: y - s, width: 2 * s, height: 2 * s, class: `pl-handle pl-${name}` }));
+      this.svg.appendChild(el("rect", { x: x - s, y: y - s, width: 2 * s, height: 2 * s, class: `pl-handle pl-${name}`,
+        "data-handle": name }));
     }
   }
 
@@ -149,53 +401,136 @@ class Editor {
     return [["nw", b.x, b.y], ["ne", b.x + b.w, b.y], ["sw", b.x, b.y + b.h], ["se", b.x + b.w, b.y + b.h]];
   }
 
+  legend() {
+    const d = this.data;
+    const sig = JSON.stringify([(d.tracks || []).map((t) => t.id), d.parts]);
+    if (this.legendSig === sig) return;
+    this.legendSig = sig;
+    const row = (box, text, colour, checked, onChange, attr) => {
+      const label = document.createElement("label");
+      const cb = document.createElement("input");
+      cb.type = "checkbox"; cb.checked = checked;
+      cb.setAttribute(attr[0], attr[1]);
+      cb.addEventListener("change", () => { onChange(cb.checked); this.tlSig = null; this.render(); this.drawTimeline(); });
+      label.appendChild(cb);
+      if (colour) { const sw = document.createElement("span"); sw.className = "pl-swatch"; sw.style.background = colour; label.appendChild(sw); }
+      const t = document.createElement("span"); t.textContent = text; label.appendChild(t);
+      box.appendChild(label);
+    };
+    for (const box of [this.partsBox, this.tracksBox]) while (box.firstChild) box.removeChild(box.firstChild);
+    for (const p of (d.parts || []).filter((p) => (d.used_parts || d.parts).includes(p))) {
+      row(this.partsBox, SHORT[p] || p, null, !this.hiddenParts.has(p),
+        (on) => (on ? this.hiddenParts.delete(p) : this.hiddenParts.add(p)), ["data-part-toggle", p]);
+    }
+    for (const t of d.tracks || []) {
+      row(this.tracksBox, `#${t.id}${t.state ? " " + t.state : ""}`, t.colour, !this.hiddenTracks.has(t.id),
+        (on) => (on ? this.hiddenTracks.delete(t.id) : this.hiddenTracks.add(t.id)), ["data-track-toggle", String(t.id)]);
+    }
+  }
+
+  drawTimeline() {
+    // the tracks' rows are drawn once per data / visibility change into a layer; a frame step only
+    // copies the layer and draws the cursor
+    const tl = (this.data.timeline || {});
+    const tracks = (tl.tracks || []).filter((t) => !this.hiddenTracks.has(t.id));
+    const c = this.timeline;
+    const rowH = 7, top = 10, labelW = 34;
+    const h = top + Math.max(1, tracks.length) * rowH + 2;
+    const w = Math.max(100, c.clientWidth || 600);
+    const n = Math.max(1, this.data.frame_count || 1);
+    const X = (f) => labelW + (f / n) * (w - labelW);
+    const sig = `${w}:${h}:${this.version}:${[...this.hiddenTracks].join(",")}:${JSON.stringify(tl.flagged || []).length}`;
+    if (this.tlSig !== sig) {
+      this.tlSig = sig;
+      if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
+      const layer = this.tlLayer || (this.tlLayer = document.createElement("canvas"));
+      layer.width = w; layer.height = h;
+      const ctx = layer.getContext("2d");
+      ctx.clearRect(0, 0, w, h);
+      ctx.fillStyle = "#e15759"; // flagged frames on the top strip
+      for (const f of tl.flagged || []) ctx.fillRect(X(f), 0, Math.max(1, (w - labelW) / n), 4);
+      ctx.font = "9px sans-serif";
+      tracks.forEach((t, i) => {
+        const y = top + i * rowH;
+        ctx.fillStyle = "#888"; ctx.fillText(`#${t.id}`, 0, y + rowH - 1);
+        ctx.globalAlpha = 0.75; ctx.fillStyle = t.colour;
+        for (const [a, b] of t.spans || []) ctx.fillRect(X(a), y + 1, Math.max(1, X(b + 1) - X(a)), rowH - 2);
+        ctx.globalAlpha = 1;
+        ctx.fillStyle = "#2ca02c"; for (const [a, b] of t.acc || []) ctx.fillRect(X(a), y + rowH - 2, X(b + 1) - X(a), 2);
+        ctx.fillStyle = "#d62728"; for (const [a, b] of t.rej || []) ctx.fillRect(X(a), y + rowH - 2, X(b + 1) - X(a), 2);
+        ctx.fillStyle = "#000"; for (const f of t.fails || []) ctx.fillRect(X(f), y + 1, 1, rowH - 2);
+        ctx.fillStyle = "#fff"; for (const f of t.keys || []) ctx.fillRect(X(f) - 1, y, 2, rowH);
+      });
+    }
+    const ctx = c.getContext("2d");
+    ctx.clearRect(0, 0, c.width, c.height);
+    ctx.drawImage(this.tlLayer, 0, 0);
+    ctx.fillStyle = "#ff4b4b";
+    ctx.fillRect(X(this.cur) - 1, 0, 2, h);
+    this.tlGeom = { labelW, w, n, top, rowH, tracks };
+  }
+
   setStatus(text) { this.status.textContent = text; }
 
   showFrameLabel() {
     const last = Math.max(0, (this.data.frame_count || 1) - 1);
-    const wait = this.viewFrame !== this.data.frame ? ` (loading ${this.viewFrame})` : "";
-    this.frameLabel.textContent = `frame ${this.data.frame} / ${last}${wait}`;
+    this.frameLabel.textContent = `frame ${this.cur} / ${last}`;
+  }
+
+  buttons() {
+    const on = (act, v) => this.root.querySelector(`[data-act="${act}"]`).classList.toggle("pl-on", !!v);
+    on("play", this.playing); on("draw", this.drawMode); on("fill", this.fill);
+    this.root.querySelector('[data-act="play"]').textContent = this.playing ? "pause" : "play";
+    this.root.querySelector('[data-act="labels"]').textContent = this.labelsAll ? "labels: all" : "labels: hover";
+    this.root.classList.toggle("pl-drawing", this.drawMode);
   }
 
   // ------------------------------------------------------------ events out
   emit(event) {
     event.seq = ++this.seq;
-    event.frame = this.data.frame;
+    if (event.frame === undefined) event.frame = this.cur;
     this.pending.push(event);
     if (this.setTrigger) this.setTrigger("events", this.pending.slice());
   }
 
   emitBox(b, extra) {
     this.emit({ kind: "edit", track_id: b.track_id, part: b.part, box: [b.x, b.y, b.w, b.h],
-      failure: !!b.failure, occluded: Number(b.occluded || 0), revision: b.revision ?? null, ...extra });
+      failure: !!b.failure, occluded: Number(b.occluded || 0), revision: b.revision ?? null, fill: this.fill, ...extra });
     b.revision = (b.revision ?? 0) + 1; // optimistic: the next edit of this box expects our revision
+    b.human = true;
   }
 
   emitOccluders() {
-    this.emit({ kind: "occluders", boxes: this.boxes.map((b) => [b.x, b.y, b.w, b.h]) });
+    this.emit({ kind: "occluders", boxes: this.shown.map((b) => [b.x, b.y, b.w, b.h]) });
   }
 
-  selectedBox() { return this.boxes.find((b) => keyOf(b) === this.selected) || null; }
+  selectedBox() { return this.shown.find((b) => keyOf(b) === this.selected) || null; }
 
   // ------------------------------------------------------------ actions
-  act(name) {
+  act(name, shift) {
     const occl = this.data.mode === "occluders";
     const b = this.selectedBox();
-    if (name === "prev" || name === "next") {
-      // repeated presses step on from the frame asked for last, not the one still shown
-      const f = this.viewFrame + (name === "next" ? 1 : -1);
-      if (f >= 0 && f < (this.data.frame_count || 0)) {
-        this.viewFrame = f;
-        this.emit({ kind: "frame", target: f });
-        this.showFrameLabel();
-      }
-    } else if (name === "track") {
-      this.nextTrack();
-    } else if (name === "undo" || name === "redo") {
-      if (!occl) this.emit({ kind: name });
+    if (name === "prev" || name === "next") this.step(name === "next" ? 1 : -1);
+    else if (name === "play") this.togglePlay();
+    else if (name === "track") this.nextTrack();
+    else if (name === "undo" || name === "redo") { if (!occl) this.emit({ kind: name }); }
+    else if (name === "fit") this.fit();
+    else if (name === "one") this.zoomAt(1 / this.zoom, this.vw / 2, this.vh / 2);
+    else if (name === "zoomin") this.zoomAt(1.5, this.vw / 2, this.vh / 2);
+    else if (name === "zoomout") this.zoomAt(1 / 1.5, this.vw / 2, this.vh / 2);
+    else if (name === "labels") { this.labelsAll = !this.labelsAll; this.buttons(); this.render(); }
+    else if (name === "draw") { this.drawMode = !this.drawMode; this.buttons(); }
+    else if (name === "fill") { this.fill = !this.fill; this.buttons(); this.setStatus(`track mode ${this.fill ? "on" : "off"}`); }
+    else if (name === "flag") this.jumpTo((this.data.timeline || {}).flagged || [], shift, "flagged frame");
+    else if (name === "keyframe") {
+      const tid = b ? b.track_id : null;
+      const t = ((this.data.timeline || {}).tracks || []).find((x) => x.id === tid);
+      if (!t) return this.setStatus("select a box first: K goes to that track's next keyframe");
+      this.jumpTo(t.keys || [], shift, `keyframe of #${tid}`);
     } else if (name === "delete") {
       if (!b) return this.setStatus("select a box first");
-      this.boxes = this.boxes.filter((x) => x !== b);
+      const list = this.shown;
+      list.splice(list.indexOf(b), 1);
       this.selected = null;
       if (occl) this.emitOccluders();
       else this.emit({ kind: "delete", track_id: b.track_id, part: b.part, revision: b.revision ?? null });
@@ -205,16 +540,24 @@ class Editor {
       if (!b) return this.setStatus("select a box first");
       if (name === "failure") b.failure = !b.failure;
       else b.occluded = isOccluded(b) ? 0 : 1;
-      this.emitBox(b);
+      this.emitBox(b, { fill: false });
       const on = name === "failure" ? b.failure : isOccluded(b);
       this.setStatus(`#${b.track_id} ${b.part}: ${name} ${on ? "on" : "off"}`);
       this.render();
     }
   }
 
+  jumpTo(frames, back, what) {
+    const f = back ? [...frames].reverse().find((x) => x < this.cur) : frames.find((x) => x > this.cur);
+    if (f === undefined) return this.setStatus(`no ${what} ${back ? "before" : "after"} this frame`);
+    this.show(f, true);
+    this.setStatus(`${what}: frame ${f}`);
+  }
+
   nextTrack() {
-    if (!this.boxes.length) return;
-    const order = this.boxes.slice().sort((a, b) => a.track_id - b.track_id || a.part.localeCompare(b.part));
+    const list = this.shown.filter((b) => this.visible(b));
+    if (!list.length) return;
+    const order = list.slice().sort((a, b) => a.track_id - b.track_id || a.part.localeCompare(b.part));
     const cur = this.selectedBox();
     let next;
     if (!cur) next = order[0];
@@ -230,29 +573,35 @@ class Editor {
 
   // ------------------------------------------------------------ pointer
   point(ev) {
-    const r = this.svg.getBoundingClientRect();
-    return [(ev.clientX - r.left) * (this.data.width || 1) / r.width,
-      (ev.clientY - r.top) * (this.data.height || 1) / r.height];
+    const r = this.viewport.getBoundingClientRect();
+    return [(ev.clientX - r.left - this.ox) / this.zoom, (ev.clientY - r.top - this.oy) / this.zoom];
   }
 
   hit(p) {
     const sel = this.selectedBox();
-    const s = HANDLE_PX * this.scale() * 2; // a grab area larger than the drawn handle
-    if (sel) {
+    const s = GRAB_PX / this.zoom;
+    if (sel && this.visible(sel)) {
       for (const [name, x, y] of this.corners(sel)) {
         if (Math.abs(p[0] - x) <= s && Math.abs(p[1] - y) <= s) return { box: sel, handle: name };
       }
     }
-    const inside = this.boxes.filter((b) => p[0] >= b.x && p[0] <= b.x + b.w && p[1] >= b.y && p[1] <= b.y + b.h);
+    const inside = this.shown.filter((b) => this.visible(b) && p[0] >= b.x && p[0] <= b.x + b.w && p[1] >= b.y && p[1] <= b.y + b.h);
     inside.sort((a, b) => a.w * a.h - b.w * b.h); // the smallest box on top: parts inside the person
     return inside.length ? { box: inside[0], handle: null } : null;
   }
 
   onDown(ev) {
-    if (ev.button !== 0) return;
     this.root.focus({ preventScroll: true });
+    if (ev.button === 1 || ev.button === 2 || (ev.button === 0 && this.spaceDown)) {
+      this.pan = { x: ev.clientX, y: ev.clientY, ox: this.ox, oy: this.oy };
+      this.svg.setPointerCapture(ev.pointerId);
+      ev.preventDefault();
+      return;
+    }
+    if (ev.button !== 0) return;
     const p = this.point(ev);
-    const h = this.hit(p);
+    const drawing = this.drawMode || ev.shiftKey;
+    const h = drawing ? null : this.hit(p);
     if (h) {
       this.selected = keyOf(h.box);
       this.drag = { box: h.box, handle: h.handle, start: p, orig: { x: h.box.x, y: h.box.y, w: h.box.w, h: h.box.h } };
@@ -260,15 +609,16 @@ class Editor {
       const occl = this.data.mode === "occluders";
       const part = occl ? "occluder" : this.addPart.value;
       const trackValue = this.addTrack.value;
-      const track = occl ? this.boxes.length : (trackValue === "new" ? this.data.next_track_id : Number(trackValue));
-      if (!occl && this.boxes.some((b) => b.track_id === track && b.part === part)) {
+      const track = occl ? this.shown.length : (trackValue === "new" ? this.data.next_track_id : Number(trackValue));
+      if (!occl && this.shown.some((b) => b.track_id === track && b.part === part)) {
         this.selected = null;
         this.setStatus(`track #${track} already has a ${part} box here; choose another part or track`);
         this.render();
         return;
       }
+      const colour = (this.data.colours || {})[track] || "#ffffff";
       const box = { track_id: track, part, x: p[0], y: p[1], w: 0, h: 0, failure: false, occluded: 0,
-        revision: null, colour: "#ffffff", isNew: true };
+        revision: null, colour, human: true };
       this.drag = { box, handle: "se", start: p, orig: { x: p[0], y: p[1], w: 0, h: 0 }, isNew: true };
       this.selected = null;
     }
@@ -278,8 +628,18 @@ class Editor {
   }
 
   onMove(ev) {
+    if (this.pan) {
+      this.ox = this.pan.ox + ev.clientX - this.pan.x; this.oy = this.pan.oy + ev.clientY - this.pan.y;
+      this.applyView();
+      return;
+    }
     const d = this.drag;
-    if (!d) return;
+    if (!d) {
+      const h = this.hit(this.point(ev));
+      const k = h ? keyOf(h.box) : null;
+      if (k !== this.hover) { this.hover = k; if (!this.labelsAll) this.render(); }
+      return;
+    }
     const p = this.point(ev);
     const dx = p[0] - d.start[0], dy = p[1] - d.start[1];
     const o = d.orig, b = d.box;
@@ -294,24 +654,27 @@ class Editor {
       b.x = Math.min(x1, x2); b.y = Math.min(y1, y2);
       b.w = Math.abs(x2 - x1); b.h = Math.abs(y2 - y1);
     }
-    if (d.isNew && !this.boxes.includes(b)) this.boxes.push(b);
+    if (d.isNew && !this.shown.includes(b)) {
+      if (!this.boxes.has(this.cur)) this.boxes.set(this.cur, this.shown);
+      this.shown.push(b);
+    }
     this.render();
   }
 
   onUp(ev) {
+    if (this.pan) { this.pan = null; try { this.svg.releasePointerCapture(ev.pointerId); } catch (e) { /* */ } return; }
     const d = this.drag;
     this.drag = null;
     if (!d) return;
     try { this.svg.releasePointerCapture(ev.pointerId); } catch (e) { /* already released */ }
     const b = d.box, o = d.orig;
-    const moved = Math.abs(b.x - o.x) + Math.abs(b.y - o.y) + Math.abs(b.w - o.w) + Math.abs(b.h - o.h) > 0.5;
+    const moved = Math.abs(b.x - o.x) + Math.abs(b.y - o.y) + Math.abs(b.w - o.w) + Math.abs(b.h - o.h) > 0.2;
     if (!moved) { this.render(); return; }
-    // a tenth of a pixel is plenty; a move keeps the box's size exactly
     for (const k of d.handle ? ["x", "y", "w", "h"] : ["x", "y"]) {
       if (b[k] !== o[k] || d.isNew) b[k] = Math.round(b[k] * 10) / 10;
     }
     if (d.isNew && (b.w < MIN_SIZE || b.h < MIN_SIZE)) {
-      this.boxes = this.boxes.filter((x) => x !== b);
+      this.shown.splice(this.shown.indexOf(b), 1);
       this.render();
       return;
     }
@@ -323,8 +686,29 @@ class Editor {
     this.render();
   }
 
+  onWheel(ev) {
+    ev.preventDefault();
+    const r = this.viewport.getBoundingClientRect();
+    this.zoomAt(ev.deltaY < 0 ? 1.25 : 1 / 1.25, ev.clientX - r.left, ev.clientY - r.top);
+  }
+
+  onTimeline(ev) {
+    const g = this.tlGeom;
+    if (!g) return;
+    const r = this.timeline.getBoundingClientRect();
+    const x = ev.clientX - r.left, y = ev.clientY - r.top;
+    const f = Math.round(((x - g.labelW) / (g.w - g.labelW)) * g.n);
+    this.show(f, true);
+    const row = Math.floor((y - g.top) / g.rowH);
+    const t = g.tracks[row];
+    if (t) {
+      const b = (this.boxes.get(this.cur) || []).find((x) => x.track_id === t.id);
+      if (b) { this.selected = keyOf(b); this.render(); }
+    }
+  }
+
   onKey(ev) {
-    if (ev.target && ev.target.tagName === "SELECT") return;
+    if (ev.target && (ev.target.tagName === "SELECT" || ev.target.tagName === "INPUT")) return;
     const k = ev.key;
     const ctrl = ev.ctrlKey || ev.metaKey;
     let act = null;
@@ -333,14 +717,25 @@ class Editor {
     else if (ctrl || ev.altKey) return;
     else if (k === "ArrowRight" || k === "d" || k === "D") act = "next";
     else if (k === "ArrowLeft" || k === "a" || k === "A") act = "prev";
+    else if (k === " ") act = "play";
     else if (k === "Tab" || k === "n" || k === "N") act = "track";
     else if (k === "f" || k === "F") act = "failure";
     else if (k === "o" || k === "O") act = "occluded";
+    else if (k === "g" || k === "G") act = "flag";
+    else if (k === "k" || k === "K") act = "keyframe";
+    else if (k === "b" || k === "B") act = "draw";
+    else if (k === "l" || k === "L") act = "labels";
+    else if (k === "t" || k === "T") act = "fill";
+    else if (k === "0") act = "fit";
+    else if (k === "1") act = "one";
+    else if (k === "+" || k === "=") act = "zoomin";
+    else if (k === "-") act = "zoomout";
     else if (k === "Delete" || k === "Backspace") act = "delete";
     if (!act) return;
     ev.preventDefault();
     ev.stopPropagation();
-    this.act(act);
+    if (act === "next" || act === "prev") this.stats.keyAt = performance.now();
+    this.act(act, ev.shiftKey);
   }
 
   bind() {
@@ -348,28 +743,33 @@ class Editor {
     this.svg.addEventListener("pointermove", (ev) => this.onMove(ev));
     this.svg.addEventListener("pointerup", (ev) => this.onUp(ev));
     this.svg.addEventListener("pointercancel", (ev) => this.onUp(ev));
-    this.root.addEventListener("keydown", (ev) => this.onKey(ev));
+    this.svg.addEventListener("pointerleave", () => { if (this.hover && !this.drag) { this.hover = null; this.render(); } });
+    this.svg.addEventListener("contextmenu", (ev) => ev.preventDefault());
+    this.viewport.addEventListener("wheel", (ev) => this.onWheel(ev), { passive: false });
+    this.timeline.addEventListener("click", (ev) => this.onTimeline(ev));
+    this.root.addEventListener("keydown", (ev) => { if (ev.key === " ") this.spaceDown = false; this.onKey(ev); });
     for (const button of this.root.querySelectorAll("button[data-act]")) {
-      button.addEventListener("click", () => { this.act(button.dataset.act); this.root.focus({ preventScroll: true }); });
+      button.addEventListener("click", (ev) => { this.act(button.dataset.act, ev.shiftKey); this.root.focus({ preventScroll: true }); });
     }
-    this.img.addEventListener("load", () => this.render());
     if (window.ResizeObserver) {
       let last = 0;
       new ResizeObserver(() => {
         const w = this.root.clientWidth;
-        if (w !== last) { last = w; this.render(); }
+        if (w !== last && this.data) { last = w; this.fitted = false; this.layout(); this.drawTimeline(); }
       }).observe(this.root);
     }
+    window.partlabEditor = this; // for the browser test's measurements
   }
 }
 
 export default function (component) {
-  const { data, setTriggerValue, parentElement } = component;
+  const { data, setTriggerValue, setStateValue, parentElement } = component;
   let editor = INSTANCES.get(parentElement);
   if (!editor) {
     editor = new Editor(parentElement);
     INSTANCES.set(parentElement, editor);
   }
   editor.setTrigger = setTriggerValue;
+  editor.setState = setStateValue;
   editor.update(data);
 }

@@ -1,11 +1,22 @@
-"""Small page helpers shared by the page scripts (choosing a project and a clip)."""
+"""Small page helpers shared by the page scripts (choosing a project and a clip, showing
+names as text)."""
 
 from __future__ import annotations
+
+import re
 
 import streamlit as st
 
 from partlab.app import state
 from partlab.labelling.store import Clip, Store
+
+_MARKDOWN = re.compile(r"([\\`*_{}\[\]<>#$:|~])")
+
+
+def plain(text) -> str:
+    """``text`` escaped so that Streamlit's Markdown shows it as typed: a project called
+    ``**x**`` or ``:red[x]`` stays those characters (names are the users', not markup)."""
+    return _MARKDOWN.sub(r"\\\1", str(text))
 
 
 def require_project(s: Store):
@@ -55,15 +66,18 @@ def job_panel(kind: str, limit: int = 5, **meta) -> None:
         ended = False
         for job in jobs.jobs(kind, **meta)[:limit]:
             if job.active:
-                st.progress(job.fraction, text=f"{job.label}: {job.done} of {job.total or '?'}")
+                st.progress(job.fraction, text=f"{plain(job.label)}: {job.done} of {job.total or '?'}")
                 continue
             if job.id in watched:
                 watched.discard(job.id)
                 ended = True
             if job.status == "done":
-                st.success(f"{job.label}: done" + (f" ({describe(job.result)})" if describe(job.result) else "."))
+                said = describe(job.result)
+                st.success(f"{plain(job.label)}: done" + (f" ({said})" if said else "."))
+            elif job.status == "cancelled":
+                st.info(f"{plain(job.label)}: cancelled (what it had stored stays).")
             else:
-                st.error(f"{job.label}: failed: {job.error}")
+                st.error(f"{plain(job.label)}: failed: {plain(job.error)}")
         if ended:
             st.rerun()
 

@@ -1,132 +1,264 @@
-"""Correct: scrub frames, fix boxes and failure/occluded flags, re-track from a fix.
+"""Correct: step, play, zoom and fix boxes from a frame cache in the browser; keyframes and
+track mode; the track list with delete / merge / split / change id; a review pass; re-track
+between keyframes.
 
-Edits are written to the store as they are made (a refused stale edit says so); the
-frames are the decoder's frames by index, the same the tracker used.
+Edits are written to the store as they are made (a refused stale edit says so), each
+action one step of undo; the frames are the decoder's frames by index, the same the
+tracker used. The page only glues: the operations are in :mod:`partlab.labelling.trackops`
+and :mod:`partlab.app.editing`, the editor in :mod:`partlab.app.box_editor`.
 """
 
 import threading
-import time
+from collections import OrderedDict
 
+import pandas as pd
 import streamlit as st
 
 from partlab.app import state
-from partlab.app.box_editor import box_editor, pending_events
-from partlab.app.editing import apply_events
-from partlab.app.runs import next_human_frame, start_tracking
-from partlab.app.views.common import bound_widget, job_panel, pick_clip, require_project
-from partlab.labelling.store import Store
+from partlab.app.box_editor import box_editor, encode_image, pack_boxes, pending_events, track_colour, view
+from partlab.app.editing import apply_events, record
+from partlab.app.runs import start_tracking
+from partlab.app.views.common import job_panel, pick_clip, plain, require_project
+from partlab.labelling import trackops
+from partlab.labelling.store import Store, StoreError
 from partlab.labelling.video import VideoClip, VideoError
-from partlab.tracking.parts import PART_NAMES
+from partlab.tracking.parts import BOX_PARTS
 
 s = state.store()
-st.title("Correct")
 project = require_project(s)
-clip = pick_clip(s, project.id)
+top = st.columns([3, 2, 2], vertical_alignment="bottom")
+with top[0]:
+    clip = pick_clip(s, project.id)
 last = max(clip.frame_count - 1, 0)
 fkey = state.frame_key(clip.id)
 st.session_state[fkey] = state.frame(clip.id, clip.frame_count)
-
-
-@st.cache_resource(max_entries=8)
-def video(path: str) -> tuple[VideoClip, threading.Lock]:
-    """One open decoder per clip, shared by the sessions (seeking is the slow part);
-    the lock keeps two sessions from moving the same decoder at once."""
-    return VideoClip(path), threading.Lock()
-
-
-def read_frame(path: str, index: int):
-    clip_reader, lock = video(path)
-    with lock:
-        return clip_reader.read(index)
-
-
-@st.cache_data(max_entries=32, show_spinner=False)
-def track_ids(url: str, clip_id: int, n_runs: int, next_id: int) -> list[int]:
-    """The clip's track ids; reading every box takes a while on long clips, so this is
-    cached until a tracker run or a new track changes it (the arguments after the clip)."""
-    return sorted(set(Store(url).tracks(clip_id).track_id.astype(int).tolist()))
-
-
-def step(delta: int) -> None:
-    st.session_state[fkey] = min(max(st.session_state[fkey] + delta, 0), last)
-
-
 history = state.history(clip.id)
-occluder_mode = bool(st.session_state.get(f"occluders:{clip.id}"))
+occluder_mode = top[2].toggle("Edit occluder regions", key=f"occluders:{clip.id}",
+                              help="regions that hide people (shelves, pillars); drawn once per clip")
 editor_key = state.editor_key(clip.id, "occluders" if occluder_mode else "boxes")
+jkey = f"jump:{clip.id}"
+st.session_state.setdefault(jkey, dict(seq=0, frame=st.session_state[fkey]))
+
+
+def jump(frame: int) -> None:
+    """Make the editor show ``frame`` (it otherwise keeps its own frame)."""
+    frame = min(max(int(frame), 0), last)
+    st.session_state[fkey] = frame
+    st.session_state[jkey] = dict(seq=st.session_state[jkey]["seq"] + 1, frame=frame)
+
+
+class FrameCache:
+    """JPEG data URLs of one clip's frames, newest used last; decoding in order is what
+    makes a chunk cheap (a seek costs a keyframe's worth of decoding)."""
+
+    def __init__(self, path: str, size: int = 900):
+        self.clip, self.lock, self.size = VideoClip(path), threading.Lock(), size
+        self.urls: OrderedDict[int, str] = OrderedDict()
+
+    def url(self, index: int) -> str:
+        with self.lock:
+            if index in self.urls:
+                self.urls.move_to_end(index)
+                return self.urls[index]
+            url = encode_image(self.clip.read(index), quality=80)
+            self.urls[index] = url
+            while len(self.urls) > self.size:
+                self.urls.popitem(last=False)
+            return url
+
+
+@st.cache_resource(max_entries=4)
+def frame_cache(path: str) -> FrameCache:
+    """One decoder and JPEG cache per clip, shared by the sessions."""
+    return FrameCache(path)
+
+
+@st.cache_resource(max_entries=8, show_spinner=False)
+def clip_boxes(url: str, clip_id: int, version) -> dict:
+    """Everything the page and the editor read from the clip's boxes, once per data version:
+    the boxes by frame, the timeline and the track list."""
+    store = Store(url)
+    df = store.tracks(clip_id)
+    verdicts = store.reviews(clip_id)
+    tracks, rows = [], []
+    for tid, g in df.groupby("track_id", sort=True):
+        frames = sorted(set(g.frame.astype(int)))
+        spans, start = [], frames[0]
+        for a, b in zip(frames, frames[1:] + [None]):
+            if b is None or b != a + 1:
+                spans.append([start, a])
+                start = b
+        keys = sorted(set(g[g.source == "human"].frame.astype(int)))
+        fails = sorted(set(g[g.failure.astype(bool)].frame.astype(int)))
+        mine = verdicts[verdicts.track_id == tid] if len(verdicts) else verdicts
+        acc = [[int(r.start), int(r.stop)] for r in mine.itertuples() if r.accepted] if len(mine) else []
+        rej = [[int(r.start), int(r.stop)] for r in mine.itertuples() if not r.accepted] if len(mine) else []
+        lost = g.state.astype(str).str.contains("lost").groupby(g.frame).any()
+        tracks.append(dict(id=int(tid), colour=track_colour(int(tid)), spans=spans, keys=keys, fails=fails, acc=acc,
+                           rej=rej))
+        rows.append(dict(track=int(tid), parts=", ".join(sorted(set(g.part))), first=frames[0], last=frames[-1],
+                         frames=len(frames), keyframes=len(keys), flagged=len(fails),
+                         lost=int(lost.sum()), reviewed=sum(b - a + 1 for a, b in acc)))
+    flagged = sorted(set(df[df.failure.astype(bool)].frame.astype(int)))
+    return dict(by_frame=pack_boxes(df), timeline=dict(tracks=tracks, flagged=flagged), table=pd.DataFrame(rows),
+                parts=[p for p in BOX_PARTS if p in set(df.part)] or list(BOX_PARTS), ids=[t["id"] for t in tracks])
 
 
 def apply(events: list[dict]) -> None:
     """Write the editor's events; the messages show above the editor on this run."""
-    result = apply_events(s, clip.id, events, history, author=state.author())
+    fill = any(e.get("fill") for e in events if e.get("kind") == "edit")
+    result = apply_events(s, clip.id, events, history, author=state.author(), fill=fill)
     st.session_state.setdefault("correct_messages", []).extend(result.errors + result.notes)
-    if result.frame is not None:
-        st.session_state[fkey] = min(max(result.frame, 0), last)
+    if result.frame is not None and any(e.get("kind") in ("undo", "redo") for e in events):
+        jump(result.frame)
 
 
-# events the user made since the last run are applied first, so the editor is drawn with their result
-apply(pending_events(editor_key))
+def current_frame() -> int:
+    """The frame the editor shows (it steps on its own and reports the frame in its view)."""
+    shown = view(editor_key)
+    if "frame" in shown and shown.get("frame") != st.session_state.get(f"seen_view:{clip.id}"):
+        st.session_state[fkey] = min(max(int(shown["frame"]), 0), last)
+        st.session_state[f"seen_view:{clip.id}"] = shown.get("frame")
+    return st.session_state[fkey]
 
-c1, c2, c3, c4, c5 = st.columns([5, 1, 1, 1.4, 2.6], vertical_alignment="bottom")
-with c1:
-    bound_widget(st.slider, fkey, state.slider_key(clip.id), "Frame", 0, max(last, 1), disabled=last == 0)
-c2.button("◀", on_click=step, args=(-1,), help="previous frame", width="stretch")
-c3.button("▶", on_click=step, args=(1,), help="next frame", width="stretch")
-playing = c4.toggle("Play", key=f"play:{clip.id}")
-c5.toggle("Edit occluder regions", key=f"occluders:{clip.id}",
-          help="regions that hide people (shelves, pillars); drawn once per clip")
-frame = st.session_state[fkey]
 
-try:
-    image = read_frame(str(clip.path), frame)
-except (VideoError, IndexError) as exc:
-    st.error(f"Cannot show frame {frame}: {exc}")
-    st.stop()
-
-for message in st.session_state.pop("correct_messages", []):
-    (st.error if message.startswith("Not saved") else st.info)(message)
-if occluder_mode:
-    regions = [dict(x=b.x, y=b.y, w=b.w, h=b.h) for b in s.occluders(clip.id)]
-    events = box_editor(image, regions, key=editor_key, frame=frame, frame_count=clip.frame_count,
-                        mode="occluders")
-else:
-    boxes = s.frame_boxes(clip.id, frame)
-    next_id = s.next_track_id(clip.id)
-    tracks = track_ids(s.url, clip.id, len(s.runs(clip.id)), next_id)
-    events = box_editor(image, boxes, key=editor_key, frame=frame, frame_count=clip.frame_count,
-                        tracks=tracks, next_track_id=next_id, parts=PART_NAMES)
-if events:  # events the early read did not see (not expected; kept so none is ever dropped)
+@st.fragment
+def editor_panel() -> None:
+    """The editor and what it needs; its own requests (frames, boxes, edits) rerun only this
+    fragment, so the browser is not busy redrawing the page while it plays."""
+    # events the user made since the last run are applied first, so the editor is drawn with their result
+    events = pending_events(editor_key)
     apply(events)
-    st.rerun()
+    frame = current_frame()
+    version = s.data_version(clip.id)
+    data = clip_boxes(s.url, clip.id, version)
+    for message in st.session_state.pop("correct_messages", []):
+        (st.error if message.startswith("Not saved") else st.info)(plain(message))
+    try:
+        cache = frame_cache(str(clip.path))
+        cache.url(frame)
+    except (VideoError, IndexError, ValueError) as exc:
+        st.error(f"Cannot show frame {frame}: {exc}")
+        return
+    tracks = [dict(id=t, colour=track_colour(t)) for t in data["ids"]]
+    late = box_editor(key=editor_key, width=clip.width, height=clip.height, frame_count=clip.frame_count,
+                      fps=clip.fps, frame_url=cache.url, boxes_by_frame={} if occluder_mode else data["by_frame"],
+                      version=version, jump=st.session_state[jkey], tracks=tracks,
+                      next_track_id=s.next_track_id(clip.id), used_parts=data["parts"], timeline=data["timeline"],
+                      mode="occluders" if occluder_mode else "boxes",
+                      occluders=[dict(x=b.x, y=b.y, w=b.w, h=b.h) for b in s.occluders(clip.id)])
+    if late:  # events the early read did not see (not expected; kept so none is ever dropped)
+        apply(late)
+        st.rerun()
+    if any(e.get("kind") not in ("frame",) for e in events):
+        st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
+
+editor_panel()
+frame = current_frame()
+version = s.data_version(clip.id)
+data = clip_boxes(s.url, clip.id, version)
 progress = s.progress(clip.id)
-st.caption(f"Frame {frame} of {last} · {progress['corrected_frames']} corrected frames "
-           f"({100 * progress['fraction']:.1f}%) · session edits: {len(history.undo)} "
-           f"(undo {len(history.undo)}, redo {len(history.redo)})")
+top[1].caption(f"{progress['corrected_frames']} corrected · {progress['accepted_frames']} accepted of "
+               f"{clip.frame_count} frames · undo {len(history.undo)} / redo {len(history.redo)}")
 
-with st.expander("Re-track from this frame", expanded=False):
-    stop = next_human_frame(s, clip.id, frame)
-    st.write(f"Runs the tracker from the boxes of frame {frame} to "
-             + (f"frame {stop} (the next corrected frame)." if stop is not None else "the end of the clip.")
-             + " Human corrections are never overwritten.")
+tab_tracks, tab_review, tab_retrack, tab_keys = st.tabs(["Tracks", "Review", "Re-track", "Keys and help"])
+ids = data["ids"]
+
+with tab_tracks:
+    st.dataframe(data["table"], hide_index=True, width="stretch", height=min(36 * (len(ids) + 1) + 3, 260))
+    if ids:
+        c1, c2, c3, c4 = st.columns([1.2, 2.2, 1.2, 1], vertical_alignment="bottom")
+        tid = c1.selectbox("Track", ids, key=f"op_track:{clip.id}", format_func=lambda t: f"#{t}")
+        op = c2.selectbox("Operation", ("delete from this frame on", "split at this frame", "merge into track",
+                                        "change id to"), key=f"op:{clip.id}")
+        other = c3.number_input("Other / new id", min_value=1, step=1, value=int(s.next_track_id(clip.id)),
+                                key=f"op_other:{clip.id}", disabled=op in ("delete from this frame on",
+                                                                           "split at this frame"))
+        if c4.button("Apply", key=f"op_go:{clip.id}", width="stretch"):
+            try:
+                if op == "delete from this frame on":
+                    changes, label = trackops.delete_from(s, clip.id, tid, frame), f"deletion of #{tid} from {frame}"
+                elif op == "split at this frame":
+                    changes, label = trackops.split(s, clip.id, tid, frame), f"split of #{tid} at {frame}"
+                elif op == "merge into track":
+                    changes, label = trackops.merge(s, clip.id, int(other), tid), f"merge of #{tid} into #{int(other)}"
+                else:
+                    changes = trackops.change_id(s, clip.id, tid, int(other))
+                    label = f"id change #{tid} -> #{int(other)}"
+                record(s, clip.id, changes, history, label, frame, author=state.author())
+                st.session_state["correct_messages"] = [
+                    f"Done: {label} ({len(changes)} box revisions; Ctrl+Z undoes it)."]
+                jump(frame)
+                st.rerun()
+            except StoreError as exc:
+                st.error(f"Not saved: {exc}")
+        st.caption(f"Operations apply at the frame shown (frame {frame}); each is one step of undo (Ctrl+Z in the "
+                   "editor) and is stored as revisions of the boxes it changes.")
+
+with tab_review:
+    if ids:
+        c1, c2, c3, c4, c5 = st.columns([1.2, 1.2, 1.2, 1, 1], vertical_alignment="bottom")
+        rtid = c1.selectbox("Track", ids, key=f"rv_track:{clip.id}", format_func=lambda t: f"#{t}")
+        span = next(([a, b] for t in data["timeline"]["tracks"] if t["id"] == rtid for a, b in t["spans"]
+                     if a <= frame <= b), [frame, frame])
+        a = c2.number_input("From frame", 0, last, int(span[0]), key=f"rv_a:{clip.id}:{rtid}:{span[0]}")
+        b = c3.number_input("To frame", 0, last, int(span[1]), key=f"rv_b:{clip.id}:{rtid}:{span[1]}")
+        for col, label, ok in ((c4, "Accept", True), (c5, "Reject", False)):
+            if col.button(label, key=f"rv_{label}:{clip.id}", width="stretch"):
+                try:
+                    rid = s.review(clip.id, rtid, min(a, b), max(a, b), ok, author=state.author())
+                    st.session_state[f"last_review:{clip.id}"] = rid
+                    st.rerun()
+                except StoreError as exc:
+                    st.error(str(exc))
+        rid = st.session_state.get(f"last_review:{clip.id}")
+        if rid is not None and st.button("Undo my last verdict", key=f"rv_undo:{clip.id}"):
+            s.undo_review(clip.id, rid)
+            st.session_state.pop(f"last_review:{clip.id}")
+            st.rerun()
+        st.caption("A verdict covers frames From..To of one track; the newest covering a frame counts. Accepted "
+                   "frames are green under the track's timeline row, rejected red; Export can keep accepted "
+                   "frames only.")
+
+with tab_retrack:
+    sel = st.selectbox("Tracks", ["every track at the start frame"] + [f"#{t}" for t in ids],
+                       key=f"rt_tracks:{clip.id}")
+    only = None if sel.startswith("every") else int(sel[1:])
+    start, stop, rt_ids = trackops.retrack_window(s, clip.id, frame, only)
+    st.write(f"Runs the tracker from frame {start} (" + ("a keyframe" if start != frame or progress["corrected_frames"]
+                                                         else "this frame") + ") to "
+             + (f"frame {stop} (the next keyframe)" if stop is not None else "the end of the clip")
+             + f" for tracks {', '.join(f'#{t}' for t in rt_ids) or '(none)'}; every other track and every "
+               "human correction stay as they are.")
     tracker = st.radio("Tracker", ("body", "limbs", "all"), horizontal=True, key="retrack_tracker")
-    if st.button("Re-track from here"):
+    if st.button("Re-track", disabled=not rt_ids):
         try:
-            job = start_tracking(s, clip, tracker=tracker, start=frame, retrack=True,
+            job = start_tracking(s, clip, tracker=tracker, start=frame, retrack=True, track_id=only,
                                  bundle_path=next((b.path for b in s.bundles(project.id)
                                                    if b.id == project.default_bundle_id), None))
-            st.success(f"Started: {job.label}")
+            st.success(f"Started: {plain(job.label)}")
         except (RuntimeError, ValueError) as exc:
             st.error(str(exc))
+    runs = s.runs(clip.id)
+    if len(runs):
+        r = runs.iloc[-1]
+        if st.button(f"Undo the newest tracker run (run {int(r.id)}: {r.tracker} from frame {int(r.start_frame)})",
+                     key=f"undo_run:{clip.id}"):
+            s.undo_run(clip.id, int(r.id))
+            st.session_state["correct_messages"] = [f"Undid run {int(r.id)}: the boxes it replaced are back."]
+            jump(frame)
+            st.rerun()
     job_panel("track", limit=1, clip_id=clip.id)
 
-with st.expander("Keyboard shortcuts"):
-    st.markdown("Click the frame first. **←/→** or **A/D**: previous/next frame · **N** or **Tab**: next track · "
-                "**F**: toggle failure · **O**: toggle occluded · **Delete**: delete the box · "
-                "**Ctrl+Z / Ctrl+Y**: undo/redo · drag a box to move it, its corners to resize it, "
-                "an empty area to draw a new box of the part and track chosen in the toolbar.")
-
-if playing and frame < last:
-    time.sleep(max(0.04, 1.0 / max(clip.fps, 1.0)))
-    st.session_state[fkey] = frame + 1
-    st.rerun()
+with tab_keys:
+    st.markdown(
+        "Click the frame first. **←/→** or **A/D**: previous/next frame (from the browser's frame cache) · "
+        "**Space**: play/pause · **G** / **Shift+G**: next/previous flagged frame · **K** / **Shift+K**: next/previous "
+        "keyframe of the selected track · **N** or **Tab**: next track · **F**: failure · **O**: occluded · "
+        "**Delete**: delete the box · **B** or Shift+drag: draw a new box (even inside another) · **T**: track mode "
+        "(moving a keyframe refills the track's boxes up to its neighbouring keyframes) · **L**: labels on all boxes "
+        "or on hover · wheel, **+**/**-**: zoom at the mouse · **0**: fit · **1**: 1:1 · right- or middle-drag: pan · "
+        "**Ctrl+Z / Ctrl+Y**: undo/redo a step. The timeline under the frame shows each track's presence (colour), "
+        "keyframes (white ticks), failure flags (black ticks), reviewed ranges (green/red) and flagged frames (red "
+        "strip on top); click it to jump.")

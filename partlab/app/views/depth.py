@@ -27,4 +27,5 @@ with take:
         if view.color is not None:
             left.image(view.color[..., ::-1], caption=f"{name} colour, frame {index}")
         if view.depth is not None:
-            right.image(depth_colours(view.depth)[..., ::-1], caption=f"{name} depth (near red, far blue, missing black)")
+            right.image(depth_colours(view.depth)[..., ::-1],
+                        caption=f"{name} depth (near red, far blue, missing black)")

@@ -10,7 +10,7 @@ from partlab.app import jobs, state
 from partlab.app.box_editor import track_colour
 from partlab.app.demo import demo_files
 from partlab.app.runs import bundle_choices, first_boxes, start_comparison_run, training_truth
-from partlab.app.views.common import pick_clip, require_project
+from partlab.app.views.common import pick_clip, plain, require_project
 from partlab.labelling import evaluation
 from partlab.tracking.tracks import read_tracks_csv
 
@@ -53,7 +53,7 @@ def comparison():
     cols = st.columns(2)
     for side, (col, name) in enumerate(zip(cols, (a, b))):
         with col:
-            st.markdown(f"**{name}**")
+            st.markdown(f"**{plain(name)}**")
             runs = jobs.jobs("compare", clip_id=clip.id, bundle=name, tracker=tracker)
             if not runs:
                 st.caption("not run yet")

@@ -9,7 +9,7 @@ import streamlit as st
 from partlab.app import state
 from partlab.app.runs import clip_state
 from partlab.app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
-from partlab.app.views.common import require_project
+from partlab.app.views.common import plain, require_project
 from partlab.labelling.store import StoreError
 from partlab.labelling.video import VideoClip, VideoError
 
@@ -23,7 +23,7 @@ with st.expander("New project", expanded=not s.projects()):
             try:
                 project = s.create_project(name)
                 st.session_state[state.PROJECT] = project.id
-                st.session_state["projects_flash"] = f"Created project {project.name!r}."
+                st.session_state["projects_flash"] = f"Created project {plain(repr(project.name))}."
                 st.rerun()  # the sidebar's project picker shows the new project
             except StoreError as exc:
                 st.error(str(exc))
@@ -31,7 +31,7 @@ if "projects_flash" in st.session_state:
     st.success(st.session_state.pop("projects_flash"))
 
 project = require_project(s)
-st.subheader(f"Project: {project.name}")
+st.subheader(f"Project: {plain(project.name)}")
 
 try:
     limit = max_upload_mb()
@@ -48,7 +48,7 @@ for f in uploaded or []:
         try:
             with st.spinner(f"Checking and storing {f.name}..."):
                 clip = save_upload(s, project.id, f.name, f)
-            kind, message = "success", f"Added {clip.name}: {clip.frame_count} frames, {clip.fps:.1f} fps, " \
+            kind, message = "success", f"Added {plain(clip.name)}: {clip.frame_count} frames, {clip.fps:.1f} fps, " \
                                        f"{clip.width}x{clip.height}."
             st.session_state[state.CLIP] = clip.id
         except UploadRefused as exc:
@@ -76,7 +76,8 @@ if not clips:
     st.stop()
 rows = [dict(id=c.id, thumbnail=thumbnail(str(c.path), c.sha256), name=c.name, frames=c.frame_count,
              seconds=round(c.frame_count / c.fps, 1) if c.fps else None, fps=round(c.fps, 2),
-             size=f"{c.width}x{c.height}", state=clip_state(s, c)) for c in clips]
+             size=f"{c.width}x{c.height}", state=clip_state(s, c),
+             accepted=f"{s.progress(c.id)['accepted_frames']} of {c.frame_count}") for c in clips]
 st.dataframe(pd.DataFrame(rows), hide_index=True, width="stretch", row_height=70,
              column_config={"thumbnail": st.column_config.ImageColumn("thumbnail", width="small")})
 st.caption("Pick a clip on the Track or Correct page; new uploads become the current clip.")

@@ -8,7 +8,7 @@ import streamlit as st
 from partlab.app import state
 from partlab.app.demo import demo_files
 from partlab.app.runs import TRACKERS, bundle_choices, start_tracking
-from partlab.app.views.common import job_panel, pick_clip, require_project
+from partlab.app.views.common import job_panel, pick_clip, plain, require_project
 from partlab.labelling.store import Store
 from partlab.tracking.tracks import read_tracks_csv
 
@@ -47,7 +47,7 @@ if go:
         init = read_tracks_csv(demo_init) if start_from == "the synthetic scene's init boxes" else None
         job = start_tracking(s, clip, tracker=tracker, bundle_path=path, seed=int(seed),
                              start=first if from_boxes else 0, init_from_boxes=from_boxes, init=init)
-        st.success(f"Started: {job.label}. It keeps running while you use other pages.")
+        st.success(f"Started: {plain(job.label)}. It keeps running while you use other pages.")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))
 

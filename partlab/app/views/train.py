@@ -6,7 +6,7 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.runs import SHIPPED, bundle_choices, start_training
-from partlab.app.views.common import job_panel, require_project
+from partlab.app.views.common import job_panel, plain, require_project
 from partlab.labelling.store import StoreError
 
 s = state.store()
@@ -38,7 +38,7 @@ if go_train:
     try:
         job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default,
                              start_path=starts[start_label])
-        st.success(f"Started: {job.label}")
+        st.success(f"Started: {plain(job.label)}")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))
 
@@ -92,9 +92,9 @@ if bundles:
     if chosen != project.default_bundle_id:
         try:
             s.set_default_bundle(project.id, chosen)
-            st.success(f"Default bundle: {labels[chosen]}")
+            st.success(f"Default bundle: {plain(labels[chosen])}")
         except StoreError as exc:
             st.error(str(exc))
     for b in reversed(bundles):
-        with st.expander(f"{b.name} · {b.created:%Y-%m-%d %H:%M} · {b.path}", expanded=b is bundles[-1]):
+        with st.expander(f"{plain(b.name)} · {b.created:%Y-%m-%d %H:%M} · {plain(b.path)}", expanded=b is bundles[-1]):
             show_summary(b.summary, key=str(b.id))

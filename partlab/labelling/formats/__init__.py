@@ -181,13 +181,18 @@ def _clip_dir_name(clip) -> str:
     return f"{clip.id:04d}_{stem}"
 
 
-def export_clip(store, clip_id: int, fmt: str, out_dir, every: int = 1, frames: bool = True) -> Path:
+def export_clip(store, clip_id: int, fmt: str, out_dir, every: int = 1, frames: bool = True,
+                accepted_only: bool = False) -> Path:
     """Export a clip of the annotation store (its effective boxes: tracker boxes under human
-    edits) against the frame count and fps recorded when the clip was added; marks it exported."""
+    edits) against the frame count and fps recorded when the clip was added; marks it exported.
+    ``accepted_only``: only the boxes of tracks at frames a reviewer accepted (``Store.accepted``)."""
     clip = store.clip(clip_id)
     info = VideoInfo(clip.path, clip.fps, clip.width, clip.height, clip.frame_count)
-    out = export_dataset(store.tracks(clip_id), fmt, out_dir, info, video_path=clip.path, every=every,
-                         frames=frames)
+    tracks = store.tracks(clip_id)
+    if accepted_only:
+        ok = store.accepted(clip_id)
+        tracks = tracks.merge(ok, on=["frame", "track_id"], how="inner")
+    out = export_dataset(tracks, fmt, out_dir, info, video_path=clip.path, every=every, frames=frames)
     store.mark_exported(clip_id)
     return out
 

@@ -65,6 +65,8 @@ class Appearance:
     height_m: float = 1.75
     short_sleeves: bool = False
     long_hair: bool = False
+    girth: float = 1.0  # body width against the built-in adult proportions (lateral scale)
+    head_scale: float = 1.0  # head size against the built-in proportions
 
 
 def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int, int]:
@@ -105,5 +107,34 @@ def sample_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
             height_m=float(rng.uniform(1.62, 1.86)),
             short_sleeves=bool(rng.random() < 0.4),
             long_hair=bool(rng.random() < 0.35),
+        ))
+    return out
+
+
+def _random_colour(rng: np.random.Generator) -> tuple[int, int, int]:
+    """Any clothing colour: hue uniform, saturation and value over their whole plausible range."""
+    import cv2
+
+    hsv = np.array([[[rng.integers(0, 180), rng.integers(0, 256), rng.integers(25, 256)]]], np.uint8)
+    return tuple(int(v) for v in cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR)[0, 0])
+
+
+def random_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
+    """``n`` people of any look (any number; colours may repeat, as in real crowds): clothes of any
+    colour, skin anywhere between the palette's darkest and lightest tones, heights 1.50-1.95 m,
+    body width 0.8-1.3 and head size 0.85-1.15 of the built-in proportions."""
+    skins = np.asarray(SKINS, float)
+    dark, light = skins[np.argmin(skins.sum(1))], skins[np.argmax(skins.sum(1))]
+    out = []
+    for _ in range(n):
+        skin = dark + rng.uniform(0, 1) * (light - dark)
+        out.append(Appearance(
+            shirt=_random_colour(rng), trousers=_random_colour(rng),
+            skin=_jitter(rng, tuple(int(v) for v in skin), 8),
+            hair=_jitter(rng, HAIRS[rng.integers(len(HAIRS))], 10),
+            shoes=_random_colour(rng),
+            height_m=float(rng.uniform(1.50, 1.95)),
+            short_sleeves=bool(rng.random() < 0.4), long_hair=bool(rng.random() < 0.35),
+            girth=float(rng.uniform(0.8, 1.3)), head_scale=float(rng.uniform(0.85, 1.15)),
         ))
     return out

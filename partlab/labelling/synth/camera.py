@@ -28,6 +28,21 @@ class Camera:
         """The scenes' camera at any frame size (sizes scale with the frame height)."""
         return cls(width, height, f=1.46 * height, horizon=0.14 * height)
 
+    @classmethod
+    def random(cls, rng: np.random.Generator, width: int, height: int) -> Camera:
+        """A camera of any plausible mounting: 2.2-5.5 m up, tilted so that the horizon lies
+        anywhere from above the frame to a third of the way down it, focal length 1.1-1.9 frame
+        heights (the randomized suite of issue 13)."""
+        return cls(width, height, f=float(rng.uniform(1.1, 1.9)) * height,
+                   horizon=float(rng.uniform(-0.15, 0.3)) * height, cam_height=float(rng.uniform(2.2, 5.5)))
+
+    def depth_range(self, height_m: float = 1.75, min_px: float = 0.22, margin: float = 0.03) -> tuple[float, float]:
+        """Depths at which a standing person's feet are in the frame (``margin`` of its height above
+        the bottom) and who is at least ``min_px`` of the frame height tall."""
+        near = self.f * self.cam_height / ((1 - margin) * self.height - self.horizon)
+        far = self.f * height_m / (min_px * self.height)
+        return float(near), float(max(far, near * 1.15))
+
     @property
     def cx(self) -> float:
         return self.width / 2.0

@@ -273,7 +273,7 @@ def _cameras(rng: np.random.Generator, width: int, height: int) -> dict[str, Cam
     return {"cam0": left, "cam0_right": right}
 
 
-def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 150, width: int = 320,
+def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 150, width: int = 320,  # noqa: C901
                      height: int = 240, *, fast: float = 1.0) -> DepthScene:
     """Render ``name`` (``desk_depth`` or ``standing_depth``) from ``seed``; ``fast`` scales the
     hands' speed (1: keyframes 0.2-0.6 s apart, up to about 3 m/s)."""
@@ -321,7 +321,8 @@ def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 15
     floor_col = rng.uniform(60, 160, 3)
     # desk tops: grey, white, dark, blue-grey (a skin-hued wood top is a colour distractor of its own,
     # the limb tracker's desk scene; here the hands' depth is under test)
-    desk_col = np.asarray([(128, 128, 128), (225, 225, 220), (45, 45, 50), (150, 120, 100)][int(rng.integers(4))], float)
+    desk_tops = [(128, 128, 128), (225, 225, 220), (45, 45, 50), (150, 120, 100)]
+    desk_col = np.asarray(desk_tops[int(rng.integers(4))], float)
     tex_skin, tex_cloth = _texture(rng, 25.0), _texture(rng, 14.0)
     tex_wall, tex_wall2 = _texture(rng, 180.0), _texture(rng, 35.0)
 

@@ -233,16 +233,23 @@ def _arm_solids(pose: FigurePose, shoulders: np.ndarray, project, depth, scale: 
 
 
 def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False,
-                  long_hair: bool = False) -> list[_Solid]:
-    """The solids of the figure in image coordinates, sorted far to near."""
+                  long_hair: bool = False, anchors: dict | None = None, girth: float = 1.0,
+                  head_scale: float = 1.0) -> list[_Solid]:
+    """The solids of the figure in image coordinates, sorted far to near; ``girth`` scales the body
+    across (lateral offsets), ``head_scale`` the head's radii.
+
+    ``anchors``, when given, receives the floor offsets and height ``(dx, dz, u)`` (metres, the
+    view's floor frame) of the head's centre and of each hand's centre, keyed by part name: the
+    3D truth of the multi-camera scenes (:mod:`partlab.labelling.synth.multiview`)."""
     H = height_m
     F = np.array([np.cos(pose.facing), np.sin(pose.facing)])  # forward on the floor (X, Z)
     L = np.array([-F[1], F[0]])  # the person's left
 
     def to_world(p: np.ndarray):
         p = np.atleast_2d(p)
-        dx = p[:, 0] * L[0] + p[:, 1] * F[0]
-        dz = p[:, 0] * L[1] + p[:, 1] * F[1]
+        lat = p[:, 0] * girth
+        dx = lat * L[0] + p[:, 1] * F[0]
+        dz = lat * L[1] + p[:, 1] * F[1]
         return dx, dz, p[:, 2]
 
     def project(p):
@@ -286,6 +293,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
     Lh = np.array([-Fh[1], Fh[0]])
 
     def head_ellipse(offset_f, offset_u, rl, rf, ru):
+        rl, rf, ru = rl * head_scale, rf * head_scale, ru * head_scale
         c = head_c[0] + np.array([0.0, 0.0, offset_u * H])
         dx = c[0] * L[0] + c[1] * F[0] + offset_f * H * Fh[0]
         dz = c[0] * L[1] + c[1] * F[1] + offset_f * H * Fh[1]
@@ -309,6 +317,10 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         solids.append(_Solid("ellipse", (fc, fax), FACE, "head", head_depth))
     # ---- arms
     solids.extend(_arm_solids(pose, shoulders, project, depth, view.s * H, H, short_sleeves))
+    if anchors is not None:
+        anchors["head"] = np.concatenate([np.ravel(v) for v in to_world(head_c)])
+        for side, part, sh in ((1, "left_hand", shoulders[0]), (-1, "right_hand", shoulders[1])):
+            anchors[part] = np.concatenate([np.ravel(v) for v in to_world(_arm_joints(pose, side, sh, H)[2])])
     solids.sort(key=lambda s: -s.depth)
     return solids
 
@@ -375,9 +387,10 @@ def _extent(solid: _Solid) -> np.ndarray:
     return np.concatenate([pts.min(0) - rm, pts.max(0) + rm])
 
 
-def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView) -> Figure:
+def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView, anchors: dict | None = None) -> Figure:
     """Draw one person: the label image and the part masks over its bounding region."""
-    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair)
+    solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair,
+                           anchors, appearance.girth, appearance.head_scale)
     ext = np.array([_extent(s) for s in solids])
     x1, y1 = np.floor(ext[:, :2].min(0)).astype(int) - 2
     x2, y2 = np.ceil(ext[:, 2:].max(0)).astype(int) + 2

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from partlab.labelling.synth.appearance import Appearance, sample_appearances
+from partlab.labelling.synth.appearance import Appearance, random_appearances, sample_appearances
 from partlab.labelling.synth.background import WALL_DEPTH, Prop
 from partlab.labelling.synth.camera import Camera, LocalView
 from partlab.labelling.synth.figure import HAND_R, WAIST_HALF_D
@@ -48,6 +48,7 @@ class Script:
     occluders: list[Occluder] = field(default_factory=list)
     objects: list = field(default_factory=list)
     events: list = field(default_factory=list)
+    lighting: np.ndarray | None = None  # (H, W, 3) float32 gain on the whole frame (None: as drawn)
 
 
 def _j(rng: np.random.Generator, scale: float) -> float:
@@ -218,6 +219,43 @@ def _desk(rng, camera, n_frames, fps) -> Script:
     return Script([Actor(app, motion, view=view, seat_cut=seat_cut)], props=props)
 
 
+def random_lighting(rng: np.random.Generator, width: int, height: int) -> np.ndarray:
+    """``(H, W, 3)`` gain: overall brightness 0.55-1.25, a colour cast of up to 20 % per channel
+    (warm lamps, cold daylight) and light falling off across the frame from a random side."""
+    level = rng.uniform(0.55, 1.25)
+    cast = rng.uniform(0.8, 1.2, 3)
+    angle = rng.uniform(0, 2 * np.pi)
+    yy, xx = np.mgrid[0:height, 0:width].astype(np.float32)
+    ramp = ((xx / width - 0.5) * np.cos(angle) + (yy / height - 0.5) * np.sin(angle))
+    fall = 1.0 + rng.uniform(0.0, 0.5) * ramp
+    return (level * fall[..., None] * cast[None, None, :]).astype(np.float32)
+
+
+def _random(rng, camera, n_frames, fps) -> Script:
+    """Randomized scene (issue 13): 1-12 people of any look and size walking across at their own
+    depths, speeds and times (some enter late, some leave), seen by a random camera
+    (:meth:`Camera.random`) under random lighting. Nothing here was tuned against."""
+    n = int(rng.integers(1, 13))
+    apps = random_appearances(rng, n)
+    near, far = camera.depth_range()
+    actors = []
+    for app in apps:
+        z0, z1 = rng.uniform(near, far, 2)
+        d = 1.0 if rng.random() < 0.5 else -1.0  # walking towards image right (+1) or left
+        # 0.9-1.7 m/s over the clip, in half frame widths at the mean depth
+        half = float(camera.cx / camera.scale(0.5 * (z0 + z1)))
+        dist = rng.uniform(0.9, 1.7) * (n_frames / fps) / half
+        if rng.random() < 0.3:  # off the frame until t0, then walks in
+            t0 = float(rng.uniform(0.05, 0.3))
+            keys = [(0.0, -d * 1.25, z0), (t0, -d * 1.25, z0), (1.0, -d * 1.25 + d * dist * (1 - t0), z1)]
+        else:
+            x0 = d * rng.uniform(-0.9, 0.6)
+            keys = [(0.0, x0, z0), (1.0, x0 + d * dist, z1)]
+        m = walk(camera, n_frames, keys, app.height_m)
+        actors.append(Actor(app, with_changes(m, head_yaw=_glances(rng, n_frames, fps))))
+    return Script(actors, lighting=random_lighting(rng, camera.width, camera.height))
+
+
 BUILDERS = {
     "single": _single,
     "pair_cross": _pair_cross,
@@ -226,4 +264,5 @@ BUILDERS = {
     "crowd": _crowd,
     "bend": _bend,
     "desk": _desk,
+    "random": _random,
 }

@@ -48,7 +48,7 @@ from partlab.tracking.parts import PART_NAMES
 from partlab.tracking.tracks import normalise_tracks
 
 SCENARIOS: tuple[str, ...] = ("single", "pair_cross", "pillar", "distractors", "crowd", "bend", "desk",
-                              "pick_place", "exchange", "handshake", "clap")
+                              "pick_place", "exchange", "handshake", "clap", "random")
 #: the columns of a scene's event truth (``events.csv``)
 EVENT_TRUTH_COLUMNS = ("kind", "start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b", "colour")
 FPS = 25.0
@@ -125,6 +125,14 @@ def _shadow(frame: np.ndarray, camera: Camera, x: float, z: float, height_m: flo
     frame[y1:y2, x1:x2] = (frame[y1:y2, x1:x2] * gain[..., None]).astype(np.uint8)
 
 
+#: frame sizes of the randomized suite (:func:`random_size`)
+RANDOM_SIZES: tuple[tuple[int, int], ...] = ((480, 360), (640, 360), (640, 480), (720, 480), (768, 576), (960, 540))
+
+
+def random_size(seed: int) -> tuple[int, int]:
+    """The frame size the randomized suite renders scene ``seed`` at (one of :data:`RANDOM_SIZES`)."""
+    return RANDOM_SIZES[int(np.random.default_rng([seed, 99]).integers(len(RANDOM_SIZES)))]
+
 def _truth_rows(i: int, drawn: list, owner: np.ndarray) -> list[tuple]:
     """Truth rows of frame ``i``: every drawn person's box and each part's box (its visible
     pixels, or all of it when hidden), with the occluded fraction from the owner map."""
@@ -160,7 +168,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     """
     _check(name, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
-    camera = Camera.for_frame(width, height)
+    camera = Camera.random(rng, width, height) if name == "random" else Camera.for_frame(width, height)
     script: Script = {**BUILDERS, **ACTIVITY_BUILDERS}[name](rng, camera, n_frames, FPS)
     background = draw_props(room(rng, camera), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
@@ -212,6 +220,8 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
             owner[y:y + h, x:x + w] = OCCLUDER_ID
         rows.extend(_truth_rows(i, drawn, owner))
+        if script.lighting is not None:
+            frame = np.clip(frame * script.lighting, 0, 255).astype(np.uint8)
         frames[i] = frame if effects is None else effects.apply(frame, i)
         if owner_maps is not None:
             owner_maps[i] = owner
@@ -221,6 +231,14 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
     truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
+    if name == "random":  # people walking in start where an annotator would: once wholly in view
+        person = truth[truth["part"] == "person"]
+        inside = person[(person["x"] >= 2) & (person["y"] >= 2) & (person["x"] + person["w"] <= width - 2)
+                        & (person["y"] + person["h"] <= height - 2)]
+        start = inside.groupby("track_id")["frame"].min()
+        # never wholly in view: start at the frame it shows most of itself
+        largest = person.assign(a=person["w"] * person["h"]).sort_values("a").groupby("track_id")["frame"].last()
+        first = truth["track_id"].map(start).fillna(truth["track_id"].map(largest)).fillna(first)
     init = truth[truth["frame"] == first].reset_index(drop=True)
     events = None
     if script.events:

@@ -223,6 +223,18 @@ class BodyDetection:
     lost_frames: int = number(10, POSITIVE_COUNT)
     support_min: float = number(0.1, FRACTION)
     leave_fraction: float = number(0.5, FRACTION)
+    # (Automatically started tracks end at once; the rest of this applies to --init tracks.)
+    # Tracks started from --init are judged by the same foreground support once the background
+    # model has learnt the scene (after ``background.warmup`` frames). A person without support
+    # for ``lost_frames`` frames is *lost*: all parts coast on the person's recent velocity (an
+    # obstacle nobody listed with --occluders may hide them) while the torso's model looks for
+    # them near the prediction (``occlusion.release_search``, ``release_similarity``) on
+    # foreground. Found again: tracking goes on and the coasted rows stay; still lost after
+    # ``coast_frames`` frames (1.6 s at 25 fps: a walker crosses a pillar or a parked car in
+    # about that), the track ends and the rows written while it was lost are withdrawn
+    # (it had left, or the tracker had lost it: either way those boxes are on background).
+    coast_frames: int = number(40, COUNT)
+    end_init_tracks: bool = flag(True)
 
 
 @dataclass(frozen=True)
@@ -334,6 +346,8 @@ class BodyParams(Parameters):
         "lost_frames": "detection.lost_frames",
         "support_min": "detection.support_min",
         "leave_fraction": "detection.leave_fraction",
+        "coast_frames": "detection.coast_frames",
+        "end_init_tracks": "detection.end_init_tracks",
         "occlusion_overlap": "occlusion.overlap",
         "occlusion_margin": "occlusion.margin",
         "occlusion_pad": "occlusion.pad",

@@ -165,7 +165,7 @@ class DepthParams(Parameters):
     posture: Posture = group_field(Posture)
 
     @classmethod
-    def ablation(cls, variant: str) -> "DepthParams":
+    def ablation(cls, variant: str) -> DepthParams:
         """Table 2's rows: ``color_ms`` (Color-PF + MS), ``color_is`` (Color-PF + Depth-IS), ``all``."""
         p = cls()
         if variant == "color_ms":

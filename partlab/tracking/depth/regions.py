@@ -98,7 +98,7 @@ def hand_regions(depth: np.ndarray, face: FaceDepth, face_box, fx: float, p: Dep
 
 def _sums(integ, xl, yl, xu, yu):
     x1, y1, x2, y2 = int(np.floor(xl)), int(np.floor(yl)), int(np.floor(xu)) + 1, int(np.floor(yu)) + 1
-    return [float(I[y2, x2] - I[y1, x2] - I[y2, x1] + I[y1, x1]) for I in integ]
+    return [float(ii[y2, x2] - ii[y1, x2] - ii[y2, x1] + ii[y1, x1]) for ii in integ]
 
 
 def _refine(integ, xl, yl, xu, yu, p: DepthCue):

@@ -19,8 +19,8 @@ calibration the camera is taken as a pinhole with focal length = the image width
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Callable, Mapping, Sequence
 
 import cv2
 import numpy as np
@@ -28,12 +28,18 @@ import pandas as pd
 
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
-from partlab.tracking.core.hue_histogram import (back_projection, box_histograms, hue_bin_image, hue_confidence,
-                                                 integral_histogram, reference_histogram)
+from partlab.tracking.core.hue_histogram import (
+    back_projection,
+    box_histograms,
+    hue_bin_image,
+    hue_confidence,
+    integral_histogram,
+    reference_histogram,
+)
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthParams
 from partlab.tracking.depth.posture import head_width, recover
-from partlab.tracking.depth.regions import FaceDepth, HandRegion, depth_foreground, face_depth, hand_regions
+from partlab.tracking.depth.regions import HandRegion, depth_foreground, face_depth, hand_regions
 from partlab.tracking.depth.sampling import draw_importance, icondensation_correction
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
@@ -260,6 +266,40 @@ class DepthTracker:
             h.low = 0
 
     # -- the loop ----------------------------------------------------------------------------------
+    def _first_face(self, color, depth, bins, integral, camera) -> bool:
+        """Start the face from the init box or a detection, and the hands' sizes from it."""
+        p, ap = self.params, self.params.appearance
+        box = self._init_boxes.get("head") or self._detect_face(color)
+        if box is None or not self._start_face(box, bins):
+            return False
+        self.face.conf = self.face.conf + hue_confidence(
+            box_histograms(integral, self.face.boxes(self.face.estimate)), self.face.ref, ap.lam)[0]
+        for name in HANDS:
+            hb = self._init_boxes.get(name)
+            h = self.hands[name]
+            if hb is not None:
+                h.size = np.array(hb[2:], float)
+                h.start = (hb[0] + hb[2] / 2, hb[1] + hb[3] / 2)
+            else:
+                s = p.reacquisition.hand_size * self.face_size[0]
+                h.size = np.array([s, s])
+        fd = face_depth(depth, self.face.box(), float(camera.K[0, 0]))
+        self._fg = depth_foreground(depth, fd, p.depth) if (fd and p.depth.depth_foreground) else None
+        return True
+
+    def _follow_face(self, color, bins, integral) -> None:
+        """Track the face; re-acquire it with the detector after ``face_frames`` unsure frames."""
+        p = self.params
+        self._track_face(bins, integral, self._fg)
+        if self.face.conf.max() < p.reacquisition.face_confidence:
+            self.face_low += 1
+        else:
+            self.face_low = 0
+        if self.face_low >= p.reacquisition.face_frames:
+            found = self._detect_face(color)
+            if found is not None and self._start_face(found, bins):
+                self.stats.reacquired += 1
+
     def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
         view = frames.first
         index = frames.index
@@ -277,32 +317,10 @@ class DepthTracker:
         self.stats.frames += 1
         # 1. the face: started from the init box or a detection, then tracked
         if self.face is None:
-            box = self._init_boxes.get("head") or self._detect_face(color)
-            if box is None or not self._start_face(box, bins):
+            if not self._first_face(color, depth, bins, integral, camera):
                 return []
-            self.face.conf = self.face.conf + hue_confidence(
-                box_histograms(integral, self.face.boxes(self.face.estimate)), self.face.ref, ap.lam)[0]
-            for name in HANDS:
-                hb = self._init_boxes.get(name)
-                h = self.hands[name]
-                if hb is not None:
-                    h.size = np.array(hb[2:], float)
-                    h.start = (hb[0] + hb[2] / 2, hb[1] + hb[3] / 2)
-                else:
-                    s = p.reacquisition.hand_size * self.face_size[0]
-                    h.size = np.array([s, s])
-            fd = face_depth(depth, self.face.box(), float(camera.K[0, 0]))
-            self._fg = depth_foreground(depth, fd, p.depth) if (fd and p.depth.depth_foreground) else None
         else:
-            self._track_face(bins, integral, self._fg)
-            if self.face.conf.max() < p.reacquisition.face_confidence:
-                self.face_low += 1
-            else:
-                self.face_low = 0
-            if self.face_low >= p.reacquisition.face_frames:
-                found = self._detect_face(color)
-                if found is not None and self._start_face(found, bins):
-                    self.stats.reacquired += 1
+            self._follow_face(color, bins, integral)
         fbox = self.face.box()
         fd = face_depth(depth, fbox, float(camera.K[0, 0]))
         # 2. depth foreground and hand candidate regions (Table 1)

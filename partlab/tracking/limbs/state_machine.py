@@ -107,10 +107,17 @@ def assign_by_direction(before: np.ndarray, modes: np.ndarray) -> tuple[np.ndarr
     ``before``: ``(2,)`` position of a minus position of b before the join; ``modes``: ``(2, 2)``.
     Returns (mode of a, mode of b).
     """
-    m = np.asarray(modes, float).reshape(2, 2)
+    m = np.asarray(modes, float).reshape(2, -1)
     if float(np.dot(m[0] - m[1], np.asarray(before, float))) >= 0:
         return m[0], m[1]
     return m[1], m[0]
+
+
+def _length(vector) -> float:
+    """Length of a 2D vector (``np.hypot``, as the one-camera tracker always measured) or of a
+    3D one (the multi-camera tracker's targets, :mod:`partlab.tracking.limbs3d`)."""
+    v = np.asarray(vector, float).ravel()
+    return float(np.hypot(*v)) if v.size == 2 else float(np.linalg.norm(v))
 
 
 def distance_threshold(pixels: float, per_size: float, size: float) -> float:
@@ -225,12 +232,12 @@ class LimbStateMachine:
         unlabelled trackers once its two modes are ``split_size`` sides apart."""
         p = self.params.states
         b = s.partner
-        modes = np.asarray(obs.modes, float).reshape(-1, 2)
+        modes = np.asarray(obs.modes, float).reshape(len(obs.modes), -1) if len(obs.modes) else np.zeros((0, 2))
         if s.low >= p.lost_frames:
             self._end_join(frame, t, b, "lost")
             move(t, LimbState.LOST, "combined target lost", b)
             move(b, LimbState.LOST, "combined target lost", t)
-        elif len(modes) >= 2 and np.hypot(*(modes[0] - modes[1])) > distance_threshold(
+        elif len(modes) >= 2 and _length(modes[0] - modes[1]) > distance_threshold(
                 p.split_distance, p.split_size, obs.size):
             pos_a, pos_b = assign_by_direction(s.before, modes[:2])
             self._end_join(frame, t, b, "split")
@@ -254,7 +261,7 @@ class LimbStateMachine:
         pairs = []
         for i, a in enumerate(ids):
             for b in ids[i + 1:]:
-                d = float(np.hypot(*(np.subtract(observations[a].position, observations[b].position))))
+                d = _length(np.subtract(observations[a].position, observations[b].position))
                 size = (observations[a].size + observations[b].size) / 2 if (
                     observations[a].size > 0 and observations[b].size > 0) else 0.0
                 if d < distance_threshold(p.states.combine_distance, p.states.combine_size, size):
@@ -277,7 +284,7 @@ class LimbStateMachine:
         pairs = list(zip(ha[len(ha) - n:], hb[len(hb) - n:]))
         for pa, pb in reversed(pairs):
             states = self.params.states
-            if np.hypot(*(pa - pb)) >= distance_threshold(states.combine_distance, states.combine_size,
+            if _length(pa - pb) >= distance_threshold(states.combine_distance, states.combine_size,
                                                        self._sizes.get(a, 0.0)):
                 return pa - pb
         if pairs:

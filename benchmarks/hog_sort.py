@@ -1,0 +1,121 @@
+"""The baseline a user would pick instead (issue 13): OpenCV's HOG people detector with SORT on top.
+
+Detector: ``cv2.HOGDescriptor_getDefaultPeopleDetector`` (Dalal & Triggs; ships with OpenCV) on
+frames upscaled 1.5x (PETS walkers are 50-100 px tall, the detector's window 128), windows shrunk
+to the body (0.6 x 0.75 about their centre: the window has a margin around the person), kept at an
+SVM score >= ``min_score`` after non-maximum suppression.
+
+Tracker: SORT (Bewley et al. 2016, "Simple online and realtime tracking"): one constant-velocity
+Kalman filter per track on the box centre and size, detections assigned to predictions by the
+Hungarian method on IoU (at least ``iou_min``), a track reported once it has ``min_hits``
+detections and dropped after ``max_age`` frames without one. Written here because no SORT package
+is installed; numbers as in the paper's defaults.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pandas as pd
+from scipy.optimize import linear_sum_assignment
+
+from partlab.tracking.core.box import iou_xywh
+
+
+def hog_detector() -> cv2.HOGDescriptor:
+    hog = cv2.HOGDescriptor()
+    hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
+    return hog
+
+
+def detect_people(hog: cv2.HOGDescriptor, frame: np.ndarray, upscale: float = 1.5, shrink=(0.6, 0.75),
+                  min_score: float = 0.3, nms: float = 0.4) -> np.ndarray:
+    """``(N, 5)`` boxes ``x, y, w, h, score`` of the people HOG finds in ``frame``."""
+    big = cv2.resize(frame, None, fx=upscale, fy=upscale, interpolation=cv2.INTER_LINEAR)
+    rects, weights = hog.detectMultiScale(big, winStride=(8, 8), padding=(8, 8), scale=1.05)
+    if len(rects) == 0:
+        return np.zeros((0, 5))
+    rects = np.asarray(rects, float) / upscale
+    weights = np.asarray(weights, float).ravel()
+    keep = cv2.dnn.NMSBoxes(rects.tolist(), weights.tolist(), min_score, nms)
+    keep = np.asarray(keep, int).ravel()
+    r, w = rects[keep], weights[keep]
+    cx, cy = r[:, 0] + r[:, 2] / 2, r[:, 1] + r[:, 3] / 2
+    bw, bh = r[:, 2] * shrink[0], r[:, 3] * shrink[1]
+    return np.stack([cx - bw / 2, cy - bh / 2, bw, bh, w], axis=1)
+
+
+class _Track:
+    def __init__(self, box: np.ndarray, track_id: int):
+        kf = cv2.KalmanFilter(8, 4)
+        kf.transitionMatrix = np.eye(8, dtype=np.float32)
+        kf.transitionMatrix[:4, 4:] = np.eye(4, dtype=np.float32)
+        kf.measurementMatrix = np.eye(4, 8, dtype=np.float32)
+        kf.processNoiseCov = np.diag([1, 1, 1, 1, 0.01, 0.01, 0.0001, 0.0001]).astype(np.float32)
+        kf.measurementNoiseCov = np.diag([1, 1, 10, 10]).astype(np.float32)
+        kf.errorCovPost = np.diag([10, 10, 10, 10, 1e4, 1e4, 1e4, 1e4]).astype(np.float32)
+        kf.statePost = np.r_[self._z(box), np.zeros(4)].astype(np.float32).reshape(8, 1)
+        self.kf, self.id, self.hits, self.misses = kf, track_id, 1, 0
+
+    @staticmethod
+    def _z(box):
+        x, y, w, h = box[:4]
+        return np.array([x + w / 2, y + h / 2, w, h], np.float32)
+
+    def predict(self) -> np.ndarray:
+        s = self.kf.predict().ravel()
+        w, h = max(s[2], 1.0), max(s[3], 1.0)
+        return np.array([s[0] - w / 2, s[1] - h / 2, w, h])
+
+    def update(self, box) -> None:
+        self.kf.correct(self._z(box).reshape(4, 1))
+        self.hits += 1
+        self.misses = 0
+
+    def box(self) -> np.ndarray:
+        s = self.kf.statePost.ravel()
+        return np.array([s[0] - s[2] / 2, s[1] - s[3] / 2, s[2], s[3]])
+
+
+def sort_tracks(detections: list[np.ndarray], iou_min: float = 0.3, min_hits: int = 3,
+                max_age: int = 1) -> pd.DataFrame:
+    """SORT over per-frame detections (``(N, >=4)`` arrays); a tracks table of ``person`` rows."""
+    tracks: list[_Track] = []
+    next_id = 1
+    rows = []
+    for frame, dets in enumerate(detections):
+        preds = np.array([t.predict() for t in tracks]).reshape(-1, 4)
+        matched_t, matched_d = set(), set()
+        if len(tracks) and len(dets):
+            iou = iou_xywh(dets[:, :4], preds)
+            r, c = linear_sum_assignment(-iou)
+            for d, t in zip(r, c):
+                if iou[d, t] >= iou_min:
+                    tracks[t].update(dets[d])
+                    matched_t.add(t)
+                    matched_d.add(d)
+        for t, tr in enumerate(tracks):
+            if t not in matched_t:
+                tr.misses += 1
+        for d in range(len(dets)):
+            if d not in matched_d:
+                tracks.append(_Track(dets[d], next_id))
+                next_id += 1
+        tracks = [t for t in tracks if t.misses <= max_age]
+        for t in tracks:
+            if t.misses == 0 and (t.hits >= min_hits or frame < min_hits):
+                x, y, w, h = t.box()
+                rows.append((frame, t.id, "person", x, y, w, h))
+    return pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def hog_sort(take) -> pd.DataFrame:
+    """HOG + SORT over every frame of ``take`` (frame indexes of the take)."""
+    hog = hog_detector()
+    dets, first = [], None
+    for fs in take.frames():
+        first = fs.index if first is None else first
+        dets.append(detect_people(hog, fs.first.color))
+    out = sort_tracks(dets)
+    out["frame"] += first or 0
+    return out

@@ -1,0 +1,66 @@
+"""The Dask cluster partlab's work runs on: a :class:`distributed.LocalCluster` on this machine by
+default, or an existing scheduler by address (``tcp://HOST:8786``).
+
+Tracking is CPU-bound numpy/numba in Python, so a local cluster runs one single-threaded worker
+process per core asked for (threads would share one interpreter lock). Each worker process
+compiles partlab's kernels on its first task; that start-up is part of the per-task overhead
+measured by ``benchmarks/batch_scaling.py``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Iterator
+
+from partlab.errors import UserError
+
+
+def _quiet_logs() -> None:
+    for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
+                 "distributed.core", "distributed.http.proxy", "bokeh", "tornado"):
+        logging.getLogger(name).setLevel(logging.ERROR)
+
+
+@contextlib.contextmanager
+def client(scheduler: str | None = None, workers: int | None = None,
+           dashboard: str | None = ":0") -> Iterator[distributed.Client]:  # noqa: F821
+    """A connected :class:`distributed.Client`, closed (and a local cluster shut down) on exit.
+
+    ``scheduler``: address of a running scheduler; None starts a local cluster of ``workers``
+    single-threaded worker processes (default: the machine's cores). ``dashboard``: the local
+    cluster's dashboard address (``":0"`` any free port, None no dashboard).
+    """
+    from distributed import Client, LocalCluster
+
+    _quiet_logs()
+    if scheduler:
+        try:
+            c = Client(scheduler, timeout="10s")
+        except (OSError, TimeoutError) as exc:
+            raise UserError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
+        try:
+            yield c
+        finally:
+            c.close()
+        return
+    n = workers or os.cpu_count() or 1
+    if n < 1:
+        raise UserError(f"--workers must be at least 1, got {n}")
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
+                           silence_logs=logging.ERROR)
+    try:
+        with Client(cluster) as c:
+            yield c
+    finally:
+        cluster.close()
+
+
+def dashboard_link(c) -> str | None:
+    """The dashboard's URL, or None when the scheduler has none (bokeh missing)."""
+    try:
+        link = c.dashboard_link
+    except (AttributeError, KeyError):
+        return None
+    return link or None

@@ -1,0 +1,85 @@
+"""One particle filter per 3D target (sec. 4.2, SIR; weights by eq. 17).
+
+``particles: (N, 6) float64 [X, Y, Z, vX, vY, vZ]`` (mm, mm per frame). Each frame the filter
+predicts with damped constant velocity plus Gaussian noise, weights every particle by
+
+    w_i = sum_c p(x_i | Z_c) p(Z_c)                                    (eq. 17)
+
+over the candidates it may use (``p(x | Z)`` a Gaussian of spread ``sigma_x``), takes the weighted
+mean as its estimate, and resamples systematically (every frame, as SIR does, eq. 12). Its
+confidence is the best candidate's ``p(x | Z) p(Z)`` at the estimate: near the prior of the
+candidate it sits on, near 0 when no candidate is near (what the state machine thresholds).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from partlab.tracking.core.resampling import systematic_resample
+from partlab.tracking.limbs3d.params import Limbs3DParams
+
+
+class TargetFilter:
+    def __init__(self, position, params: Limbs3DParams, rng: np.random.Generator, spread: float | None = None):
+        self.params = params
+        self.rng = rng
+        self.particles = np.zeros((params.particles, 6))
+        self.reset(position, spread)
+        self.confidence = 1.0
+
+    def reset(self, position, spread: float | None = None, keep_velocity: bool = False) -> None:
+        """Put the particles around ``position`` (``spread`` mm, default ``noise_xyz``)."""
+        s = self.params.noise_xyz if spread is None else spread
+        n = self.params.particles
+        v = self.particles[:, 3:].copy() if keep_velocity else np.zeros((n, 3))
+        self.particles = np.hstack([np.asarray(position, float)[None] + self.rng.normal(0, s, (n, 3)), v])
+
+    @property
+    def estimate(self) -> np.ndarray:
+        return self.particles[:, :3].mean(axis=0)
+
+    def predict(self, scale: float = 1.0) -> None:
+        p = self.params
+        n = len(self.particles)
+        v = p.velocity_decay * self.particles[:, 3:] + self.rng.normal(0, p.noise_v * scale, (n, 3))
+        self.particles[:, :3] += v + self.rng.normal(0, p.noise_xyz * scale, (n, 3))
+        self.particles[:, 3:] = v
+
+    def propose(self, candidates: np.ndarray, prior: np.ndarray) -> None:
+        """Redraw ``candidate_mix`` of the particles around the gated candidates (sec. 4.2's
+        "further steps"); the others keep their predicted state."""
+        p = self.params
+        if len(candidates) == 0 or p.candidate_mix <= 0:
+            return
+        near = np.linalg.norm(candidates - self.estimate, axis=1) < p.candidate_gate
+        if not near.any():
+            return
+        c, w = candidates[near], prior[near]
+        k = int(round(p.candidate_mix * len(self.particles)))
+        pick = self.rng.choice(len(c), size=k, p=w / w.sum())
+        rows = self.rng.choice(len(self.particles), size=k, replace=False)
+        self.particles[rows, :3] = c[pick] + self.rng.normal(0, p.noise_xyz, (k, 3))
+
+    def weigh(self, candidates: np.ndarray, prior: np.ndarray) -> np.ndarray:
+        """Eq. 17 for every particle (``(N,)``, not normalised)."""
+        p = self.params
+        if len(candidates) == 0:
+            return np.full(len(self.particles), p.weight_floor)
+        d2 = ((self.particles[:, None, :3] - candidates[None]) ** 2).sum(-1)
+        return np.exp(-d2 / (2 * p.sigma_x**2)) @ prior + p.weight_floor
+
+    def update(self, candidates: np.ndarray, prior: np.ndarray) -> np.ndarray:
+        """Propose, weigh, estimate, resample; returns the estimate (mm)."""
+        self.propose(candidates, prior)
+        w = self.weigh(candidates, prior)
+        w = w / w.sum()
+        est = (self.particles[:, :3] * w[:, None]).sum(0)
+        idx = systematic_resample(w, len(w), self.rng)
+        self.particles = self.particles[idx]
+        if len(candidates):
+            d2 = ((candidates - est) ** 2).sum(-1)
+            self.confidence = float(np.max(np.exp(-d2 / (2 * self.params.sigma_x**2)) * prior))
+        else:
+            self.confidence = 0.0
+        self._estimate = est
+        return est

@@ -1,0 +1,141 @@
+"""How good is a candidate point: its prior ``p(Z) = p_o(Z) p_t(Z) p_b(Z)`` (eq. 19, 25-27), then
+pruning and merging (sec. 6.4).
+
+- ``p_o`` (eq. 25) compares the two blobs in their own images: the relative row of each blob
+  within its person's silhouette, ``Dv`` (0 at the silhouette's top, 1 at its bottom), should agree,
+  because with every camera upright a higher point has a smaller row in every view;
+- ``p_t`` (eq. 26) is the reconstruction error ``d`` of eq. 24;
+- ``p_b`` (eq. 27) projects the candidate into every view and measures its distance ``Ds`` (pixels)
+  to that view's silhouette: a false pair of two limbs on one line of sight in one camera lands
+  off the people in another. A view with no silhouette at all (a covered lens) says nothing and
+  is left out of the product.
+
+Each term measures something the pair of blobs does not already guarantee (the silhouettes are
+the background model's, not the skin mask the blobs were cut from). Terms are kept by name
+(:class:`Prior`) so that the app and training can show and fit them one by one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from partlab.tracking.camera import Camera
+from partlab.tracking.limbs3d.geometry import PairCandidates
+from partlab.tracking.limbs3d.params import Limbs3DParams
+
+
+@dataclass(frozen=True, eq=False)
+class ViewObservation:
+    """One view at one frame: skin-blob ``centres (K, 2)``, their relative rows ``dv (K,)`` in
+    their silhouettes, and ``distance (H, W) float32``: pixels to the nearest silhouette pixel
+    (0 inside); ``has_silhouette`` False when the view sees nobody at all."""
+
+    centres: np.ndarray
+    dv: np.ndarray
+    distance: np.ndarray
+    has_silhouette: bool
+    scale: float = 1.0  # image pixels per silhouette pixel (silhouettes may be found at lower resolution)
+
+
+def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0) -> ViewObservation:
+    """The silhouette measures of one view (``silhouette``: ``(H, W)`` mask, nonzero = person;
+    ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel)."""
+    sil = (np.asarray(silhouette) > 0).astype(np.uint8)
+    centres = np.asarray(centres, float).reshape(-1, 2)
+    h, w = sil.shape
+    if not sil.any():
+        return ViewObservation(centres, np.full(len(centres), 0.5), np.zeros((h, w), np.float32), False, scale)
+    n, labels, stats, _ = cv2.connectedComponentsWithStats(sil, 8)
+    distance = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
+    top_all = float(stats[1:, cv2.CC_STAT_TOP].min())
+    bottom_all = float((stats[1:, cv2.CC_STAT_TOP] + stats[1:, cv2.CC_STAT_HEIGHT]).max())
+    dv = np.empty(len(centres))
+    for k, (x, y) in enumerate(centres):
+        lab = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
+        if lab > 0:
+            top, bottom = stats[lab, cv2.CC_STAT_TOP], stats[lab, cv2.CC_STAT_TOP] + stats[lab, cv2.CC_STAT_HEIGHT]
+        else:
+            top, bottom = top_all, bottom_all
+        dv[k] = (y - top) / max(float(bottom - top), 1.0)
+    return ViewObservation(centres, dv, distance * np.float32(scale), True, scale)
+
+
+def silhouette_distance(camera: Camera, view: ViewObservation, points: np.ndarray) -> np.ndarray:
+    """``Ds``: pixels from each point's projection to the view's silhouette (eq. 27); outside the
+    image, the distance at the border plus how far outside."""
+    uv = camera.project(points) / view.scale
+    h, w = view.distance.shape
+    cu = np.clip(uv[:, 0], 0, w - 1)
+    cv_ = np.clip(uv[:, 1], 0, h - 1)
+    inside = view.distance[cv_.astype(int), cu.astype(int)]
+    out = np.hypot(uv[:, 0] - cu, uv[:, 1] - cv_) * view.scale
+    ds = inside + out
+    return np.where(np.isfinite(ds), ds, 1e6)
+
+
+@dataclass(frozen=True)
+class Prior:
+    """The named terms of eq. 19 for every candidate, each ``(C,)`` in [0, 1]."""
+
+    p_o: np.ndarray
+    p_t: np.ndarray
+    p_b: np.ndarray
+
+    @property
+    def value(self) -> np.ndarray:
+        return self.p_o * self.p_t * self.p_b
+
+
+def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[ViewObservation],
+                    params: Limbs3DParams) -> tuple[Prior, dict]:
+    """Eq. 25-27 for every candidate; also returns the raw errors (``dv``, ``d``, ``ds``), which
+    training (sec. 6.4) fits the sigmas from."""
+    if len(cands) == 0:
+        z = np.zeros(0)
+        return Prior(z, z, z), {"dv": z, "d": z, "ds": np.zeros((0, len(views)))}
+    dv_a = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 0], cands.blobs[:, 0])])
+    dv_b = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 1], cands.blobs[:, 1])])
+    ddv = dv_a - dv_b
+    p_o = np.exp(-ddv**2 / (2 * params.sigma_v**2))
+    p_t = np.exp(-cands.error**2 / (2 * params.sigma_d**2))
+    ds = np.stack([silhouette_distance(c, v, cands.points) if v.has_silhouette else np.zeros(len(cands))
+                   for c, v in zip(cameras, views)], axis=1)
+    p_b = np.exp(-(ds**2).sum(axis=1) / (2 * params.sigma_s**2))
+    return Prior(p_o, p_t, p_b), {"dv": ddv, "d": cands.error, "ds": ds}
+
+
+def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams) -> tuple[np.ndarray, np.ndarray]:
+    """Drop candidates below ``prior_threshold`` or outside the room, then merge close ones (sec.
+    6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
+    ``merge_boost`` times its prior to the one that absorbs it (capped at 1).
+    Returns ``points (K, 3)`` and ``prior (K,)``, strongest first."""
+    keep = (prior >= params.prior_threshold) & np.isfinite(points).all(axis=1)
+    keep &= (points[:, 2] > 0) & (points[:, 2] < params.max_height)
+    pts, pr = points[keep], prior[keep]
+    order = np.argsort(-pr, kind="stable")
+    pts, pr = pts[order], pr[order]
+    alive = np.ones(len(pr), bool)
+    out_p, out_w = [], []
+    if len(pr):
+        dist = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
+    for i in range(len(pr)):
+        if not alive[i]:
+            continue
+        near = alive & (dist[i] < params.merge_distance)
+        near[i] = False
+        absorbed = np.flatnonzero(near)
+        alive[absorbed] = False
+        value = min(1.0, pr[i] + params.merge_boost * float(pr[absorbed].sum()))
+        if params.merge_average and len(absorbed):
+            idx = np.concatenate([[i], absorbed])
+            p = (pts[idx] * pr[idx, None]).sum(0) / pr[idx].sum()
+        else:
+            p = pts[i]
+        out_p.append(p)
+        out_w.append(value)
+    if not out_p:
+        return np.zeros((0, 3)), np.zeros(0)
+    return np.array(out_p), np.array(out_w)

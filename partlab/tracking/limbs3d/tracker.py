@@ -1,0 +1,285 @@
+"""The multi-camera head-and-hands tracker, frame by frame (sec. 5-6).
+
+Per frame (:meth:`Limbs3DTracker.step`):
+
+1. per view (sec. 6.1-6.2): the person silhouettes (empty-scene plate or the adaptive
+   foreground), skin pixels within them or around a tracked target's projection, the largest
+   skin blobs and their centres of mass, each blob's relative row in its silhouette;
+2. candidates (sec. 6.3, eq. 16, 18, 22-24) from every pair of views, their priors p_o p_t p_b
+   (eq. 19, 25-27), pruned and merged (sec. 6.4);
+3. the low layer: every active target's particle filter predicts and is weighted by eq. 17 over
+   the candidates no other target is nearer to (a combined pair's filter over both's);
+4. the high layer (sec. 5.2): the five-state machine of :mod:`partlab.tracking.limbs.state_machine`
+   on 3D positions combines targets that come within ``combine_distance`` mm, splits them when the
+   combined posterior's two modes part by ``split_distance`` mm, giving each tracker the mode that
+   keeps the direction between them from before the join (sec. 7.1), loses and recovers targets;
+5. output: each target's 3D estimate (``X, Y, Z``) and, for every view, its back-projected box
+   (``camera`` column), so that every view can be corrected.
+
+Targets start from ``--init`` (3D points, or boxes in two or more views that are triangulated with
+``cv2.triangulatePoints``); without one, a strong candidate that persists ``start_frames`` frames
+starts a target (uninitialized -> unlabelled), and a person's highest target is labelled its head,
+the others its hands by side.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+import pandas as pd
+
+from partlab.tracking.camera import Camera
+from partlab.tracking.core.box import Box
+from partlab.tracking.core.skin import SkinModel, find_blobs
+from partlab.tracking.frame import FrameSet
+from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
+from partlab.tracking.limbs3d.filter import TargetFilter
+from partlab.tracking.limbs3d.geometry import pair_candidates
+from partlab.tracking.limbs3d.params import Limbs3DParams
+from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
+
+LIMB_PARTS = ("head", "left_hand", "right_hand")
+
+
+def triangulate(cameras: list[Camera], pixels: list[np.ndarray]) -> np.ndarray:
+    """A world point (mm) from its pixels in two or more views: ``cv2.triangulatePoints`` on each
+    pair of views (undistorted pixels), averaged."""
+    pts = []
+    for i in range(len(cameras)):
+        for j in range(i + 1, len(cameras)):
+            a = cv2.undistortPoints(np.asarray(pixels[i], float).reshape(1, 1, 2), cameras[i].K, cameras[i].dist,
+                                    P=cameras[i].K).reshape(2, 1)
+            b = cv2.undistortPoints(np.asarray(pixels[j], float).reshape(1, 1, 2), cameras[j].K, cameras[j].dist,
+                                    P=cameras[j].K).reshape(2, 1)
+            h = cv2.triangulatePoints(cameras[i].P, cameras[j].P, a, b).ravel()
+            pts.append(h[:3] / h[3])
+    return np.mean(pts, axis=0)
+
+
+@dataclass
+class _Target:
+    track_id: int
+    part: str
+    filter: TargetFilter | None = None
+    start_frame: int = 0
+    position: np.ndarray | None = None
+    labelled: bool = True
+    waiting: int = 0  # frames an automatically started target has waited for a label
+    history: list = field(default_factory=list)
+
+
+class Limbs3DTracker:
+    """Heads and hands of everybody in a calibrated take of two or more views."""
+
+    def __init__(self, params: Limbs3DParams, rng: np.random.Generator, cameras: Mapping[str, Camera],
+                 init: pd.DataFrame | None = None, backgrounds: Mapping[str, np.ndarray] | None = None):
+        self.params = params
+        self.rng = rng
+        self.streams = list(cameras)
+        self.cameras = [cameras[s] for s in self.streams]
+        self.plates = {s: self._half(b) for s, b in (backgrounds or {}).items() if b is not None}
+        self.skin = SkinModel.default()
+        self.machine = LimbStateMachine(params)
+        self.targets: dict[int, _Target] = {}
+        self.pending: dict[int, _Target] = {}
+        self._next = 0
+        self.last: dict = {}  # the latest frame's candidates, priors and raw errors (training, the app)
+        if init is not None and len(init):
+            self._from_init(init)
+
+    # -- starting targets -----------------------------------------------------------------
+    def _from_init(self, init: pd.DataFrame) -> None:
+        rows = init[init["part"].isin(LIMB_PARTS)]
+        for (tid, part), g in rows.groupby(["track_id", "part"], sort=True):
+            first = int(g["frame"].min())
+            g = g[g["frame"] == first]
+            xyz = g[["X", "Y", "Z"]].to_numpy(float) if {"X", "Y", "Z"} <= set(g.columns) else np.zeros((0, 3))
+            xyz = xyz[np.isfinite(xyz).all(axis=1)] if len(xyz) else xyz
+            if len(xyz):
+                point = xyz.mean(axis=0)
+            else:
+                views = [(self.cameras[self.streams.index(r.camera)], (r.x + r.w / 2, r.y + r.h / 2))
+                         for r in g.itertuples() if getattr(r, "camera", "") in self.streams]
+                if len(views) < 2:
+                    raise ValueError(f"init track {tid} {part}: needs X,Y,Z or boxes in two or more views "
+                                     f"(has {len(views)})")
+                point = triangulate([v[0] for v in views], [v[1] for v in views])
+            self._add(int(tid), str(part), first, point, LimbState.NORMAL)
+
+    def _add(self, track_id: int, part: str, frame: int, point, state: LimbState) -> int:
+        key = self._next
+        self._next += 1
+        self.targets[key] = _Target(track_id, part, None, frame, np.asarray(point, float),
+                                    labelled=state == LimbState.NORMAL)
+        self.machine.add(key, LimbState.UNINITIALIZED if state == LimbState.NORMAL else state)
+        if state == LimbState.NORMAL:  # an init target: normal from its first frame
+            self.machine._status[key].state = LimbState.NORMAL
+        return key
+
+    # -- 1. observations per view (sec. 6.1-6.2) -----------------------------------------------
+    @staticmethod
+    def _half(image: np.ndarray) -> np.ndarray:
+        """Silhouettes are found at half resolution (a 2 x 2 area average also halves the noise)."""
+        return cv2.resize(image, (image.shape[1] // 2, image.shape[0] // 2), interpolation=cv2.INTER_AREA)
+
+    def _silhouette(self, stream: str, color: np.ndarray, foreground) -> np.ndarray:
+        """``(H/2, W/2) uint8`` 0/1 person mask of one view."""
+        plate = self.plates.get(stream)
+        h, w = color.shape[0] // 2, color.shape[1] // 2
+        if plate is not None and plate.shape == (h, w, 3):
+            diff = cv2.absdiff(self._half(color), plate)
+            b, g, r = cv2.split(diff)
+            sil = cv2.threshold(cv2.max(cv2.max(b, g), r), self.params.plate_threshold, 1, cv2.THRESH_BINARY)[1]
+            return cv2.morphologyEx(sil, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+        if foreground is None:
+            return np.zeros((h, w), np.uint8)
+        return cv2.resize((np.asarray(foreground) > 0).astype(np.uint8), (w, h), interpolation=cv2.INTER_NEAREST)
+
+    def _support(self, camera: Camera, shape) -> np.ndarray:
+        """Discs around the projections of the tracked targets (skin counts there even outside the
+        silhouette: a person who sits still fades into an adaptive background model)."""
+        mask = np.zeros(shape, np.uint8)
+        for key, t in self.targets.items():
+            if self.machine.state(key) == LimbState.UNINITIALIZED or t.position is None:
+                continue
+            uv, r = self._project(camera, t)
+            if np.all(np.isfinite(uv)):
+                cv2.circle(mask, (int(uv[0]), int(uv[1])), int(max(self.params.support_scale * r, 3)), 1, -1)
+        return mask
+
+    def _project(self, camera: Camera, t: _Target) -> tuple[np.ndarray, float]:
+        cam = camera.to_camera(t.position[None])[0]
+        size = self.params.head_size_mm if t.part == "head" else self.params.hand_size_mm
+        return camera.project(t.position[None])[0], 0.5 * camera.K[0, 0] * size / max(cam[2], 1.0)
+
+    def observe(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]):
+        p = self.params
+        people = max(1, len({t.track_id for t in self.targets.values()}))
+        centres, views = [], []
+        for stream, cam in zip(self.streams, self.cameras):
+            view = frames.views.get(stream)
+            if view is None or view.color is None:
+                h, w = cam.size[1], cam.size[0]
+                centres.append(np.zeros((0, 2)))
+                views.append(observe_view(np.zeros((h, w), np.uint8), np.zeros((0, 2))))
+                continue
+            sil = self._silhouette(stream, view.color, foreground.get(stream))
+            H, W = view.color.shape[:2]
+            allowed = cv2.resize(cv2.dilate(sil, np.ones((3, 3), np.uint8)), (W, H), interpolation=cv2.INTER_NEAREST)
+            if stream not in self.plates:  # an adaptive background may have absorbed a still person
+                allowed = np.maximum(allowed, self._support(cam, (H, W)))
+            skin = np.zeros((H, W), np.uint8)
+            x, y, w, h = cv2.boundingRect(allowed)
+            if w > 0 and h > 0:  # skin is looked for only where people are (the costly part)
+                pad = self.skin.blur
+                x0, y0, x1, y1 = max(x - pad, 0), max(y - pad, 0), min(x + w + pad, W), min(y + h + pad, H)
+                crop = self.skin.mask(view.color[y0:y1, x0:x1], allowed[y0:y1, x0:x1], p.skin_threshold)
+                skin[y0:y1, x0:x1] = crop
+            blobs = find_blobs(skin, people, p.blob_alpha, p.blob_min_area)
+            centres.append(blobs.centres)
+            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0))
+        return centres, views
+
+    # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
+    def candidates(self, centres, views):
+        cands = pair_candidates(self.cameras, centres)
+        prior, raw = candidate_prior(cands, self.cameras, views, self.params)
+        points, weights = prune_and_merge(cands.points, prior.value, self.params)
+        self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights}
+        return points, weights
+
+    # -- 3-4. one frame -------------------------------------------------------------------------
+    def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
+        p = self.params
+        index = frames.index
+        centres, views = self.observe(frames, foreground)
+        points, weights = self.candidates(centres, views)
+        m = self.machine
+        # targets whose init frame is now come alive
+        for key, t in self.targets.items():
+            if t.filter is None and t.start_frame <= index and m.state(key) == LimbState.NORMAL:
+                t.filter = TargetFilter(t.position, p, self.rng)
+        active = [k for k, t in self.targets.items() if t.filter is not None and m.is_leader(k)
+                  and m.state(k) != LimbState.UNINITIALIZED]
+        # predict
+        for k in active:
+            t = self.targets[k]
+            state = m.state(k)
+            if state == LimbState.LOST:
+                t.filter.reset(t.position, p.lost_search)
+            else:
+                t.filter.predict(p.combined_noise_scale if state == LimbState.COMBINED else 1.0)
+        # exclusive use of candidates: each goes to the nearest predicted target (a combined pair
+        # counts as one), unless it is about as near to several
+        preds = np.array([self.targets[k].filter.estimate for k in active]).reshape(-1, 3)
+        if len(points) and len(active):
+            dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
+        observations: dict[int, Observation] = {}
+        for a, k in enumerate(active):
+            t = self.targets[k]
+            if len(points) and len(active) > 1:
+                others = np.delete(dist, a, axis=1).min(axis=1)
+                mine = dist[:, a] <= p.exclusive_ratio * others
+            else:
+                mine = np.ones(len(points), bool)
+            est = t.filter.update(points[mine], weights[mine])
+            t.position = est
+            obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
+            if m.state(k) == LimbState.COMBINED:
+                obs["modes"] = self._modes(est, points[mine], weights[mine])
+            observations[k] = Observation(**obs)
+            partner = m.partner(k)
+            if partner is not None and m.state(k) == LimbState.COMBINED:
+                self.targets[partner].position = est
+                observations[partner] = Observation(position=tuple(est), likelihood=t.filter.confidence,
+                                                    labelled=True)
+        for tr in m.update(index, observations):
+            t = self.targets[tr.tracker]
+            if tr.new == LimbState.UNLABELLED and tr.reason == "split":
+                t.position = np.asarray(tr.position, float)
+                if t.filter is None:
+                    t.filter = TargetFilter(t.position, p, self.rng)
+                else:
+                    t.filter.reset(t.position)
+                t.labelled = True  # the direction cue (sec. 7.1) keeps its label
+            elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
+                pass  # the leader's filter tracks both
+        return self._records(index)
+
+    def _modes(self, est, points, weights) -> tuple:
+        """The combined posterior's two strongest modes: the strongest candidate near the filter,
+        then the strongest at least ``combine_distance`` from it."""
+        p = self.params
+        if len(points) == 0:
+            return ()
+        near = np.linalg.norm(points - est, axis=1) < p.mode_search * p.split_distance
+        pts, w = points[near], weights[near]
+        if len(pts) < 2:
+            return tuple(map(tuple, pts))
+        order = np.argsort(-w, kind="stable")
+        first = pts[order[0]]
+        rest = [i for i in order[1:] if np.linalg.norm(pts[i] - first) >= p.combine_distance]
+        return (tuple(first),) if not rest else (tuple(first), tuple(pts[rest[0]]))
+
+    # -- 5. output ------------------------------------------------------------------------------
+    def _records(self, index: int) -> list[TrackRecord]:
+        out = []
+        for key, t in self.targets.items():
+            state = self.machine.state(key)
+            if state == LimbState.UNINITIALIZED or t.position is None or t.start_frame > index:
+                continue
+            conf = self.targets[key].filter.confidence if t.filter is not None else 0.0
+            X, Y, Z = (float(v) for v in t.position)
+            for stream, cam in zip(self.streams, self.cameras):
+                uv, r = self._project(cam, t)
+                out.append(TrackRecord(index, t.track_id, t.part, Box(float(uv[0] - r), float(uv[1] - r),
+                                                                      float(2 * r), float(2 * r)),
+                                       score=round(conf, 4), state=state.value, camera=stream, X=X, Y=Y, Z=Z))
+        return out
+
+    def table(self, records: list[TrackRecord]) -> pd.DataFrame:
+        return records_to_frame(records) if records else empty_tracks()

@@ -1,0 +1,140 @@
+"""One person's particle filter (Migniot & Ababsa sec. 2.2-2.4).
+
+Each frame runs the paper's four steps in its order: resampling, propagation, weighting,
+estimation. With ``mode="part"`` every particle carries one weight per weighting part (eq. 3);
+each part's degrees of freedom are resampled by that part's weights and then shuffled by a
+random permutation ``f_p`` (eq. 4), so that a good arm of one particle meets a good torso of
+another. With ``mode="global"`` a particle has one weight and is resampled whole.
+
+Shapes: ``particles (N, 17) float64`` (:data:`partlab.tracking.topview.model.DOF` order);
+``weights (N, 5)`` normalised per part (every column the same in global mode).
+
+*Survival rate* (sec. 3, Fig. 7), which the paper does not define: the number of distinct
+particles a part's resampling keeps, divided by ``N`` (1 = every particle survives: flat weights;
+low = a few particles win: a sharp likelihood). In global mode all parts share one rate.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from partlab.tracking.core.resampling import systematic_resample
+from partlab.tracking.topview.likelihood import bhattacharyya, free_space, nearest, weigh
+from partlab.tracking.topview.model import JOINT_LIMITS, N_DOF, N_PARTS, PART_DOFS, WEIGHT_PARTS, Body, primitives
+from partlab.tracking.topview.params import TopViewParams
+
+_PART_SLICES = [np.array(PART_DOFS[p]) for p in WEIGHT_PARTS]
+_YAW = 3
+
+
+def noise_scales(p: TopViewParams) -> np.ndarray:
+    """``(17,)`` per-frame propagation standard deviation of each degree of freedom."""
+    d = p.dynamics
+    arm = [*d.shoulder, *d.elbow]
+    return np.array([d.position_mm] * 3 + [d.yaw, d.bend, d.neck, d.neck] + arm + arm)
+
+
+class PersonFilter:
+    """The particle filter of one person, started around ``state`` (``(17,)``, or ``(S, 17)``
+    hypotheses split evenly among the particles)."""
+
+    def __init__(self, params: TopViewParams, rng: np.random.Generator, body: Body, state: np.ndarray,
+                 spread: float = 1.0):
+        self.params = params
+        self.rng = rng
+        self.body = body
+        n = params.resampling.n_particles
+        starts = np.atleast_2d(np.asarray(state, np.float64))
+        self.scales = noise_scales(params)
+        self.particles = starts[np.arange(n) % len(starts)] + spread * self.scales * rng.standard_normal((n, N_DOF))
+        self._clip()
+        self.weights = np.full((n, N_PARTS), 1.0 / n)
+        self.estimate = starts[0].copy()
+        self.survival = np.ones(N_PARTS)
+        self.reference: np.ndarray | None = None  # (5, bins) colour histograms of the estimate
+
+    @property
+    def n(self) -> int:
+        return len(self.particles)
+
+    def _clip(self) -> None:
+        np.clip(self.particles, JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1], out=self.particles)
+
+    # -- 1. resampling (eq. 4) ----------------------------------------------------------------
+    def resample(self) -> None:
+        n = self.n
+        if self.params.resampling.mode == "global":
+            idx = systematic_resample(self.weights[:, 0], n, self.rng)
+            self.particles = self.particles[idx]
+            self.survival[:] = len(np.unique(idx)) / n
+            return
+        new = np.empty_like(self.particles)
+        for p, dofs in enumerate(_PART_SLICES):
+            idx = systematic_resample(self.weights[:, p], n, self.rng)
+            self.survival[p] = len(np.unique(idx)) / n
+            idx = idx[self.rng.permutation(n)]  # f_p: recombine parts across particles
+            new[:, dofs] = self.particles[idx][:, dofs]
+        self.particles = new
+
+    # -- 2. propagation -----------------------------------------------------------------------
+    def propagate(self) -> None:
+        self.particles += self.scales * self.rng.standard_normal(self.particles.shape)
+        self._clip()
+
+    # -- 3. weighting (eq. 1-3) ----------------------------------------------------------------
+    def weigh(self, points: np.ndarray, bins: np.ndarray | None, n_bins: int, depth: np.ndarray | None = None,
+              camera=None) -> None:
+        lk = self.params.likelihood
+        use_colour = bins is not None and self.reference is not None
+        prims = primitives(self.particles, self.body)
+        sums, counts, hist = weigh(points, prims, bins if use_colour else None, n_bins)
+        bh = bhattacharyya(hist, self.reference[None]) if use_colour else np.zeros_like(sums)
+        free = np.zeros_like(sums)
+        if lk.free_space_weight > 0 and depth is not None and camera is not None:
+            free = free_space(prims, depth, camera, lk.free_space_cap_mm)
+        if self.params.resampling.mode == "global":
+            d = sums.sum(1) / np.maximum(counts.sum(1), 1.0)
+            cost = (d + lk.free_space_weight * free.mean(1)) / lk.distance_scale_mm + lk.colour_weight * bh.sum(1)
+            cost = np.repeat(cost[:, None], N_PARTS, 1)
+        else:
+            # a part's mean over the points nearest it (eq. 3), shrunk towards the whole model's
+            # mean by ``prior_points`` pseudo-points: a part few points are nearest to (the torso
+            # under the shoulders, an arm in the air) is judged by the whole model, not by chance
+            whole = sums.sum(1, keepdims=True) / np.maximum(counts.sum(1, keepdims=True), 1.0)
+            d = (sums + lk.prior_points * whole) / (counts + lk.prior_points)
+            cost = (d + lk.free_space_weight * free) / lk.distance_scale_mm + lk.colour_weight * bh
+        w = np.exp(-(cost - cost.min(0)))
+        self.weights = w / w.sum(0)
+
+    # -- 4. estimation -------------------------------------------------------------------------
+    def estimate_state(self) -> np.ndarray:
+        est = np.empty(N_DOF)
+        for p, dofs in enumerate(_PART_SLICES):
+            w = self.weights[:, p]
+            est[dofs] = w @ self.particles[:, dofs]
+        w = self.weights[:, WEIGHT_PARTS.index("torso")]
+        yaw = self.particles[:, _YAW]
+        est[_YAW] = np.arctan2(w @ np.sin(yaw), w @ np.cos(yaw))  # a circular mean
+        self.estimate = est
+        return est
+
+    def step(self, points: np.ndarray, bins: np.ndarray | None = None, n_bins: int = 0,
+             depth: np.ndarray | None = None, camera=None) -> np.ndarray:
+        """One frame with this person's ROI points ``(M, 3)`` (and their colour bins ``(M,)``;
+        ``depth``/``camera``: the frame's depth image and calibration for the free-space check)."""
+        self.resample()
+        self.propagate()
+        self.weigh(points, bins, n_bins, depth, camera)
+        est = self.estimate_state()
+        if bins is not None:
+            self.update_reference(points, bins, n_bins)
+        return est
+
+    def update_reference(self, points: np.ndarray, bins: np.ndarray, n_bins: int) -> None:
+        """Sec. 2.3.2: each part's histogram of the estimate, compared with at the next frame."""
+        if not len(points):
+            return
+        _, part = nearest(points, primitives(self.estimate[None], self.body)[0])
+        ref = np.zeros((N_PARTS, n_bins))
+        np.add.at(ref, (part, bins), 1.0)
+        self.reference = ref

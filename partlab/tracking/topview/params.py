@@ -1,0 +1,145 @@
+"""Every tunable number of the top-view tracker (Migniot & Ababsa), grouped by what it tunes.
+
+The paper gives the model, the likelihoods and the resampling but almost no numbers; each default
+here says where it comes from. Distances are millimetres, angles radians, per frame at 25 fps.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from partlab.tracking.core.params import (
+    FRACTION,
+    POSITIVE,
+    POSITIVE_COUNT,
+    Parameters,
+    flag,
+    group_field,
+    mapping,
+    number,
+    pair,
+)
+
+
+@dataclass(frozen=True)
+class RoiParams:
+    """Sec. 2.1: the region of interest is the depth pixels high enough above the floor to be a
+    torso, arm or head. Hands hang at about 0.45 of a person's height (720 mm for 1.6 m), a low
+    basket or shelf board stays below 650 mm; the sensor measures 0.8..3.5 m (sec. 3)."""
+
+    min_height_mm: float = number(650.0)
+    max_height_mm: float = number(2400.0)
+    min_depth_mm: float = number(800.0)
+    max_depth_mm: float = number(3500.0)
+    #: points per person given to the likelihood each frame, drawn at random from its ROI pixels
+    #: (a person covers 3-6 thousand pixels at 320x240; 500 keep eq. 1's mean within ~2 mm of
+    #: all of them and the frame within budget)
+    max_points: int = number(500, POSITIVE_COUNT)
+
+
+@dataclass(frozen=True)
+class DynamicsParams:
+    """Random-walk propagation (sec. 2.2): per-frame standard deviations of each group of degrees
+    of freedom. Arms move fastest (a reaching hand about 50 mm a frame), the pelvis slowest."""
+
+    position_mm: float = number(12.0)
+    yaw: float = number(0.04)
+    bend: float = number(0.03)
+    neck: float = number(0.06)
+    shoulder: tuple[float, float, float] = pair((0.10, 0.08, 0.10), n=3)  # flexion, abduction, twist
+    elbow: tuple[float, float] = pair((0.12, 0.10))               # flexion, twist
+
+
+@dataclass(frozen=True)
+class LikelihoodParams:
+    """Eq. (1)-(2): ``omega = exp(-(d_ch / distance_scale_mm + colour_weight * d_bh))``.
+
+    The text writes ``exp(d)`` (the minus sign was lost) and gives no scale: 10 mm is the size of
+    the differences between good and poor particles (a depth point on a misplaced forearm is
+    30-80 mm off), so weights spread over about one e-fold per centimetre."""
+
+    distance_scale_mm: float = number(5.0, POSITIVE)
+    #: pseudo-points of the whole model's mean distance added to each part's mean (eq. 3): a
+    #: part with 20 points of its own is judged half by them, one with 200 almost only by them
+    prior_points: float = number(20.0)
+    use_colour: bool = flag(True)
+    #: weight of the summed Bhattacharyya distances; a distance of 0.1 (a clearly different
+    #: histogram) then costs as much as 5 mm of eq. 1
+    colour_weight: float = number(0.5)
+    #: partlab's free-space check (:func:`partlab.tracking.topview.likelihood.free_space`): the
+    #: weight of a part's mean violation in the cost (0: the paper's eq. 1-2 alone) and its cap
+    #: (a misplaced arm over the floor costs ``cap`` at most, as much as a point 100 mm off)
+    free_space_weight: float = number(0.5)
+    free_space_cap_mm: float = number(100.0)
+    #: colour histogram: levels per BGR channel (4 -> 64 bins: enough for clothes vs skin vs hair)
+    colour_levels: int = number(4, POSITIVE_COUNT)
+
+
+@dataclass(frozen=True)
+class ResamplingParams:
+    """Sec. 2.4: ``part`` weighs and resamples each of Table 1's five parts on its own and
+    shuffles them (eq. 3-4); ``global`` resamples whole particles by one weight (the "3D model")."""
+
+    mode: str = "part"
+    n_particles: int = number(200, POSITIVE_COUNT)
+
+    def check(self, path: str) -> None:
+        if self.mode not in ("part", "global"):
+            raise ValueError(f"{path}.mode: must be 'part' or 'global', got {self.mode!r}")
+        if self.n_particles < 2:
+            raise ValueError(f"{path}.n_particles: must be at least 2, got {self.n_particles}")
+
+
+@dataclass(frozen=True)
+class ExclusionParams:
+    """Eq. (5): each ROI point goes to the person whose predicted model is nearest; points
+    farther than this from every model belong to nobody (a newcomer, an object)."""
+
+    max_assign_mm: float = number(250.0)
+
+
+@dataclass(frozen=True)
+class StartParams:
+    """Automatic start from the ROI and dropping lost people.
+
+    A blob of unassigned ROI pixels covering at least ``min_person_fraction`` of the image starts
+    a person (one person at 2.9 m covers 3-6 % of a Kinect picture); its highest point is the top
+    of the head. A person with fewer than ``min_points`` points for ``lost_after`` frames is dropped."""
+
+    min_person_fraction: float = number(0.012, FRACTION)
+    head_band_mm: float = number(120.0)
+    #: a blob's highest point starts a person only this high (1.2 m: a child's head, above any
+    #: arm a grown-up holds at the side); the person is what lies this close to it, seen from
+    #: above (a torso's half diagonal plus a bent arm)
+    min_head_height_mm: float = number(1200.0)
+    person_radius_mm: float = number(450.0)
+    #: height from the top of a head down to the lowest point around it: at least the head and
+    #: neck (about 270 mm) plus the shoulders' slope; a forearm held level spans less
+    min_person_span_mm: float = number(350.0)
+    min_points: int = number(80, POSITIVE_COUNT)
+    lost_after: int = number(10, POSITIVE_COUNT)
+
+
+@dataclass(frozen=True)
+class OutputParams:
+    """The joints' image boxes: a square this many mm across at the joint's depth."""
+
+    joint_box_mm: dict[str, float] = mapping(lambda: {
+        "head": 190.0, "right_shoulder": 120.0, "left_shoulder": 120.0, "right_elbow": 110.0,
+        "left_elbow": 110.0, "right_hand": 160.0, "left_hand": 160.0}, rule=POSITIVE)
+
+
+@dataclass(frozen=True)
+class TopViewParams(Parameters):
+    """All of the top-view tracker's parameters (registry key ``topview``)."""
+
+    KEY: ClassVar[str] = "topview"
+
+    roi: RoiParams = group_field(RoiParams)
+    dynamics: DynamicsParams = group_field(DynamicsParams)
+    likelihood: LikelihoodParams = group_field(LikelihoodParams)
+    resampling: ResamplingParams = group_field(ResamplingParams)
+    exclusion: ExclusionParams = group_field(ExclusionParams)
+    start: StartParams = group_field(StartParams)
+    output: OutputParams = group_field(OutputParams)

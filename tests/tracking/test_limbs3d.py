@@ -1,0 +1,125 @@
+"""The multi-camera tracker's geometry, priors, merging, 3D state machine and a short run."""
+
+import cv2
+import numpy as np
+import pytest
+
+from partlab.labelling.synth.multiview import look_at, make_multiview_scene
+from partlab.tracking.frame import Frame, FrameSet
+from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
+from partlab.tracking.limbs3d.geometry import midpoints, pair_candidates
+from partlab.tracking.limbs3d.params import Limbs3DParams
+from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.limbs3d.tracker import Limbs3DTracker, triangulate
+
+
+def _two_cameras():
+    a = look_at("cam0", [3000.0, 0.0, 2200.0], [0.0, 0.0, 1000.0], 550.0, (640, 480))
+    b = look_at("cam1", [0.0, -3000.0, 2000.0], [0.0, 0.0, 1000.0], 600.0, (640, 480))
+    return a, b
+
+
+def test_midpoint_of_skew_lines_known_by_hand():
+    # the x axis and the line x = 0, z = 10 along y: the common perpendicular is the z axis 0..10
+    z, d = midpoints(np.array([[5.0, 0, 0]]), np.array([[1.0, 0, 0]]), np.array([[0, 3.0, 10]]),
+                     np.array([[0, 1.0, 0]]))
+    np.testing.assert_allclose(z[0], [0, 0, 5], atol=1e-9)
+    assert d[0] == pytest.approx(5.0)
+
+
+def test_midpoint_agrees_with_cv2_triangulate_points():
+    rng = np.random.default_rng(0)
+    a, b = _two_cameras()
+    X = rng.uniform([-600, -600, 600], [600, 600, 1800], (50, 3))
+    ua = a.project(X) + rng.normal(0, 0.7, (50, 2))
+    ub = b.project(X) + rng.normal(0, 0.7, (50, 2))
+    pa, va = a.centre[None].repeat(50, 0), a.rays(ua)
+    pb, vb = b.centre[None].repeat(50, 0), b.rays(ub)
+    z, d = midpoints(pa, va, pb, vb)
+    h = cv2.triangulatePoints(a.P, b.P, ua.T, ub.T)
+    cv = (h[:3] / h[3]).T
+    assert np.max(np.linalg.norm(z - cv, axis=1)) < 10.0  # within 1 cm (DESIGN: they agree within 1 cm)
+    assert np.median(np.linalg.norm(z - X, axis=1)) < 8.0
+    assert 0 < np.median(d) < 5.0
+    # noise-free: both exact
+    z0, d0 = midpoints(pa, a.rays(a.project(X)), pb, b.rays(b.project(X)))
+    np.testing.assert_allclose(z0, X, atol=1e-6)
+    assert np.max(d0) < 1e-6
+    np.testing.assert_allclose(triangulate([a, b], [a.project(X[:1]), b.project(X[:1])]), X[0], atol=1e-4)
+
+
+def test_true_pairs_get_a_high_prior_and_false_pairs_a_low_one():
+    a, b = _two_cameras()
+    X = np.array([[0.0, 0.0, 1600.0], [350.0, -250.0, 1000.0]])  # a head and a hand
+    params = Limbs3DParams()
+    views, centres = [], []
+    for cam in (a, b):
+        uv = cam.project(X)
+        sil = np.zeros((480, 640), np.uint8)
+        for (u, v), r in zip(uv, (25, 10)):
+            cv2.circle(sil, (int(u), int(v)), r, 1, -1)
+        foot = cam.project(np.array([[0.0, 0.0, 0.0]]))[0]
+        cv2.line(sil, tuple(map(int, uv[0])), tuple(map(int, foot)), 1, 30)  # the body below the head
+        centres.append(uv)
+        views.append(observe_view(sil, uv))
+    cands = pair_candidates([a, b], centres)
+    assert len(cands) == 4  # eq. 18: 2 x 2
+    prior, raw = candidate_prior(cands, [a, b], views, params)
+    true = cands.blobs[:, 0] == cands.blobs[:, 1]
+    assert np.all(prior.value[true] > 0.9)
+    assert np.all(prior.value[~true] < 0.1)
+    np.testing.assert_allclose(cands.points[true][np.argsort(cands.blobs[true, 0])], X, atol=1e-6)
+    assert np.all(raw["d"][~true] > 100)  # a false pair's lines of sight pass far apart here
+
+
+def test_prune_and_merge_drops_weak_and_merges_close_candidates():
+    params = Limbs3DParams(merge_distance=45.0, merge_boost=0.5, prior_threshold=0.1)
+    pts = np.array([[0.0, 0, 1000], [20.0, 0, 1000], [300.0, 0, 1000], [600.0, 0, 1000], [0, 0, -50]])
+    pr = np.array([0.6, 0.3, 0.5, 0.05, 0.9])
+    out, w = prune_and_merge(pts, pr, params)
+    assert len(out) == 2  # the weak one and the one under the floor are gone, two merged
+    np.testing.assert_allclose(w, [0.75, 0.5])  # 0.6 + 0.5 * 0.3
+    np.testing.assert_allclose(out[0], [20 / 3, 0, 1000])  # prior-weighted mean (merge_average)
+    out, w = prune_and_merge(pts, pr, Limbs3DParams(merge_average=False))
+    np.testing.assert_allclose(out[0], [0, 0, 1000])  # the paper: the stronger point is kept
+
+
+def test_state_machine_combines_and_splits_3d_targets_by_direction():
+    m = LimbStateMachine(Limbs3DParams(combine_distance=80.0, split_distance=120.0))
+    for t in (0, 1):
+        m.add(t, LimbState.UNLABELLED)
+        m._status[t].state = LimbState.NORMAL
+    # two hands approach along x (0 on the left), join, and part again
+    for f, gap in enumerate((400, 300, 200, 100, 60)):
+        m.update(f, {0: Observation((-gap / 2, 0.0, 1000.0), 0.9), 1: Observation((gap / 2, 0.0, 1000.0), 0.9)})
+    assert m.state(0) == m.state(1) == LimbState.COMBINED
+    # the modes part: the one at +x is listed first, the left tracker must still get the left mode
+    out = m.update(5, {0: Observation((0.0, 0.0, 1000.0), 0.9, modes=((90.0, 0.0, 1000.0), (-90.0, 0.0, 1000.0)))})
+    split = {t.tracker: t.position for t in out if t.reason == "split"}
+    assert split[0][0] == -90.0 and split[1][0] == 90.0
+
+
+def test_tracker_follows_head_and_hands_of_a_standing_person():
+    scene = make_multiview_scene("standing", 4, seed=4, n_frames=25)
+    cams = {c.name: c for c in scene.cameras}
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(0), cams, init=scene.init,
+                        backgrounds=scene.backgrounds)
+    recs = []
+    for i in range(25):
+        views = {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}
+        recs += tr.step(FrameSet(i, views), {c: None for c in cams})
+    df = tr.table(recs)
+    assert set(df["camera"]) == set(cams)  # a box in every view
+    est = df.drop_duplicates(["frame", "track_id", "part"]).merge(scene.truth3d, on=["frame", "track_id", "part"])
+    err = np.linalg.norm(est[["X_x", "Y_x", "Z_x"]].to_numpy() - est[["X_y", "Y_y", "Z_y"]].to_numpy(), axis=1)
+    est["err"] = err
+    med = est.groupby("part")["err"].median()
+    assert med["head"] < 80  # the face's centroid lies ~4-5 cm before the head's centre
+    assert med["left_hand"] < 40 and med["right_hand"] < 40
+    # the back-projected box of the head in each view overlaps the true head box
+    t = scene.truth[(scene.truth["frame"] == 24) & (scene.truth["part"] == "head")].set_index("camera")
+    d = df[(df["frame"] == 24) & (df["part"] == "head")].set_index("camera")
+    for cam in cams:
+        cx, cy = d.loc[cam, "x"] + d.loc[cam, "w"] / 2, d.loc[cam, "y"] + d.loc[cam, "h"] / 2
+        r = t.loc[cam]
+        assert r.x <= cx <= r.x + r.w and r.y <= cy <= r.y + r.h
