@@ -7,6 +7,7 @@ instead of filling memory or disk. Each is configurable by an environment variab
 | frames per clip | ``PARTLAB_MAX_FRAMES`` | 360 000 | four hours at 25 fps |
 | rows of a tracks CSV | ``PARTLAB_MAX_CSV_ROWS`` | 20 000 000 | 8 people x 6 parts x four hours at 25 fps is 17 M |
 | coordinates | ``PARTLAB_MAX_COORD`` | 1 000 000 px | far beyond any frame; larger numbers are typos or attacks |
+| bytes of one model bundle array | ``PARTLAB_MAX_BUNDLE_ARRAY_BYTES`` | 256 MiB | a failure SVM of 100 000 support vectors x 40 features is 32 MB; checked from the .npy header before reading |
 
 Ids (``track_id``) and frame indexes must fit a signed 32-bit integer (the store's column type).
 """
@@ -43,6 +44,10 @@ def max_frames() -> int:
 
 def max_csv_rows() -> int:
     return int(_env("PARTLAB_MAX_CSV_ROWS", 20_000_000))
+
+
+def max_bundle_array_bytes() -> int:
+    return int(_env("PARTLAB_MAX_BUNDLE_ARRAY_BYTES", 256 * 2**20))
 
 
 def max_coord() -> float:

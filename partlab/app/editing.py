@@ -17,6 +17,7 @@ from partlab.labelling import trackops
 from partlab.labelling.store import StaleEditError, Store, StoreError
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import BODY_PARTS
+from partlab.tracking.tracks import TracksCSVError, check_value
 
 
 @dataclass
@@ -61,8 +62,21 @@ class ApplyResult:
 
 
 def _box(values) -> Box:
-    x, y, w, h = (float(v) for v in values)
-    return Box(x, y, max(w, 0.0), max(h, 0.0))
+    """The box of an editor event, by the tracks CSV's rules (finite, in range, no negative size)."""
+    if not isinstance(values, (list, tuple)) or len(values) != 4:
+        raise StoreError(f"a box is [x, y, w, h], got {str(values)[:60]}")
+    try:
+        x, y, w, h = (check_value(c, v, f"box {c}") for c, v in zip("xywh", values))
+    except TracksCSVError as exc:
+        raise StoreError(f"Not a usable box: {exc}") from None
+    return Box(x, y, w, h)
+
+
+def _flag(value) -> bool:
+    try:
+        return check_value("failure", value, "failure")
+    except TracksCSVError as exc:
+        raise StoreError(str(exc)) from None
 
 
 def _write(store: Store, clip_id: int, changes: list[dict], author: str) -> tuple[list, list, list]:
@@ -160,7 +174,7 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 change = dict(frame=frame, track_id=tid, part=part, expected_revision=int(expected),
                               box=_box(ev["box"]) if kind == "edit" else None)
                 if kind == "edit":
-                    change.update(failure=bool(ev.get("failure")), occluded=float(ev.get("occluded") or 0.0))
+                    change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
                 record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
                        author=author, fill=fill and kind == "edit")
                 res.written += 1

@@ -20,6 +20,7 @@ from pathlib import Path
 import pandas as pd
 
 from partlab.errors import UserError
+from partlab.limits import MAX_ID
 
 KINDS: tuple[str, ...] = ("clap", "handshake", "exchange", "pick", "place", "hand_head")
 REQUIRED: tuple[str, ...] = ("start_frame", "end_frame", "kind")
@@ -51,6 +52,8 @@ def read_events(path: str | PathLike) -> pd.DataFrame:
                 raise EventsError(f"{p} line {i}, column '{col}': {v!r} is not a frame number") from None
             if not math.isfinite(f) or f < 0 or not f.is_integer():
                 raise EventsError(f"{p} line {i}, column '{col}': {v!r} is not a frame number")
+            if f > MAX_ID:
+                raise EventsError(f"{p} line {i}, column '{col}': {v!r} is larger than the limit of {MAX_ID}")
         if int(float(row.start_frame)) > int(float(row.end_frame)):
             raise EventsError(f"{p} line {i}: start_frame {row.start_frame} is after end_frame {row.end_frame}")
         if row.kind not in KINDS:

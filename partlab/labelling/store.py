@@ -17,6 +17,7 @@ saw; if someone else has written since, :class:`StaleEditError` refuses the writ
 from __future__ import annotations
 
 import json
+import os
 import threading
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -42,7 +43,8 @@ from sqlalchemy import (
     select,
     update,
 )
-from sqlalchemy.exc import IntegrityError
+from sqlalchemy.engine import make_url
+from sqlalchemy.exc import IntegrityError, OperationalError
 from sqlalchemy.orm import DeclarativeBase, Mapped, Session, mapped_column
 
 from partlab.labelling import migrations
@@ -50,7 +52,7 @@ from partlab.labelling.config import data_dir, database_url
 from partlab.labelling.video import probe, store_by_hash
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import check_part
-from partlab.tracking.tracks import COLUMNS, normalise_tracks
+from partlab.tracking.tracks import COLUMNS, TracksCSVError, check_table, check_value, normalise_tracks
 
 
 class StoreError(ValueError):
@@ -359,6 +361,18 @@ _ENGINES: dict[str, object] = {}
 _ENGINES_LOCK = threading.Lock()
 
 
+def connect_timeout() -> int:
+    """Seconds to wait for a database server (``PARTLAB_DB_CONNECT_TIMEOUT``, default 5)."""
+    raw = os.environ.get("PARTLAB_DB_CONNECT_TIMEOUT", "5")
+    try:
+        value = int(raw)
+    except ValueError:
+        raise StoreError(f"PARTLAB_DB_CONNECT_TIMEOUT must be a whole number of seconds, got {raw!r}") from None
+    if value < 1:
+        raise StoreError(f"PARTLAB_DB_CONNECT_TIMEOUT must be at least 1, got {value}")
+    return value
+
+
 def _engine(url: str):
     """One engine per URL per process (Streamlit reruns must not open new pools)."""
     with _ENGINES_LOCK:
@@ -367,6 +381,8 @@ def _engine(url: str):
             kwargs = {}
             if url.startswith("sqlite"):
                 kwargs["connect_args"] = {"check_same_thread": False, "timeout": 30}
+            elif url.startswith("postgresql"):  # a server that never answers fails in seconds, not minutes
+                kwargs["connect_args"] = {"connect_timeout": connect_timeout()}
             eng = create_engine(url, **kwargs)
             if url.startswith("sqlite"):
                 @event.listens_for(eng, "connect")
@@ -382,8 +398,34 @@ def _engine(url: str):
             except migrations.SchemaError as exc:
                 eng.dispose()
                 raise StoreError(str(exc)) from None
+            except OperationalError as exc:
+                eng.dispose()
+                shown = make_url(url).render_as_string(hide_password=True)
+                reason = " ".join(str(getattr(exc, "orig", exc)).split())[:200]
+                raise StoreError(f"cannot reach the database {shown} within {connect_timeout()} s ({reason}); "
+                                 "check PARTLAB_DATABASE_URL and that the server is up") from None
             _ENGINES[url] = eng
         return eng
+
+
+def _check_edit(frame, track_id, part, box, failure, occluded, xyz) -> None:
+    """An edit by the tracks CSV's rules (finite, in range, int32, no negative sizes), refused with a
+    StoreError naming the box and the value before any revision is compared (a NaN is not "stale")."""
+    where = f"edit of {part} #{track_id} at frame {frame}"
+    values = {"frame": frame, "track_id": track_id}
+    if box is not None:
+        values.update(x=box.x, y=box.y, w=box.w, h=box.h)
+    if occluded is not None:
+        values["occluded"] = occluded
+    if failure is not None:
+        values["failure"] = failure
+    if xyz is not None and len(xyz) == 3:
+        values.update(X=xyz[0], Y=xyz[1], Z=xyz[2])
+    try:
+        for col, v in values.items():
+            check_value(col, v, f"{where}, {col}")
+    except TracksCSVError as exc:
+        raise StoreError(f"Not a usable box: {exc}") from None
 
 
 def _point(before: dict | None, camera: str | None, xyz) -> dict:
@@ -489,6 +531,10 @@ class Store:
         superseded by this run, so :meth:`undo_run` brings them back; human edits are never touched."""
         self.clip(clip_id)
         df = normalise_tracks(tracks)
+        try:  # the tracks CSV's rules: nothing is stored that partlab's own reader would refuse
+            check_table(df, f"tracker run of clip {clip_id}")
+        except TracksCSVError as exc:
+            raise StoreError(str(exc)) from None
         with self._session() as s:
             run = RunRow(clip_id=clip_id, tracker=tracker, bundle=str(bundle), seed=seed, start_frame=start_frame)
             s.add(run)
@@ -639,6 +685,8 @@ class Store:
         out = []
         with self._session() as s:
             for c in changes:
+                _check_edit(c["frame"], c["track_id"], c["part"], c.get("box"), c.get("failure"), c.get("occluded"),
+                            c.get("xyz"))
                 frame, track_id, part = int(c["frame"]), int(c["track_id"]), check_part(str(c["part"]))
                 kind = c.get("kind", "box")
                 if kind not in EDIT_KINDS:

@@ -40,6 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
+from partlab.limits import max_bundle_array_bytes
 from partlab.models.failure_svm import SVMFailureDetector, SVMModel
 from partlab.models.features import DEFAULT_DT
 from partlab.models.labels import SVM_NAMES
@@ -163,6 +164,8 @@ def _read_manifest(root: Path) -> dict:
         manifest = json.loads(mpath.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise BundleError(f"{mpath}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise BundleError(f"{mpath}: JSON nested too deeply") from None
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT_NAME:
         raise BundleError(f"{root}: not a partlab model bundle ({MANIFEST} does not say format {FORMAT_NAME!r})")
     version = manifest.get("version")
@@ -204,7 +207,35 @@ def _verify_files(root: Path, manifest: dict) -> dict[str, str]:
     return files
 
 
+def _check_array_sizes(path: Path) -> None:
+    """Refuse an ``.npz`` any of whose arrays (or members) is larger than
+    ``PARTLAB_MAX_BUNDLE_ARRAY_BYTES``, from the zip directory and each ``.npy`` header, before
+    any array is read (a small deflated file can hold a huge array of zeros)."""
+    limit = max_bundle_array_bytes()
+    try:
+        with zipfile.ZipFile(path) as zf:
+            for info in zf.infolist():
+                if info.file_size > limit + 4096:
+                    raise BundleError(f"{path}: member {info.filename} is {info.file_size} bytes uncompressed, over "
+                                      f"the limit of {limit} (set PARTLAB_MAX_BUNDLE_ARRAY_BYTES to change it)")
+                with zf.open(info) as f:
+                    version = np.lib.format.read_magic(f)
+                    if version == (1, 0):
+                        shape, _, dtype = np.lib.format.read_array_header_1_0(f)
+                    else:
+                        shape, _, dtype = np.lib.format.read_array_header_2_0(f)
+                nbytes = math.prod(int(n) for n in shape) * dtype.itemsize
+                if nbytes > limit:
+                    raise BundleError(f"{path}: array {info.filename} of shape {tuple(shape)} is {nbytes} bytes, over "
+                                      f"the limit of {limit} (set PARTLAB_MAX_BUNDLE_ARRAY_BYTES to change it)")
+    except BundleError:
+        raise
+    except Exception as exc:  # zip errors, truncated files, headers that are not .npy
+        raise BundleError(f"{path}: not a readable .npz file of plain arrays ({exc})") from None
+
+
 def _load_arrays(path: Path) -> dict[str, np.ndarray]:
+    _check_array_sizes(path)
     try:
         with np.load(path, allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in npz.files}
@@ -218,6 +249,8 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
     for k, a in arrays.items():
         if a.dtype.kind != "f":
             raise BundleError(f"{path}: array {k!r} has dtype {a.dtype}, expected floats")
+        if not np.isfinite(a).all():
+            raise BundleError(f"{path}: array {k!r} holds NaN or infinite values")
     return arrays
 
 
@@ -264,8 +297,8 @@ def load_bundle(path: str | PathLike) -> Bundle:
     _verify_files(root, manifest)
     try:
         body, limb, more = _read_params(manifest)
-    except (KeyError, TypeError, ValueError) as exc:
-        raise BundleError(f"{root / MANIFEST}: bad parameters ({exc})") from None
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, RecursionError) as exc:
+        raise BundleError(f"{root / MANIFEST}: bad parameters ({type(exc).__name__}: {str(exc)[:160]})") from None
     detector = None
     det = manifest.get("detector")
     if det is not None:
@@ -276,6 +309,12 @@ def load_bundle(path: str | PathLike) -> Bundle:
                     raise BundleError(f"{root / MANIFEST}: unknown SVM {name!r}")
                 if meta["file"] not in manifest["files"]:
                     raise BundleError(f"{root / MANIFEST}: SVM {name!r} file {meta['file']!r} is not in 'files'")
+                numbers = {k: float(meta[k] or 0.0) if k == "gamma" else float(meta[k])
+                           for k in ("intercept", "gamma", "threshold")}
+                bad = [k for k, v in numbers.items() if not math.isfinite(v)]
+                if bad:
+                    raise BundleError(f"{root / MANIFEST}: SVM {name!r} {bad[0]} is {meta[bad[0]]!r}, "
+                                      "not a finite number")
                 arrays = _load_arrays(root / meta["file"])
                 models[name] = SVMModel(
                     kernel=str(meta["kernel"]), intercept=float(meta["intercept"]),
@@ -285,13 +324,17 @@ def load_bundle(path: str | PathLike) -> Bundle:
             detector = SVMFailureDetector(models, dt=float(det.get("dt", DEFAULT_DT)),
                                           normalise=bool(det.get("normalise", True)),
                                           persist=int(det.get("persist", 1)))
-        except (KeyError, TypeError) as exc:
-            raise BundleError(f"{root / MANIFEST}: bad detector description ({exc})") from None
+        except (KeyError, TypeError, AttributeError, OverflowError) as exc:
+            raise BundleError(f"{root / MANIFEST}: bad detector description ({type(exc).__name__}: "
+                              f"{str(exc)[:160]})") from None
         except ValueError as exc:
             if isinstance(exc, BundleError):
                 raise
             raise BundleError(f"{root}: bad SVM arrays ({exc})") from None
-    return Bundle(body, limb, detector, dict(manifest.get("summary") or {}), str(manifest.get("created", "")), more)
+    summary = manifest.get("summary") or {}
+    if not isinstance(summary, dict):
+        raise BundleError(f"{root / MANIFEST}: 'summary' must be an object, got {type(summary).__name__}")
+    return Bundle(body, limb, detector, dict(summary), str(manifest.get("created", "")), more)
 
 
 def default_bundle_path() -> Path:

@@ -134,6 +134,92 @@ def _rows(reader, label: str):
             raise TracksCSVError(f"{label} line {reader.line_num}: not a CSV row ({exc})") from None
 
 
+INT_COLUMNS = ("frame", "track_id")
+FLOAT_COLUMNS = ("x", "y", "w", "h", "score", "occluded", "X", "Y", "Z")
+#: columns whose values must be finite and within ``PARTLAB_MAX_COORD``
+COORD_COLUMNS = ("x", "y", "w", "h", "X", "Y", "Z")
+
+
+def check_value(col: str, value, where: str, coord_limit: float | None = None, text_numbers: bool = True):
+    """The one rule set for a cell of a tracks table, shared by the CSV reader, every importer
+    and the store: ``value`` (text as in the CSV, or a number/bool from a JSON or XML file) as the
+    column's type, or a :class:`TracksCSVError` naming ``where`` and the value.
+
+    Numbers are checked as the CSV reader checks their text (:func:`_parse_cell`: frames and ids
+    whole in 0..2**31-1; ``x, y, w, h, X, Y, Z`` finite within ``PARTLAB_MAX_COORD``, sizes not
+    negative; ``score`` not infinite; ``occluded`` in [0, 1]; ``failure`` a boolean, ``"false"``
+    being False). Booleans, lists and objects are not numbers; a NaN ``X, Y, Z`` is "unknown".
+    With ``text_numbers=False`` (JSON files, whose numbers are numbers) text is refused for the
+    frame and the box.
+    """
+    if coord_limit is None:
+        coord_limit = max_coord()
+    numeric = col in INT_COLUMNS or col in FLOAT_COLUMNS
+    if isinstance(value, str):
+        if not text_numbers and col in ("frame", "x", "y", "w", "h"):
+            raise TracksCSVError(f"{where}: {_short(value)} is text, not a number")
+        cell = value.strip()
+    elif value is None:
+        cell = ""
+    elif isinstance(value, bool):
+        if numeric:
+            raise TracksCSVError(f"{where}: {value!r} is a boolean, not a number")
+        cell = str(value).lower()
+    elif isinstance(value, int) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0
+                                    and value.dtype.kind in "iub"):
+        cell = str(int(value))
+    elif isinstance(value, float) or (hasattr(value, "dtype") and getattr(value, "ndim", 1) == 0
+                                      and value.dtype.kind == "f"):
+        if math.isnan(value) and col in ("X", "Y", "Z"):
+            return float("nan")  # an unknown 3D position
+        cell = repr(float(value))
+    else:
+        raise TracksCSVError(f"{where}: {_short(value)} is not a single value")
+    return _parse_cell(col, cell, where, coord_limit)
+
+
+def _short(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def check_rows(rows: list[dict], label: str, text_numbers: bool = True) -> list[dict]:
+    """``rows`` (dicts of tracks columns, an optional ``_where`` naming each one's place in its
+    file) checked and converted by :func:`check_value`; errors read ``LABEL WHERE, column 'C': ...``."""
+    coord_limit = max_coord()
+    out = []
+    for i, row in enumerate(rows):
+        place = row.get("_where", f"box {i + 1}")
+        out.append({col: check_value(col, v, f"{label} {place}, column '{col}'", coord_limit, text_numbers)
+                    for col, v in row.items() if col in COLUMNS})
+    return out
+
+
+def check_table(df: pd.DataFrame, label: str) -> None:
+    """:func:`check_value`'s rules over a normalised tracks table at once (what the store and the
+    writers take); raises :class:`TracksCSVError` naming the first bad row (counted from 1) and value."""
+    import numpy as np
+
+    limit = max_coord()
+    tests = {
+        "frame": lambda v: (v >= 0) & (v <= MAX_ID), "track_id": lambda v: (v >= 0) & (v <= MAX_ID),
+        "x": lambda v: np.isfinite(v) & (np.abs(v) <= limit), "y": lambda v: np.isfinite(v) & (np.abs(v) <= limit),
+        "w": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
+        "h": lambda v: np.isfinite(v) & (v >= 0) & (v <= limit),
+        "score": lambda v: ~np.isinf(v), "occluded": lambda v: (v >= 0) & (v <= 1),
+        **{c: (lambda v: np.isnan(v) | (np.abs(v) <= limit)) for c in ("X", "Y", "Z")},
+    }
+    for col, test in tests.items():
+        if col not in df.columns:
+            continue
+        values = df[col].to_numpy(dtype=float)
+        bad = ~test(values)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            check_value(col, values[i].item(), f"{label} row {i + 1}, column '{col}'", limit)
+            raise TracksCSVError(f"{label} row {i + 1}, column '{col}': {values[i]!r} is out of range")
+
+
 def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> pd.DataFrame:
     """Read and validate a tracks CSV.
 
@@ -203,6 +289,8 @@ def _parse_int(cell: str, where: str) -> int:
             raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
         if not f.is_integer():
             raise TracksCSVError(f"{where}: {cell!r} is not an integer") from None
+        if f > MAX_ID:
+            raise TracksCSVError(f"{where}: {cell!r} is larger than the limit of {MAX_ID}") from None
         value = int(f)
     if value < 0:
         raise TracksCSVError(f"{where}: {value} is negative")

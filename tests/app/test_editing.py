@@ -86,6 +86,35 @@ def test_bad_event_is_reported_not_raised(store, tracked_clip):
     assert "outside clip" in res.errors[0] and "unknown part 'elbow'" in res.errors[1]
 
 
+def test_nan_inf_and_negative_boxes_are_refused_as_such_and_never_stored(store, tracked_clip):
+    _, clip = tracked_clip
+    before = store.tracks(clip.id)
+    events = [dict(kind="edit", frame=2, track_id=1, part="head", box=box, failure=flag, occluded=occ, revision=0)
+              for box, flag, occ in (([float("nan"), 1, 2, 2], False, 0), ([1, 1, float("inf"), 2], False, 0),
+                                     ([1, 1, -4, 2], False, 0), ([1, 1, 2, 1e308], False, 0),
+                                     ([1, 1, 2, 2], "maybe", 0), ([1, 1, 2, 2], False, float("nan")),
+                                     ([1, 1, 2], False, 0), ("1,1,2,2", False, 0))]
+    res = apply_events(store, clip.id, events, EditHistory())
+    assert res.written == 0 and len(res.errors) == len(events)
+    assert not any("changed by someone else" in e for e in res.errors)
+    assert "box x: 'nan' is not a finite number" in res.errors[0]
+    assert "box w: 'inf' is not a finite number" in res.errors[1]
+    assert "box w: negative size -4" in res.errors[2]
+    assert "box h: '1e+308' is beyond the limit" in res.errors[3]
+    assert "'maybe' is not a boolean" in res.errors[4]
+    assert "occluded: 'nan' is not a fraction" in res.errors[5]
+    assert "a box is [x, y, w, h]" in res.errors[6] and "a box is [x, y, w, h]" in res.errors[7]
+    after = store.tracks(clip.id)
+    assert after.equals(before)  # nothing stored, nothing exported
+
+
+def test_the_failure_flag_as_text_is_a_boolean(store, tracked_clip):
+    _, clip = tracked_clip
+    res = apply_events(store, clip.id, [dict(kind="edit", frame=2, track_id=1, part="head", box=[1, 1, 2, 2],
+                                             failure="false", occluded=0, revision=0)], EditHistory())
+    assert res.errors == [] and not bool(_box(store, clip.id, 2, "head").failure)
+
+
 def test_an_undone_edit_is_no_correction(store, tracked_clip):
     _, clip = tracked_clip
     hist = EditHistory()

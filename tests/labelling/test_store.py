@@ -173,3 +173,47 @@ def test_killed_writer_loses_no_committed_edit(tmp_path, store_and_clip):
             assert c.exec_driver_sql("PRAGMA integrity_check").scalar() == "ok"
     last = fresh.revision(clip.id, 0, 7, "head")
     assert fresh.edit_box(clip.id, 0, 7, "head", Box(1, 1, 1, 1), expected_revision=last) == last + 1
+
+
+def test_unusable_boxes_are_refused_by_the_store(store_and_clip):
+    """NaN, inf, negative sizes and ids beyond int32 never reach the database (edits and tracker runs)."""
+    import math
+
+    _pytest = pytest
+    store, clip = store_and_clip
+    for box, says in ((Box(math.nan, 1, 2, 2), "x: 'nan' is not a finite number"),
+                      (Box(1, 1, math.inf, 2), "w: 'inf' is not a finite number"),
+                      (Box(1, 1, 2, 2e7), "h: '20000000.0' is beyond the limit")):
+        with _pytest.raises(StoreError, match=says):
+            store.edit_box(clip.id, 0, 1, "head", box, expected_revision=0)
+    with _pytest.raises(StoreError, match="track_id: 2147483648 is larger than the limit"):
+        store.edit_box(clip.id, 0, 2**31, "head", Box(1, 1, 2, 2), expected_revision=0)
+    with _pytest.raises(StoreError, match="occluded: '2' is not a fraction"):
+        store.edit_box(clip.id, 0, 1, "head", Box(1, 1, 2, 2), occluded=2, expected_revision=0)
+    run = pd.DataFrame({"frame": [0, 1], "track_id": [0, 0], "part": ["head", "head"], "x": [1.0, 1.0],
+                        "y": [1.0, 1.0], "w": [2.0, -3.0], "h": [2.0, 2.0]})
+    with _pytest.raises(StoreError, match="row 2, column 'w': negative size -3"):
+        store.save_tracker_run(clip.id, run)
+    assert store.tracks(clip.id).empty
+
+
+def test_an_unreachable_database_fails_fast_without_its_password(monkeypatch):
+    """A server that accepts the connection and never answers: refused within the connect timeout, the
+    message names the URL with its password hidden."""
+    import socket
+    import threading
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+    port = listener.getsockname()[1]
+    held = []
+    threading.Thread(target=lambda: held.append(listener.accept()), daemon=True).start()
+    monkeypatch.setenv("PARTLAB_DB_CONNECT_TIMEOUT", "1")
+    url = f"postgresql+psycopg://labeller:s3cret@127.0.0.1:{port}/partlab"
+    start = time.monotonic()
+    shown = rf"postgresql\+psycopg://labeller:\*\*\*@127.0.0.1:{port}/partlab"
+    with pytest.raises(StoreError, match=rf"cannot reach the database {shown} within 1 s") as exc:
+        Store(url)
+    assert time.monotonic() - start < 10 and "s3cret" not in str(exc.value)
+    listener.close()

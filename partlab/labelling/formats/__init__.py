@@ -119,12 +119,23 @@ def _import_dir(path: Path, f: Format, mapping, video, frame_offset: int) -> pd.
             manifest.check_video(info)
         elif stated is not None:
             check_frame_count(stated, info, f"the {f.name} annotations")
-    if f.name == "labelstudio":  # percentages of the frame: the clip gives the size when the file does not
-        df = f.import_(path, mapping, size=(info.width, info.height) if info is not None else None)
-    else:
-        df = f.import_(path, mapping)
+    try:
+        if f.name == "labelstudio":  # percentages of the frame: the clip gives the size when the file does not
+            df = f.import_(path, mapping, size=(info.width, info.height) if info is not None else None)
+        else:
+            df = f.import_(path, mapping)
+    except (TypeError, AttributeError, KeyError, IndexError, ValueError, OverflowError, RecursionError,
+            UnicodeDecodeError) as exc:
+        if isinstance(exc, FormatError):
+            raise
+        # the safety net: a shape of file no check above foresaw is still a refusal naming the file
+        detail = " ".join(str(exc).split())[:120]
+        raise FormatError(f"{path}: not a {f.name} file partlab can read ({type(exc).__name__}: {detail})") from None
     if frame_offset:
         attrs = df.attrs
+        if len(df) and int(df["frame"].min()) + int(frame_offset) < 0:
+            raise FormatError(f"{path}: --frame-offset {frame_offset} moves frame {int(df['frame'].min())} "
+                              "before the clip's first frame (0)")
         df = df.assign(frame=df["frame"] + int(frame_offset))
         df.attrs = dict(attrs, images={k + int(frame_offset): v for k, v in attrs.get("images", {}).items()})
     if info is not None:

@@ -18,7 +18,7 @@ import pandas as pd
 
 from partlab.labelling.video import VideoInfo, probe
 from partlab.tracking.parts import PART_NAMES
-from partlab.tracking.tracks import TracksCSVError, normalise_tracks
+from partlab.tracking.tracks import TracksCSVError, check_rows, normalise_tracks
 
 MANIFEST_NAME = "partlab.json"
 MANIFEST_VERSION = 1
@@ -89,8 +89,9 @@ class ExportManifest:
             d["files"] = tuple(str(f) for f in d.get("files", ()))
             known = {k: v for k, v in d.items() if k in cls.__dataclass_fields__}
             return cls(**known)
-        except (ValueError, TypeError) as exc:
-            raise FormatError(f"{path}: not a readable partlab export manifest ({exc})") from None
+        except (ValueError, TypeError, AttributeError, RecursionError) as exc:
+            raise FormatError(f"{path}: not a readable partlab export manifest ({type(exc).__name__}: "
+                              f"{str(exc)[:120]})") from None
 
     def check_video(self, info: VideoInfo) -> None:
         """Refuse a clip whose decoded frame count or size differs from the one annotated."""
@@ -198,12 +199,18 @@ def map_label(label, mapping: dict[str, str]) -> str | None:
     return mapping.get(str(label).strip().lower())
 
 
-def finish_import(rows: list[dict], skipped: dict[str, int], source: str) -> pd.DataFrame:
-    """Tracks table from imported rows; ``df.attrs['skipped']`` counts rows of unmapped labels."""
+def finish_import(rows: list[dict], skipped: dict[str, int], source: str, text_numbers: bool = True) -> pd.DataFrame:
+    """Tracks table from imported rows (raw values, checked by the tracks CSV's rules,
+    :func:`~partlab.tracking.tracks.check_value`; a row's ``_where`` names its place in the file);
+    ``df.attrs['skipped']`` counts rows of unmapped labels."""
     if not rows:
         found = ", ".join(f"{k} ({n})" for k, n in sorted(skipped.items())) or "none"
         raise FormatError(f"{source}: no boxes with a label that maps to our parts "
                           f"({', '.join(PART_NAMES)}); labels found: {found}. Use --mapping THEIRS=PART")
+    try:  # the tracks CSV reader's rules: what is imported, partlab's own reader reads back
+        rows = check_rows(rows, source, text_numbers)
+    except TracksCSVError as exc:
+        raise FormatError(str(exc)) from None
     df = normalise_tracks(pd.DataFrame(rows))
     order = {p: i for i, p in enumerate(PART_NAMES)}
     df = df.assign(_p=df["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")

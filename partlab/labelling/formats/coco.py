@@ -110,6 +110,8 @@ def _load(js: Path) -> dict:
         doc = json.loads(js.read_text(encoding="utf-8"))
     except (ValueError, UnicodeDecodeError) as exc:
         raise FormatError(f"{js}: not a JSON file ({exc}); expected COCO detection JSON") from None
+    except RecursionError:
+        raise FormatError(f"{js}: JSON nested too deeply; expected COCO detection JSON") from None
     if not isinstance(doc, dict) or not all(isinstance(doc.get(k), list)
                                             for k in ("images", "annotations", "categories")):
         raise FormatError(f"{js}: expected COCO detection JSON with lists 'images', 'annotations' and "
@@ -117,17 +119,30 @@ def _load(js: Path) -> dict:
     return doc
 
 
+def _hashable(v) -> bool:
+    return not isinstance(v, (list, dict))
+
+
+def _short(v) -> str:
+    text = repr(v)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def import_(path: Path, mapping=None) -> pd.DataFrame:
     js = _find_json(path)
     doc = _load(js)
     names = parse_mapping(mapping)
     cats = {c.get("id"): str(c.get("name", c.get("id"))) for c in doc["categories"] if isinstance(c, dict)}
-    images = sorted((im for im in doc["images"] if isinstance(im, dict)), key=lambda im: im.get("id", 0))
+    images = [im for im in doc["images"] if isinstance(im, dict)]
+    for im in images:
+        if not isinstance(im.get("id", 0), int) or isinstance(im.get("id"), bool):
+            raise FormatError(f"{js}: image {_short(im.get('id'))}: the id is not an integer")
+    images.sort(key=lambda im: im.get("id", 0))
     frame_of: dict = {}
     origin = set()
     for position, im in enumerate(images):
-        if isinstance(im.get("frame_id"), int):
-            frame_of[im.get("id")] = im["frame_id"]
+        if isinstance(im.get("frame_id"), int) and not isinstance(im.get("frame_id"), bool):
+            frame_of[im.get("id")] = im["frame_id"]  # checked with the boxes (finish_import)
             origin.add("frame_id")
         else:
             m = re.search(r"(\d+)$", Path(str(im.get("file_name", ""))).stem)
@@ -145,9 +160,10 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
     rows: list[dict] = []
     skipped: dict[str, int] = {}
     for a in doc["annotations"]:
-        if not isinstance(a, dict) or a.get("image_id") not in frame_of:
+        if not isinstance(a, dict) or not _hashable(a.get("image_id")) or a.get("image_id") not in frame_of:
             raise FormatError(f"{js}: annotation {a.get('id') if isinstance(a, dict) else a!r} refers to no image")
-        label = cats.get(a.get("category_id"), str(a.get("category_id")))
+        cat_id = a.get("category_id")
+        label = cats.get(cat_id, str(cat_id)) if _hashable(cat_id) else str(cat_id)
         part = map_label(label, names)
         if part is None:
             skipped[label] = skipped.get(label, 0) + 1
@@ -163,17 +179,18 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         if track_id is None:
             track_id = a.get("id", len(rows))
         score = attrs.get("score", attrs.get("confidence", a.get("score")))
-        if isinstance(score, str):
-            score = float(score) if score.strip() else None
-        occlusion = attrs.get("occlusion", 1.0 if attrs.get("occluded") else 0.0)
-        rows.append({
-            "frame": frame_of[a["image_id"]], "track_id": int(track_id), "part": part,
+        occluded = attrs.get("occluded")
+        if isinstance(occluded, str):  # "false" is not occluded
+            occluded = occluded.strip().lower() in ("1", "true", "yes", "y", "t")
+        occlusion = attrs.get("occlusion", 1.0 if occluded is True or occluded == 1 else 0.0)
+        rows.append({  # raw values: finish_import checks them by the tracks CSV's rules ("false" is False)
+            "_where": f"annotation {_short(a.get('id'))}",
+            "frame": frame_of[a["image_id"]], "track_id": track_id, "part": part,
             "x": bbox[0], "y": bbox[1], "w": bbox[2], "h": bbox[3],
-            "score": float("nan") if score is None else float(score),
-            "failure": bool(attrs.get("failure", False)), "occluded": float(occlusion),
+            "score": score, "failure": attrs.get("failure", False), "occluded": occlusion,
             "state": str(attrs.get("state", "")), "source": str(attrs.get("source", NAME)),
         })
-    df = finish_import(rows, skipped, str(js))
+    df = finish_import(rows, skipped, str(js), text_numbers=False)
     df.attrs["images"] = image_of
     df.attrs["frame_origin"] = "frame_id" if origin == {"frame_id"} else " and ".join(sorted(origin))
     return df

@@ -39,7 +39,7 @@ from partlab.labelling.formats.base import (
 from partlab.labelling.formats.frames import all_frames, frame_name, write_frames
 from partlab.labelling.video import VideoInfo
 from partlab.tracking.parts import PART_NAMES
-from partlab.tracking.tracks import has_take_columns
+from partlab.tracking.tracks import TracksCSVError, check_value, has_take_columns
 
 NAME = "cvat"
 FILE_NAME = "annotations.xml"
@@ -189,7 +189,12 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
             if root.find("image") is not None else ""
         raise FormatError(f"{xml}: no <track> elements; expected CVAT for video 1.1 XML{hint}")
     names = parse_mapping(mapping)
-    groups = [int(t.get("group_id", "0") or 0) for t in tracks]
+    groups = []
+    for t in tracks:
+        try:
+            groups.append(int(t.get("group_id", "0") or 0))
+        except ValueError:
+            raise FormatError(f"{xml}: track {t.get('id')}, group_id {t.get('group_id')!r} is not an integer") from None
     stated = [int(float(a.text)) for a in root.iter("attribute")
               if a.get("name") == "person" and (a.text or "").strip().lstrip("-").replace(".", "", 1).isdigit()]
     next_id = max([g - 1 for g in groups if g > 0] + stated, default=-1) + 1
@@ -213,29 +218,31 @@ def import_(path: Path, mapping=None) -> pd.DataFrame:
         for b in boxes:
             if b.get("outside") == "1":
                 continue
+            if any(b.get(k) is None for k in ("frame", "xtl", "ytl", "xbr", "ybr")):
+                raise FormatError(f"{xml}: track {t.get('id')} has a <box> without frame/xtl/ytl/xbr/ybr; "
+                                  "expected CVAT for video 1.1 XML")
+            where = f"track {t.get('id')} box frame {b.get('frame')!r}"
             try:
-                frame = int(b.get("frame"))
-                xtl, ytl, xbr, ybr = (float(b.get(k)) for k in ("xtl", "ytl", "xbr", "ybr"))
-            except (TypeError, ValueError):
-                raise FormatError(f"{xml}: track {t.get('id')} has a <box> without frame/xtl/ytl/xbr/ybr "
-                                  "numbers; expected CVAT for video 1.1 XML") from None
+                xtl, ytl, xbr, ybr = (check_value("x", b.get(k), f"{xml} {where}, {k}") for k in
+                                      ("xtl", "ytl", "xbr", "ybr"))
+            except TracksCSVError as exc:
+                raise FormatError(str(exc)) from None
+            frame = b.get("frame")
             attrs = {a.get("name"): (a.text or "") for a in b.findall("attribute")}
             keyframe = b.get("keyframe", "1") == "1"
             occluded_flag = 1.0 if b.get("occluded") == "1" else 0.0
-            try:
-                box_track = int(float(attrs["person"])) if attrs.get("person", "").strip() else track_id
-            except ValueError:
-                box_track = track_id
+            box_track = attrs["person"] if attrs.get("person", "").strip() else track_id
             rows.append({
+                "_where": where,
                 "frame": frame, "track_id": box_track, "part": part,
                 "x": xtl, "y": ytl, "w": xbr - xtl, "h": ybr - ytl,
-                "score": _attr_float(attrs.get("confidence", attrs.get("score")), float("nan")),
-                "failure": attrs.get("failure", "false").strip().lower() in ("true", "1", "yes"),
-                "occluded": _attr_float(attrs.get("occlusion"), occluded_flag),
+                "score": attrs.get("confidence", attrs.get("score")),
+                "failure": attrs.get("failure", "false"),
+                "occluded": attrs.get("occlusion") or occluded_flag,
                 "state": attrs.get("state", ""),
                 "source": attrs.get("source") or ("cvat" if keyframe else "interpolated"),
                 "camera": attrs.get("camera", ""),
-                **{a: _attr_float(attrs.get(a), float("nan")) for a in ("X", "Y", "Z")},
+                **{a: attrs.get(a) for a in ("X", "Y", "Z")},
             })
     df = finish_import(rows, skipped, str(xml))
     images = xml.parent / "images"

@@ -24,6 +24,7 @@ task; its most recent annotation (or, with none, its most recent prediction), ev
 from __future__ import annotations
 
 import json
+import math
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -40,6 +41,7 @@ from partlab.labelling.formats.base import (
     thinned_tracks,
 )
 from partlab.labelling.video import VideoInfo
+from partlab.limits import max_frames
 from partlab.tracking.parts import BOX_PARTS
 
 NAME = "labelstudio"
@@ -121,6 +123,8 @@ def _task(path: Path) -> tuple[Path, dict]:
         doc = json.loads(js.read_text(encoding="utf-8"))
     except (ValueError, UnicodeDecodeError) as exc:
         raise FormatError(f"{js}: not a JSON file ({exc}); expected a Label Studio JSON export") from None
+    except RecursionError:
+        raise FormatError(f"{js}: JSON nested too deeply; expected a Label Studio JSON export") from None
     tasks = doc if isinstance(doc, list) else [doc]
     tasks = [t for t in tasks if isinstance(t, dict) and ("annotations" in t or "predictions" in t)]
     if len(tasks) != 1:
@@ -148,7 +152,14 @@ def annotated_frame_count(path: Path) -> int | None:
 
 def expand(sequence: list[dict], frames_count: int | None) -> list[tuple[int, float, float, float, float, bool]]:
     """Frames ``(frame 1-based, x, y, w, h, keyframe)`` a keyframe sequence shows (see the module docstring)."""
-    keys = sorted((k for k in sequence if isinstance(k, dict)), key=lambda k: k["frame"])
+    limit = max_frames()
+    keys = [k for k in sequence if isinstance(k, dict)]
+    for k in keys:  # whole frame numbers inside the clip limit, before any frame is expanded
+        f = k["frame"]
+        if isinstance(f, bool) or not isinstance(f, (int, float)) or not math.isfinite(f) or f != int(f) \
+                or not 1 <= f <= limit:
+            raise TypeError(f"a whole frame number in 1..{limit} (PARTLAB_MAX_FRAMES), got {f!r}")
+    keys.sort(key=lambda k: k["frame"])
     out: dict[int, tuple] = {}
     for i, a in enumerate(keys):
         box = np.array([a["x"], a["y"], a["width"], a["height"]], float)
@@ -156,6 +167,9 @@ def expand(sequence: list[dict], frames_count: int | None) -> list[tuple[int, fl
         if not a.get("enabled", True):
             continue
         b = keys[i + 1] if i + 1 < len(keys) else None
+        if b is None and frames_count is not None and (isinstance(frames_count, bool) or not isinstance(
+                frames_count, int) or not 0 <= frames_count <= limit):  # held to the end: the end must be sane
+            raise TypeError(f"a framesCount in 0..{limit} (PARTLAB_MAX_FRAMES), got {frames_count!r}")
         end = int(b["frame"]) if b is not None else int(frames_count or a["frame"]) + 1
         nb = np.array([b["x"], b["y"], b["width"], b["height"]], float) if b is not None else box
         for f in range(int(a["frame"]) + 1, end):
@@ -206,15 +220,21 @@ def tracks_from_results(regions_: list, size: tuple[int, int] | None, source: st
             raise FormatError(f"{source}: region {r.get('id')} gives no frame size (original_width/height) to turn "
                               "its percentages into pixels; pass the clip with --video")
         try:
-            boxes = expand(seq, value.get("framesCount"))
+            with np.errstate(over="ignore", invalid="ignore"):  # huge numbers become inf, refused below
+                boxes = expand(seq, value.get("framesCount"))
         except (KeyError, TypeError) as exc:
             raise FormatError(f"{source}: region {r.get('id')} has a keyframe without {exc}; expected "
                               "frame, x, y, width, height") from None
+        except (ValueError, OverflowError) as exc:
+            raise FormatError(f"{source}: region {r.get('id')}: a keyframe's x, y, width, height are not numbers "
+                              f"({exc})") from None
         for frame, x, y, w, h, key in boxes:
+            x, y, w, h = (float(v) for v in (x, y, w, h))
             if frame < 1:
                 raise FormatError(f"{source}: region {r.get('id')} has frame {frame}; Label Studio frames count "
                                   "from 1")
-            rows.append({"frame": frame - 1, "track_id": track_id, "part": part,
+            rows.append({"_where": f"region {r.get('id')!r} frame {frame}",
+                         "frame": frame - 1, "track_id": track_id, "part": part,
                          "x": x * W / 100.0, "y": y * H / 100.0, "w": w * W / 100.0, "h": h * H / 100.0,
                          "score": float(r["score"]) if isinstance(r.get("score"), (int, float)) else float("nan"),
                          "source": NAME if key else "interpolated"})

@@ -26,6 +26,8 @@ from __future__ import annotations
 
 import configparser
 import csv
+import io
+import math
 from pathlib import Path
 
 import numpy as np
@@ -41,7 +43,9 @@ from partlab.labelling.formats.base import (
 )
 from partlab.labelling.formats.frames import all_frames, write_frames
 from partlab.labelling.video import VideoInfo
+from partlab.limits import max_coord
 from partlab.tracking.parts import BOX_PARTS
+from partlab.tracking.tracks import TracksCSVError, check_value
 
 NAME = "mot"
 ID_RULE = "MOT id = track_id + 1; gt/gt.txt holds person boxes (class 1), gt/<part>.txt each other part"
@@ -159,50 +163,70 @@ def _images_by_frame(img_dir: Path) -> dict[int, Path]:
 def _read(gt: Path, mapping, root: Path, ours: bool, part: str | None = None) -> pd.DataFrame:
     """Rows of one MOT file; ``part`` names the part of every row (our ``gt/<part>.txt``)."""
     labels_path = next((p for p in (gt.parent / "labels.txt", root / "labels.txt") if p.is_file()), None)
-    labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path else []
+    try:
+        labels = [ln.strip() for ln in labels_path.read_text(encoding="utf-8").splitlines()] if labels_path else []
+        text = gt.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise FormatError(f"{labels_path if labels_path else gt}: not a text file (not UTF-8)") from None
     names = parse_mapping(mapping)
     names.setdefault("1", "person")  # MOT16/17 class 1 is 'pedestrian'
     is_gt = gt.name.startswith("gt")
+    try:
+        return _rows(gt, text, labels, names, is_gt, ours, part)
+    except csv.Error as exc:
+        raise FormatError(f"{gt}: not a MOTChallenge text file ({exc})") from None
+
+
+def _rows(gt: Path, text: str, labels: list[str], names: dict, is_gt: bool, ours: bool, part) -> pd.DataFrame:
     rows: list[dict] = []
     skipped: dict[str, int] = {}
-    with open(gt, newline="", encoding="utf-8") as f:
-        for lineno, cells in enumerate(csv.reader(f), start=1):
-            cells = [c.strip() for c in cells]
-            while cells and cells[-1] == "":  # trailing commas
-                cells.pop()
-            if not cells:
-                continue
-            if len(cells) < 6:
-                raise FormatError(f"{gt} line {lineno}: {len(cells)} values; expected MOTChallenge rows "
-                                  "frame,id,x,y,w,h,conf,class,visibility")
-            try:
-                v = [float(c) for c in cells]
-            except ValueError:
-                raise FormatError(f"{gt} line {lineno}: non-numeric value in {','.join(cells)}; expected "
-                                  "MOTChallenge rows frame,id,x,y,w,h,conf,class,visibility") from None
-            frame, oid = int(v[0]), int(v[1])
-            if frame < 1:
-                raise FormatError(f"{gt} line {lineno}: frame {frame}; MOTChallenge frames count from 1")
-            conf = v[6] if len(v) > 6 else 1.0
-            if len(v) == 9 or (len(v) == 8 and not ours):
-                cls = int(v[7])
-                label = labels[cls - 1] if labels and 1 <= cls <= len(labels) else str(cls)
-            else:  # 6, 7 or 10 columns (MOT15: 3D position instead of class)
-                label = "pedestrian"
-            if is_gt and conf == 0:
-                skipped["conf=0 (ignored)"] = skipped.get("conf=0 (ignored)", 0) + 1
-                continue
-            box_part = part or map_label(label, names)
-            if box_part is None:
-                skipped[label] = skipped.get(label, 0) + 1
-                continue
-            vis = v[8] if len(v) == 9 else 1.0
-            rows.append({
-                "frame": frame - 1,
-                "track_id": oid - 1 if ours else oid,
-                "part": box_part, "x": v[2] - 1.0, "y": v[3] - 1.0, "w": v[4], "h": v[5],
-                "score": float("nan") if is_gt else conf,
-                "occluded": float(np.clip(1.0 - vis, 0.0, 1.0)) if 0.0 <= vis <= 1.0 else 0.0,
-                "source": NAME,
-            })
+    limit = max_coord()
+    for lineno, cells in enumerate(csv.reader(io.StringIO(text, newline="")), start=1):
+        cells = [c.strip() for c in cells]
+        while cells and cells[-1] == "":  # trailing commas
+            cells.pop()
+        if not cells:
+            continue
+        if len(cells) < 6:
+            raise FormatError(f"{gt} line {lineno}: {len(cells)} values; expected MOTChallenge rows "
+                              "frame,id,x,y,w,h,conf,class,visibility")
+        try:
+            v = [float(c) for c in cells]
+        except ValueError:
+            raise FormatError(f"{gt} line {lineno}: non-numeric value in {','.join(cells)[:80]}; expected "
+                              "MOTChallenge rows frame,id,x,y,w,h,conf,class,visibility") from None
+        try:  # the tracks CSV's rules (whole, int32; finite, in range)
+            frame = check_value("frame", cells[0], f"{gt} line {lineno}, frame", limit)
+            oid = check_value("track_id", cells[1], f"{gt} line {lineno}, id", limit)
+            for k in range(6, min(len(v), 9)):
+                check_value("score", cells[k], f"{gt} line {lineno}, column {k + 1}", limit)
+        except TracksCSVError as exc:
+            raise FormatError(str(exc)) from None
+        if len(v) > 7 and not math.isfinite(v[7]):
+            raise FormatError(f"{gt} line {lineno}, class: {cells[7]!r} is not a class number")
+        if frame < 1:
+            raise FormatError(f"{gt} line {lineno}: frame {frame}; MOTChallenge frames count from 1")
+        conf = v[6] if len(v) > 6 else 1.0
+        if len(v) == 9 or (len(v) == 8 and not ours):
+            cls = int(v[7])
+            label = labels[cls - 1] if labels and 1 <= cls <= len(labels) else str(cls)
+        else:  # 6, 7 or 10 columns (MOT15: 3D position instead of class)
+            label = "pedestrian"
+        if is_gt and conf == 0:
+            skipped["conf=0 (ignored)"] = skipped.get("conf=0 (ignored)", 0) + 1
+            continue
+        box_part = part or map_label(label, names)
+        if box_part is None:
+            skipped[label] = skipped.get(label, 0) + 1
+            continue
+        vis = v[8] if len(v) == 9 else 1.0
+        rows.append({
+            "_where": f"line {lineno}",
+            "frame": frame - 1,
+            "track_id": oid - 1 if ours else oid,
+            "part": box_part, "x": v[2] - 1.0, "y": v[3] - 1.0, "w": v[4], "h": v[5],
+            "score": float("nan") if is_gt else conf,
+            "occluded": float(np.clip(1.0 - vis, 0.0, 1.0)) if 0.0 <= vis <= 1.0 else 0.0,
+            "source": NAME,
+        })
     return finish_import(rows, skipped, str(gt))
