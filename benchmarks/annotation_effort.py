@@ -38,9 +38,9 @@ from partlab.labelling.evaluation import count_edits, evaluate, interpolate_keyf
 from partlab.tracking.frame import MemoryTake  # noqa: E402
 from partlab.tracking.run import track  # noqa: E402
 
-DATA = ROOT.parent.parent / "shared" / "data"
-if not DATA.exists():
-    DATA = Path("/work/shared/data")
+# ../shared/data beside the repository (or beside the folder of worktrees holding it)
+DATA = next((p / "shared" / "data" for p in (ROOT.parent, ROOT.parent.parent) if (p / "shared" / "data").is_dir()),
+            ROOT.parent / "shared" / "data")
 PETS = DATA / "pets09_s2l1_vtest"
 OTB = {"human3": DATA / "otb_human3_strcf", "crossing": DATA / "otb_crossing_eco"}
 

@@ -28,9 +28,9 @@ from pathlib import Path
 import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
-PETS = ROOT.parent.parent / "shared" / "data" / "pets09_s2l1_vtest"
-if not PETS.is_dir():
-    PETS = Path("/work/shared/data/pets09_s2l1_vtest")
+# ../shared/data beside the repository (or beside the folder of worktrees holding it)
+PETS = next((p / "shared" / "data" / "pets09_s2l1_vtest" for p in (ROOT.parent, ROOT.parent.parent)
+             if (p / "shared" / "data" / "pets09_s2l1_vtest").is_dir()), ROOT.parent / "shared" / "data" / "pets09_s2l1_vtest")
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu"]
 
 

@@ -1,7 +1,7 @@
 """Seed 002 sec. 5.2 ablation on the synthetic suite: per-part tracking rates at frame 105.
 
     PYTHONPATH=. python benchmarks/failure_ablation.py [--scenes distractors,bend,...] [--seed 0]
-                                                      [--fast] [--out /tmp/ablation.csv] [--video]
+                                                      [--fast] [--out ablation.csv] [--video]
 
 For every test scene (``partlab.labelling.synth``, seeds not used by the default bundle) the
 body tracker runs from the truth's first boxes
