@@ -33,7 +33,7 @@ import pandas as pd
 
 from partlab.labelling.synth.appearance import Appearance, sample_appearances
 from partlab.labelling.synth.background import CameraEffects, smooth_noise
-from partlab.labelling.synth.figure import FIGURE_PARTS, HAND_R, PART_LABELS, FigurePose, colour_table, draw_figure
+from partlab.labelling.synth.figure import HAND_R, FigurePose, colour_table, draw_figure
 from partlab.labelling.synth.motion import bump
 from partlab.labelling.synth.scene import SKIN_LABELS
 from partlab.tracking.camera import Camera
@@ -416,27 +416,11 @@ def _check(name: str, n_cameras: int, seed: int, n_frames: int, width: int, heig
 
 
 def _part_rows(drawn, owner: np.ndarray, i: int, camera: str) -> list[tuple]:
-    """Truth rows of one view at frame ``i``: each drawn part's tight box and occluded fraction."""
-    rows = []
-    for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
-        own = owner[cy1:cy2, cx1:cx2]
-        lab = fig.labels[crop]
-        parts = {"person": lab > 0}
-        for p in FIGURE_PARTS:
-            if p in fig.masks:
-                whole = fig.masks[p][crop]
-                shown = whole & np.isin(lab, PART_LABELS[p])
-                parts[p] = shown if shown.any() else whole
-        for part, mask in parts.items():
-            total = int(mask.sum())
-            if total == 0:
-                continue
-            cs = np.flatnonzero(mask.any(axis=0))
-            rs = np.flatnonzero(mask.any(axis=1))
-            visible = int(np.count_nonzero(own[mask] == a + 1))
-            rows.append((i, a + 1, part, cx1 + cs[0], cy1 + rs[0], cs[-1] - cs[0] + 1, rs[-1] - rs[0] + 1,
-                         round(1.0 - visible / total, 4), camera))
-    return rows
+    """Truth rows of one view at frame ``i`` (:func:`partlab.labelling.synth.scene._truth_rows`
+    with the view's name)."""
+    from partlab.labelling.synth.scene import _truth_rows
+
+    return [row + (camera,) for row in _truth_rows(i, drawn, owner)]
 
 
 def _draw_carried(frame, owner, cam: Camera, view: PinholeView, anchors: dict, objects, track: int, i: int) -> None:
