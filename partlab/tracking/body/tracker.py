@@ -398,19 +398,28 @@ class BodyTracker:
             if not visible:
                 self._probe_hidden(person, ycc)
 
+    def _probe_anchor(self, person: Person, ycc: np.ndarray):
+        """The person's torso (or only part) model searched for around its state: ``(filter,
+        state, box)`` of a clear match (similarity at least ``release_similarity`` within
+        ``release_search`` widths), or None."""
+        p = self.params
+        if p.occlusion.release_similarity <= 0:
+            return None
+        f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
+        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
+        if rho < p.occlusion.release_similarity:
+            return None
+        return f, state, Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+
     def _probe_hidden(self, person: Person, ycc: np.ndarray) -> None:
         """A person wholly behind occluder regions whose torso shows clearly again away from
         them (similarity at least ``release_similarity``) is moved there: a walker may speed
         up or slow down behind a pillar."""
         p = self.params
-        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
-        f = person.filters[anchor]
-        if p.occlusion.release_similarity <= 0:
+        probed = self._probe_anchor(person, ycc)
+        if probed is None:
             return
-        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
-        if rho < p.occlusion.release_similarity:
-            return
-        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        f, state, found = probed
         if any(_overlap_fraction(found, o) >= p.occlusion.occluder_overlap for o in self.occluders):
             return
         delta = state[0:2] - f.state[0:2]
@@ -422,14 +431,10 @@ class BodyTracker:
         for near the coasting prediction by the torso's model; a clear match (similarity at least
         ``release_similarity``) on foreground brings every part there and ends the loss."""
         p = self.params
-        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
-        f = person.filters[anchor]
-        if p.occlusion.release_similarity <= 0:
+        probed = self._probe_anchor(person, ycc)
+        if probed is None:
             return
-        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
-        if rho < p.occlusion.release_similarity:
-            return
-        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
+        f, state, found = probed
         if mask is not None and _support(mask, found) < 2 * p.detection.support_min:
             return
         delta = state[0:2] - f.state[0:2]
@@ -443,16 +448,13 @@ class BodyTracker:
         ``release_similarity``, clear of the front person's box) near its prediction is released
         there, all parts moved with it: dynamics cannot foresee a stop or a turn behind
         someone, and the two may walk on together without ever separating."""
-        p = self.params
-        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
-        f = person.filters[anchor]
-        if person.occluded_frames < 2 or p.occlusion.release_similarity <= 0:
+        if person.occluded_frames < 2:
             return
-        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
-        if rho < p.occlusion.release_similarity:
+        probed = self._probe_anchor(person, ycc)
+        if probed is None:
             return
+        f, state, found = probed
         front = self.people.get(person.occluded_by)
-        found = Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
         if front is not None and found.intersection(front.box()) > 0:
             return  # still behind (or beside and touching) the front person: keep waiting
         delta = state[0:2] - f.state[0:2]
