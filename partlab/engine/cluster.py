@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import sys
 from collections.abc import Iterator
 
 from partlab.errors import UserError
@@ -48,13 +49,32 @@ def client(scheduler: str | None = None, workers: int | None = None,
     n = workers or os.cpu_count() or 1
     if n < 1:
         raise UserError(f"--workers must be at least 1, got {n}")
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
-                           silence_logs=logging.ERROR)
+    with _spawn_safe_main():  # worker processes are spawned once, here
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
+                               silence_logs=logging.ERROR)
     try:
         with Client(cluster) as c:
             yield c
     finally:
         cluster.close()
+
+
+@contextlib.contextmanager
+def _spawn_safe_main() -> Iterator[None]:
+    """Spawned worker processes re-run the parent's ``__main__`` script unless it is a module run by
+    name. When partlab is embedded (a Streamlit page script, a test runner that ran one) that script
+    is not meant to run again: hide its file while the workers start."""
+    main = sys.modules.get("__main__")
+    spec = getattr(main, "__spec__", None)
+    path = getattr(main, "__file__", None)
+    if main is None or spec is not None or path is None:
+        yield
+        return
+    del main.__file__
+    try:
+        yield
+    finally:
+        main.__file__ = path
 
 
 def dashboard_link(c) -> str | None:
