@@ -34,7 +34,7 @@ from typing import Any
 from sqlalchemy import delete, select
 
 #: progress is written to the database at most this often (seconds); state changes always
-PROGRESS_EVERY = 1.0
+PROGRESS_EVERY = 0.25
 STATES = ("queued", "running", "done", "failed", "cancelled")
 ACTIVE = ("queued", "running")
 

@@ -51,10 +51,25 @@ def test_a_track_job_outlives_its_server_shows_progress_and_cancels(service, tmp
     assert (short.id, long.id) == (1, 2)
     # "server 1" starts both jobs and stops at once (killed before its jobs could end)
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    assert jobs.get("none") is None  # reads the job table once (imports the engine) before the clock matters
     started = subprocess.run([sys.executable, "-c", SERVER], env=env, capture_output=True, text=True, timeout=300)
     assert started.returncode == 0, started.stderr
     short_id, long_id = started.stdout.split()
-    # this process is the restarted server: it sees the jobs, the first finishes and is stored
+    # this process is the restarted server: it sees both jobs. The second (run after the first on the
+    # one worker) shows live progress, then is cancelled from the job list before it ends
+    deadline = time.time() + 300
+    while time.time() < deadline:
+        job = jobs.get(long_id)
+        if job.status == "running" and job.done >= 5:
+            break
+        time.sleep(0.1)
+    assert job.active and job.total == 400 and 0 < job.fraction < 1
+    assert [j.id for j in jobs.active("track", clip_id=long.id)] == [long_id]
+    jobs.cancel(long_id)
+    ended = jobs.wait(long_id, timeout=60)
+    assert ended.status == "cancelled" and ended.done < 400
+    assert store.runs(long.id).empty  # nothing half-stored
+    # the first finished and was stored
     done = jobs.wait(short_id, timeout=300)
     assert done.status == "done", done.error
     from partlab.app.pipeline import track_video
@@ -66,19 +81,6 @@ def test_a_track_job_outlives_its_server_shows_progress_and_cancels(service, tmp
     pd.testing.assert_frame_equal(stored[["frame", "track_id", "part"]], expected[["frame", "track_id", "part"]])
     assert abs(stored[["x", "y", "w", "h"]].to_numpy() - expected[["x", "y", "w", "h"]].to_numpy()).max() < 1e-9
     assert store.runs(short.id)[["tracker", "seed"]].values.tolist() == [["body", 3]]
-    # the second shows live progress, then is cancelled from the job list before it ends
-    deadline = time.time() + 300
-    while time.time() < deadline:
-        job = jobs.get(long_id)
-        if job.status == "running" and job.done >= 5:
-            break
-        time.sleep(0.3)
-    assert job.active and job.total == 400 and 0 < job.fraction < 1
-    assert [j.id for j in jobs.active("track", clip_id=long.id)] == [long_id]
-    jobs.cancel(long_id)
-    ended = jobs.wait(long_id, timeout=60)
-    assert ended.status == "cancelled" and ended.done < 400
-    assert store.runs(long.id).empty  # nothing half-stored
     assert jobs.clear_finished() >= 2 and jobs.get(short_id) is None
 
 

@@ -179,7 +179,6 @@ def test_eval_matches_motmetrics_published_numbers_on_tud():
 
 
 def test_hota_known_by_hand():
-    pytest.importorskip("trackeval")
     # one person tracked perfectly but under id 5 for frames 0-1 and id 6 for frames 2-3:
     # DetA = 1, AssA = 2 / (2 + 2 + 0) = 0.5, HOTA = sqrt(DetA * AssA)
     truth = tracks([(f, 1, "head", 0, 0, 10, 10) for f in range(4)])

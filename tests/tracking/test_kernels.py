@@ -9,7 +9,9 @@ from partlab.tracking.core import kernels
 from partlab.tracking.core.histogram import bhattacharyya_counts, equalization_map, fused_lut, level_histogram
 from partlab.tracking.core.integral_histogram import particle_rectangles, rectangle_histograms, sampled_areas
 
-pytestmark = pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
+
+def test_numba_is_there():  # a dependency: the kernels below must run compiled, not be skipped
+    assert kernels.HAVE_NUMBA
 
 
 def _scene(seed=3):

@@ -286,6 +286,7 @@ class Editor {
     this.playing = !this.playing;
     this.buttons();
     if (!this.playing) { this.scheduleSync(); return; }
+    if (this.cur >= (this.data.frame_count || 1) - 1) this.show(0, false); // play at the end starts over
     const fps = Number(this.speed.value) || this.data.fps || 10;
     const interval = 1000 / fps;
     let next = performance.now() + interval;

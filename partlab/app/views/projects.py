@@ -16,7 +16,7 @@ from partlab.labelling.video import VideoClip, VideoError
 s = state.store()
 st.title("Projects and clips")
 
-with st.expander("New project", expanded=not s.projects()):
+def new_project_form() -> None:
     with st.form("new_project", clear_on_submit=True):
         name = st.text_input("Project name")
         if st.form_submit_button("Create project"):
@@ -27,6 +27,15 @@ with st.expander("New project", expanded=not s.projects()):
                 st.rerun()  # the sidebar's project picker shows the new project
             except StoreError as exc:
                 st.error(str(exc))
+
+
+if s.projects():
+    with st.expander("New project"):
+        new_project_form()
+else:  # the first thing to do: the form in plain view
+    st.markdown("**New project**: name it, then upload its clips.")
+    new_project_form()
+    st.stop()
 if "projects_flash" in st.session_state:
     st.success(st.session_state.pop("projects_flash"))
 
