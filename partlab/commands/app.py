@@ -129,8 +129,7 @@ def check_users() -> None:
 
 def run(args) -> int:
     mode = auth_mode(args.host, args.auth)
-    if not os.environ.get("PARTLAB_DATABASE_URL"):
-        check_data_dir()
+    check_data_dir()  # clips, uploads and exports live there whatever the database
     if mode == "password":
         check_users()
     print(f"partlab app: serving on http://{args.host}:{args.port} "

@@ -24,8 +24,9 @@ def storage_message(exc: BaseException) -> str:
     if isinstance(exc, OSError):
         from partlab.cli import describe_os_error
 
-        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-        return plain(f"Not saved: {where}{describe_os_error(exc)}. What was saved before is intact.")
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        return plain(f"Cannot write{where}: {describe_os_error(exc)}. Nothing was changed; what was saved "
+                     "before is intact.")
     return plain(f"Not done: {exc}")
 
 
