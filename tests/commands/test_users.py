@@ -50,7 +50,8 @@ def test_users_are_added_granted_listed_and_removed(tmp_path, capsys):
      "partlab users: no project 'nowhere' (projects: none yet; --create-project makes it)"),
     (["users", "grant", "ghost", "--project", "p", "--create-project", "--role", "viewer"],
      "partlab users: no user named 'ghost'"),
-    (["users", "grant", "bo", "--project", "p"], "partlab users: users grant needs --role (viewer, annotator or owner)"),
+    (["users", "grant", "bo", "--project", "p"],
+     "partlab users: users grant needs --role (viewer, annotator or owner)"),
     (["users", "add"], "partlab users: users add needs a user name"),
     (["users", "add", "bo", "--password-file", "MISSING"], "partlab users: cannot read the password from"),
 ])
