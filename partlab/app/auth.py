@@ -18,6 +18,7 @@ import time
 
 import streamlit as st
 
+from partlab.app.views.common import plain
 from partlab.labelling import access
 from partlab.labelling.store import Store, StoreError
 
@@ -58,7 +59,7 @@ def signed_in_store() -> Store:
         return access.GuardedStore(name)
     except access.AccessError as exc:  # removed while signed in
         st.session_state.pop(USER, None)
-        st.error(str(exc))
+        st.error(plain(exc))
         st.stop()
 
 

@@ -187,3 +187,37 @@ def test_a_read_only_data_directory_is_a_sentence(tmp_path, monkeypatch):
     [said] = [shown(e) for e in at.error]
     assert said == (f"Cannot write {data}/partlab.db.migrate-lock: not allowed to write here (Operation not "
                     "permitted). Nothing was changed; what was saved before is intact."), said
+
+
+def test_a_viewer_cannot_start_a_tracking_run(signed):
+    from partlab.app import jobs
+
+    project, clip = signed
+    at = page("track", signed_in_user="vic", project_id=project.id, clip_id=clip.id)
+    [go] = [b for b in at.button if b.label == "Track the whole clip"]
+    go.click().run()
+    assert not at.exception
+    assert any("vic is a viewer of project 'test' and cannot change it" in shown(e) for e in at.error)
+    assert jobs.jobs("track", clip_id=clip.id) == []
+
+
+HOSTILE = "[x](http://evil.example/a) ![i](http://evil.example/i.png) <img src=http://evil.example/b> **bold-x** :red[r]"
+
+
+def unescaped(markdown: str) -> bool:
+    """Whether Markdown source would render a link, an image, HTML or emphasis of HOSTILE's."""
+    return bool(re.search(r"(?<!\\)(\]\(http|<img|\*\*bold-x|:red\[)", markdown))
+
+
+def test_names_are_text_on_every_page(store, clip_file, tmp_path):
+    """A project, clip and bundle named with Markdown and HTML: no element carries them unescaped."""
+    project = store.create_project(HOSTILE)
+    clip = store.add_clip(project.id, clip_file, name=HOSTILE + ".mp4")
+    store.add_bundle(project.id, HOSTILE, tmp_path / "b")
+    for name in ("projects", "track", "correct", "train", "evaluate", "export"):
+        at = page(name, project_id=project.id, clip_id=clip.id)
+        assert not at.exception, name
+        kinds = ("title", "subheader", "markdown", "caption", "info", "success", "error", "warning")
+        bad = [e.value for k in kinds for e in getattr(at, k) if unescaped(str(e.value))]
+        bad += [b.label for b in at.button if unescaped(b.label)]
+        assert bad == [], (name, bad)

@@ -138,7 +138,7 @@ def editor_panel() -> None:
         cache = frame_cache(str(clip.path))
         cache.url(frame)
     except (VideoError, IndexError, ValueError) as exc:
-        st.error(f"Cannot show frame {frame}: {exc}")
+        st.error(plain(f"Cannot show frame {frame}: {exc}"))
         return
     tracks = [dict(id=t, colour=track_colour(t)) for t in data["ids"]]
     late = box_editor(key=editor_key, width=clip.width, height=clip.height, frame_count=clip.frame_count,
@@ -192,7 +192,7 @@ with tab_tracks:
                 jump(frame)
                 st.rerun()
             except StoreError as exc:
-                st.error(f"Not saved: {exc}")
+                st.error(plain(f"Not saved: {exc}"))
         st.caption(f"Operations apply at the frame shown (frame {frame}); each is one step of undo (Ctrl+Z in the "
                    "editor) and is stored as revisions of the boxes it changes.")
 
@@ -211,7 +211,7 @@ with tab_review:
                     st.session_state[f"last_review:{clip.id}"] = rid
                     st.rerun()
                 except StoreError as exc:
-                    st.error(str(exc))
+                    st.error(plain(exc))
         rid = st.session_state.get(f"last_review:{clip.id}")
         if rid is not None and st.button("Undo my last verdict", key=f"rv_undo:{clip.id}"):
             s.undo_review(clip.id, rid)
@@ -239,7 +239,7 @@ with tab_retrack:
                                                    if b.id == project.default_bundle_id), None))
             st.success(f"Started: {plain(job.label)}")
         except (RuntimeError, ValueError) as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     runs = s.runs(clip.id)
     if len(runs):
         r = runs.iloc[-1]

@@ -58,7 +58,7 @@ for f in uploaded or []:
         kind, message = seen[f.file_id]
     else:
         try:
-            with st.spinner(f"Checking and storing {f.name}..."):
+            with st.spinner(f"Checking and storing {plain(f.name)}..."):
                 clip = save_upload(s, project.id, f.name, f)
             kind, message = "success", f"Added {plain(clip.name)}: {clip.frame_count} frames, {clip.fps:.1f} fps, " \
                                        f"{clip.width}x{clip.height}."

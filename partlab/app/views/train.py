@@ -40,7 +40,7 @@ if go_train:
                              start_path=starts[start_label])
         st.success(f"Started: {plain(job.label)}")
     except (RuntimeError, ValueError) as exc:
-        st.error(str(exc))
+        st.error(plain(exc))
 
 
 job_panel("train", limit=3, project_id=project.id)
@@ -94,7 +94,7 @@ if bundles:
             s.set_default_bundle(project.id, chosen)
             st.success(f"Default bundle: {plain(labels[chosen])}")
         except StoreError as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     for b in reversed(bundles):
         with st.expander(f"{plain(b.name)} · {b.created:%Y-%m-%d %H:%M} · {plain(b.path)}", expanded=b is bundles[-1]):
             show_summary(b.summary, key=str(b.id))
