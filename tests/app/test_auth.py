@@ -201,7 +201,8 @@ def test_a_viewer_cannot_start_a_tracking_run(signed):
     assert jobs.jobs("track", clip_id=clip.id) == []
 
 
-HOSTILE = "[x](http://evil.example/a) ![i](http://evil.example/i.png) <img src=http://evil.example/b> **bold-x** :red[r]"
+HOSTILE = ("[x](http://evil.example/a) ![i](http://evil.example/i.png) <img src=http://evil.example/b> "
+           "**bold-x** :red[r]")
 
 
 def unescaped(markdown: str) -> bool:
