@@ -29,19 +29,6 @@ def _demo_ready(data: str) -> bool:
     return ready
 
 
-def _sign_in():
-    auth.sign_in_form()
-
-
-try:  # a read-only or full data directory, an unreachable database: a sentence, not a traceback
-    if auth.enabled() and not auth.user():
-        st.navigation([st.Page(_sign_in, title="Sign in", default=True)], position="hidden").run()
-        st.stop()
-    _demo_ready(str(data_dir()))
-    store = state.store()
-except (StoreError, OSError) as exc:
-    st.error(storage_message(exc))
-    st.stop()
 
 PROJECTS = st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects")
 PAGES = [
@@ -53,6 +40,24 @@ PAGES = [
     st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
     st.Page("views/depth.py", title="Depth", icon=":material/layers:", url_path="depth"),
 ]
+
+
+def _sign_in():
+    auth.sign_in_form()
+
+
+try:  # a read-only or full data directory, an unreachable database: a sentence, not a traceback
+    if auth.enabled() and not auth.user():
+        # every address (a link to /correct too) shows the sign-in form, and stays where it was after it
+        st.navigation([st.Page(_sign_in, title="Sign in", default=True)]
+                      + [st.Page(_sign_in, title="Sign in", url_path=p.url_path) for p in PAGES],
+                      position="hidden").run()
+        st.stop()
+    _demo_ready(str(data_dir()))
+    store = state.store()
+except (StoreError, OSError) as exc:
+    st.error(storage_message(exc))
+    st.stop()
 
 
 def _home():

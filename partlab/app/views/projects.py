@@ -8,6 +8,7 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.runs import clip_state
+from partlab.app.upload_notice import show_refusals
 from partlab.app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
 from partlab.app.views.common import plain, require_project
 from partlab.labelling import access
@@ -52,6 +53,7 @@ uploaded = None
 if access.may(s, project.id, "annotator"):  # a viewer gets no uploader (the store would refuse the clip too)
     uploaded = st.file_uploader(f"Upload clips ({', '.join(UPLOAD_EXTENSIONS)}; up to {limit} MB each)",
                                 type=list(UPLOAD_EXTENSIONS), accept_multiple_files=True, key=f"upload:{project.id}")
+    show_refusals()  # a file over the limit, refused by the browser: its sentence shown, not just an icon
 seen = st.session_state.setdefault("uploads_done", {})
 for f in uploaded or []:
     if f.file_id in seen:
