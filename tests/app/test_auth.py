@@ -222,3 +222,25 @@ def test_names_are_text_on_every_page(store, clip_file, tmp_path):
         bad = [e.value for k in kinds for e in getattr(at, k) if unescaped(str(e.value))]
         bad += [b.label for b in at.button if unescaped(b.label)]
         assert bad == [], (name, bad)
+
+
+def test_an_export_on_a_full_disk_is_a_sentence_and_leaves_no_half_archive(store, tracked_clip, monkeypatch):
+    import shutil
+
+    from partlab.labelling.config import data_dir
+
+    project, clip = tracked_clip
+
+    def no_space(base_name, *args, **kwargs):
+        Path(base_name + ".zip").write_bytes(b"PK\x03\x04 half")
+        raise OSError(errno.ENOSPC, "No space left on device", base_name + ".zip")
+
+    monkeypatch.setattr(shutil, "make_archive", no_space)
+    at = page("export", project_id=project.id)
+    at.button[0].click().run()
+    assert not at.exception
+    [said] = [shown(e) for e in at.error]
+    assert said.startswith("Cannot write ") and said.endswith(
+        "-mot.zip: no space left on the device (earlier outputs are left as they were)."), said
+    assert list((data_dir() / "exports").iterdir()) == []
+    assert len(store.tracks(clip.id)) == 24

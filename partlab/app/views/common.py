@@ -25,8 +25,9 @@ def storage_message(exc: BaseException) -> str:
         from partlab.cli import describe_os_error
 
         where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
-        return plain(f"Cannot write{where}: {describe_os_error(exc)}. Nothing was changed; what was saved "
-                     "before is intact.")
+        said = describe_os_error(exc)  # a full disk says itself that earlier outputs stay
+        return plain(f"Cannot write{where}: {said}." + ("" if "earlier outputs" in said else
+                                                        " Nothing was changed; what was saved before is intact."))
     return plain(f"Not done: {exc}")
 
 

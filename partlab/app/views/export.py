@@ -8,7 +8,7 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.runs import safe_name
-from partlab.app.views.common import plain, require_project
+from partlab.app.views.common import plain, require_project, storage_message
 from partlab.labelling import formats
 from partlab.labelling.config import data_dir
 
@@ -55,7 +55,7 @@ if go:
         _old_archives()
     except (ValueError, OSError) as exc:
         shutil.rmtree(work, ignore_errors=True)
-        st.error(plain(f"Export failed: {exc}"))
+        st.error(storage_message(exc) if isinstance(exc, OSError) else plain(f"Export failed: {exc}"))
 
 archive = Path(st.session_state.get("export_archive", ""))
 if archive.name and archive.is_file():
