@@ -7,6 +7,10 @@ killed app loses nothing that was shown as saved. Undo/redo walk this session's 
 from it, the in-between boxes refilled from it, every box of a merged track), undone
 together. The store keeps every revision, so an undo is itself a new revision
 (``Store.undo_many``) and a redo writes the undone content again.
+
+Events (activities over a range of frames, ``Store.add_event``) are edited the same way: adding,
+stretching, retyping or deleting one is a step whose undo writes the event's fields from before it
+as a new revision (an added event is deleted, a deleted one comes back).
 """
 
 from __future__ import annotations
@@ -34,6 +38,8 @@ class Step:
     frame: int
     run_id: int | None = None
     refill: list[tuple[int, str, int]] = field(default_factory=list)
+    #: events the step changed: ``(event_id, fields before, fields after)``; None = no such event
+    events: list[tuple[int, dict | None, dict | None]] = field(default_factory=list)
 
 
 @dataclass
@@ -44,6 +50,8 @@ class EditHistory:
     undo: list[Step] = field(default_factory=list)
     redo: list[Step] = field(default_factory=list)
     revs: dict[tuple[int, int, str], int] = field(default_factory=dict)
+    #: the revision this session wrote last for each event
+    event_revs: dict[int, int] = field(default_factory=dict)
 
     def wrote(self, keys: list[tuple[int, int, str, int]]) -> None:
         for f, t, p, r in keys:
@@ -133,23 +141,93 @@ def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = ""
     step = history.undo[-1]
     if step.run_id is not None:
         store.undo_run(clip_id, step.run_id)
-    keys = _rewrite(store, clip_id, history, step, step.before, author)
+    keys = _rewrite(store, clip_id, history, step, step.before, author) if step.keys else []
+    for event_id, before, _after in step.events:
+        _set_event(store, clip_id, history, event_id, before, author)
     history.undo.pop()
     history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                             refill=step.refill))
+                             refill=step.refill, events=step.events))
     return step
 
 
 def redo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
     step = history.redo[-1]
-    keys = _rewrite(store, clip_id, history, step, step.after, author)
+    keys = _rewrite(store, clip_id, history, step, step.after, author) if step.keys else []
+    for event_id, _before, after in step.events:
+        _set_event(store, clip_id, history, event_id, after, author)
     history.redo.pop()
     again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                 refill=step.refill)
+                 refill=step.refill, events=step.events)
     if step.refill:
         again.run_id = _refill(store, clip_id, step.refill)
     history.undo.append(again)
     return again
+
+
+def _event_now(store: Store, clip_id: int, event_id: int) -> tuple[int, dict | None]:
+    """The newest revision of an event and its fields (None when it is deleted)."""
+    hist = store.events(clip_id, history=True)
+    rows = hist[hist.event_id == event_id]
+    if not len(rows):
+        raise StoreError(f"no event {event_id} in clip {clip_id}")
+    last = rows.iloc[-1]
+    conf = float(last.confidence)
+    fields = dict(start_frame=int(last.start_frame), end_frame=int(last.end_frame), type=str(last.type),
+                  tracks=[int(t) for t in last.tracks], parts=[str(p) for p in last.parts],
+                  confidence=None if conf != conf else conf, attributes=dict(last.attributes))
+    return int(last.revision), (None if bool(last.deleted) else fields)
+
+
+def _set_event(store: Store, clip_id: int, history: EditHistory, event_id: int, fields: dict | None,
+               author: str) -> None:
+    """Give an event ``fields`` (None: delete it) as a new revision, expecting the one this session wrote."""
+    revision, _ = _event_now(store, clip_id, event_id)
+    expected = history.event_revs.get(event_id, revision)
+    if fields is None:
+        rev = store.edit_event(clip_id, event_id, expected_revision=expected, author=author, delete=True)
+    else:
+        rev = store.edit_event(clip_id, event_id, expected_revision=expected, author=author, **fields)
+    history.event_revs[event_id] = rev
+
+
+def _frames(ev: dict, before: dict | None = None) -> tuple[int, int]:
+    start = int(ev.get("start_frame", before["start_frame"] if before else 0))
+    end = int(ev.get("end_frame", before["end_frame"] if before else start))
+    return min(start, end), max(start, end)
+
+
+def apply_event_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author: str = "") -> Step:
+    """One event action of the editor (``event_add``, ``event_edit``, ``event_delete``) as one step."""
+    kind = ev["kind"]
+    if kind == "event_add":
+        start, end = _frames(ev)
+        etype = str(ev.get("type") or "").strip()
+        event_id = store.add_event(clip_id, start, end, etype, tracks=ev.get("tracks") or (),
+                                   parts=ev.get("parts") or (), source="human", author=author)
+        revision, after = _event_now(store, clip_id, event_id)
+        history.event_revs[event_id] = revision
+        change, label = (event_id, None, after), f"new {etype} event {start}-{end}"
+    else:
+        event_id = int(ev["event_id"])
+        revision, before = _event_now(store, clip_id, event_id)
+        if ev.get("revision") is not None:
+            history.event_revs[event_id] = int(ev["revision"])  # what the user saw: a stale edit is refused
+        if before is None:
+            raise StoreError(f"event {event_id} was deleted")
+        if kind == "event_delete":
+            after, label = None, f"deletion of the {before['type']} event {before['start_frame']}-{before['end_frame']}"
+        else:
+            start, end = _frames(ev, before)
+            after = dict(before, start_frame=start, end_frame=end, type=str(ev.get("type") or before["type"]))
+            label = f"change of the {after['type']} event to {start}-{end}"
+        _set_event(store, clip_id, history, event_id, after, author)
+        change = (event_id, before, after)
+    shown = change[2] or change[1]
+    step = Step(keys=[], before=[], after=[], label=label, frame=int(ev.get("frame", shown["start_frame"])),
+                events=[change])
+    history.undo.append(step)
+    history.redo.clear()
+    return step
 
 
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
@@ -177,6 +255,9 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                     change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
                 record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
                        author=author, fill=fill and kind == "edit")
+                res.written += 1
+            elif kind in ("event_add", "event_edit", "event_delete"):
+                apply_event_edit(store, clip_id, ev, history, author=author)
                 res.written += 1
             elif kind == "undo":
                 if not history.undo:

@@ -127,3 +127,44 @@ def test_an_undone_edit_is_no_correction(store, tracked_clip):
     assert store.human_frames(clip.id) == [] and store.progress(clip.id)["corrected_frames"] == 0
     apply_events(store, clip.id, [dict(kind="redo")], hist)
     assert _box(store, clip.id, 4, "head").source == "human" and store.human_frames(clip.id) == [4]
+
+
+def _events(store, clip_id):
+    return [(int(r.event_id), int(r.start_frame), int(r.end_frame), r.type) for r in store.events(clip_id).itertuples()]
+
+
+def test_events_are_added_stretched_retyped_deleted_and_undone_as_steps(store, tracked_clip):
+    _, clip = tracked_clip
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [dict(seq=1, kind="event_add", frame=2, type="clap", start_frame=2,
+                                             end_frame=4, tracks=[1], parts=["left_hand", "right_hand"])], hist)
+    assert res.errors == [] and _events(store, clip.id) == [(1, 2, 4, "clap")]
+    apply_events(store, clip.id, [dict(seq=2, kind="event_edit", event_id=1, revision=1, end_frame=9)], hist)
+    apply_events(store, clip.id, [dict(seq=3, kind="event_edit", event_id=1, revision=2, type="handshake")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "handshake")]
+    apply_events(store, clip.id, [dict(seq=4, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")]
+    apply_events(store, clip.id, [dict(seq=5, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 4, "clap")]  # the stretch undone, a new revision
+    apply_events(store, clip.id, [dict(seq=6, kind="redo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")]
+    apply_events(store, clip.id, [dict(seq=7, kind="event_delete", event_id=1, revision=6)], hist)
+    assert _events(store, clip.id) == []
+    res = apply_events(store, clip.id, [dict(seq=8, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")] and res.notes == ["undid the deletion of the clap event 2-9"]
+    assert store.events(clip.id).iloc[0].parts == ["left_hand", "right_hand"]  # the fields came back whole
+    apply_events(store, clip.id, [dict(seq=9, kind="undo"), dict(seq=10, kind="undo")], hist)
+    assert _events(store, clip.id) == []  # the add undone: the event is deleted
+    assert len(store.events(clip.id, history=True)) == 10  # every step is a revision, nothing is overwritten
+
+
+def test_a_stale_or_impossible_event_edit_is_refused(store, tracked_clip):
+    _, clip = tracked_clip
+    eid = store.add_event(clip.id, 1, 3, "pick")
+    store.edit_event(clip.id, eid, expected_revision=1, end_frame=5, author="someone else")
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [dict(seq=1, kind="event_edit", event_id=eid, revision=1, end_frame=8)], hist)
+    assert "was changed by someone else (revision 2, you had 1)" in res.errors[0]
+    res = apply_events(store, clip.id, [dict(seq=2, kind="event_edit", event_id=eid, revision=2, end_frame=99)], hist)
+    assert "not an interval inside clip" in res.errors[0] and not hist.undo
+    assert _events(store, clip.id) == [(eid, 1, 5, "pick")]

@@ -20,6 +20,8 @@ from partlab.app.editing import apply_events, record
 from partlab.app.runs import start_tracking
 from partlab.app.views.common import job_panel, pick_clip, plain, require_project
 from partlab.labelling import trackops
+from partlab.labelling.events import KINDS
+from partlab.labelling.formats.events import KIND_COLOURS
 from partlab.labelling.store import Store, StoreError
 from partlab.labelling.video import VideoClip, VideoError
 from partlab.tracking.parts import BOX_PARTS
@@ -104,6 +106,13 @@ def clip_boxes(url: str, clip_id: int, version) -> dict:
                 parts=[p for p in BOX_PARTS if p in set(df.part)] or list(BOX_PARTS), ids=[t["id"] for t in tracks])
 
 
+def timeline_events() -> list[dict]:
+    """The clip's events as the editor's timeline draws them (newest revision of each, not deleted)."""
+    return [dict(id=int(r.event_id), revision=int(r.revision), start=int(r.start_frame), end=int(r.end_frame),
+                 type=str(r.type), colour=KIND_COLOURS.get(str(r.type), "#bab0ac"))
+            for r in s.events(clip.id).itertuples()]
+
+
 def apply(events: list[dict]) -> None:
     """Write the editor's events; the messages show above the editor on this run."""
     fill = any(e.get("fill") for e in events if e.get("kind") == "edit")
@@ -144,7 +153,8 @@ def editor_panel() -> None:
     late = box_editor(key=editor_key, width=clip.width, height=clip.height, frame_count=clip.frame_count,
                       fps=clip.fps, frame_url=cache.url, boxes_by_frame={} if occluder_mode else data["by_frame"],
                       version=version, jump=st.session_state[jkey], tracks=tracks,
-                      next_track_id=s.next_track_id(clip.id), used_parts=data["parts"], timeline=data["timeline"],
+                      next_track_id=s.next_track_id(clip.id), used_parts=data["parts"],
+                      timeline=dict(data["timeline"], events=timeline_events(), kinds=list(KINDS)),
                       mode="occluders" if occluder_mode else "boxes",
                       occluders=[dict(x=b.x, y=b.y, w=b.w, h=b.h) for b in s.occluders(clip.id)])
     if late:  # events the early read did not see (not expected; kept so none is ever dropped)
@@ -261,4 +271,8 @@ with tab_keys:
         "or on hover · wheel, **+**/**-**: zoom at the mouse · **0**: fit · **1**: 1:1 · right- or middle-drag: pan · "
         "**Ctrl+Z / Ctrl+Y**: undo/redo a step. The timeline under the frame shows each track's presence (colour), "
         "keyframes (white ticks), failure flags (black ticks), reviewed ranges (green/red) and flagged frames (red "
-        "strip on top); click it to jump.")
+        "strip on top); click it to jump. Its bottom row holds the **events** (activities over a range of frames, "
+        "a colour per kind): **E** or *add event* adds one of the chosen kind from the shown frame; click an event "
+        "to select it and jump to its start, drag its left or right end to stretch it, pick another kind to retype "
+        "it, *delete event* removes it; **J** / **Shift+J**: next/previous event. Event changes are undone with "
+        "Ctrl+Z like box edits and stored as revisions.")
