@@ -7,10 +7,18 @@ killed app loses nothing that was shown as saved. Undo/redo walk this session's 
 from it, the in-between boxes refilled from it, every box of a merged track), undone
 together. The store keeps every revision, so an undo is itself a new revision
 (``Store.undo_many``) and a redo writes the undone content again.
+
+Track mode refills in two passes: the straight line between the keyframes at once (part of the
+edit's step), then keyframe-guided tracking of that one track (:func:`refine_step`, which the page
+runs as a background job: about 1-2 s a stretch) written into the same step, so one undo takes
+back the edit, the line and the tracker's boxes. A refinement is dropped unwritten when its step
+was undone meanwhile or a later step refilled the same track and part (the newer boxes stay).
 """
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from partlab.labelling import trackops
@@ -25,7 +33,8 @@ class Step:
     """One undoable action: the keys it wrote ``(frame, track_id, part, revision)``, the
     human layer of those keys before and after it (changes for ``Store.edit_boxes``), the
     tracker run it wrote (in-between boxes; None: none), the keys whose in-betweens it
-    refilled ``(track_id, part, frame)``, a label for the messages and the frame to show."""
+    refilled ``(track_id, part, frame)``, a label for the messages and the frame to show;
+    ``refined``: the runs :func:`refine_step` added later (undone first)."""
 
     keys: list[tuple[int, int, str, int]]
     before: list[dict]
@@ -34,16 +43,29 @@ class Step:
     frame: int
     run_id: int | None = None
     refill: list[tuple[int, str, int]] = field(default_factory=list)
+    refined: list[int] = field(default_factory=list)
+    fills: dict[tuple[int, str], int] = field(default_factory=dict)  # EditHistory.fills when it refilled
 
 
 @dataclass
 class EditHistory:
     """Undo/redo stacks of one session and clip (newest last); ``revs``: the revision this
-    session wrote last for each key (what its next undo or redo of that key expects)."""
+    session wrote last for each key (what its next undo or redo of that key expects);
+    ``fills``: how often each ``(track_id, part)`` was refilled or un-refilled (a refinement
+    started at one count is stale at another); ``lock``: held while the stacks change (a
+    refinement job writes from another thread)."""
 
     undo: list[Step] = field(default_factory=list)
     redo: list[Step] = field(default_factory=list)
     revs: dict[tuple[int, int, str], int] = field(default_factory=dict)
+    fills: dict[tuple[int, str], int] = field(default_factory=dict)
+    lock: threading.RLock = field(default_factory=threading.RLock, repr=False, compare=False)
+
+    def touched(self, refill: list[tuple[int, str, int]]) -> dict[tuple[int, str], int]:
+        """Count a refill (or its undo) of these tracks and parts; returns their new counts."""
+        for tid, part, _ in refill:
+            self.fills[(tid, part)] = self.fills.get((tid, part), 0) + 1
+        return {(tid, part): self.fills[(tid, part)] for tid, part, _ in refill}
 
     def wrote(self, keys: list[tuple[int, int, str, int]]) -> None:
         for f, t, p, r in keys:
@@ -59,6 +81,7 @@ class ApplyResult:
     written: int = 0
     errors: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    refills: list[Step] = field(default_factory=list)  # steps whose straight lines a tracker may refine
 
 
 def _box(values) -> Box:
@@ -91,6 +114,12 @@ def record(store: Store, clip_id: int, changes: list[dict], history: EditHistory
            author: str = "", fill: bool = False) -> Step:
     """Write ``changes`` as one step (plus the person boxes recomputed from body-part edits
     and, with ``fill``, the in-between boxes of the edited key) and push it on the undo stack."""
+    with history.lock:
+        return _record(store, clip_id, changes, history, label, frame, author, fill)
+
+
+def _record(store: Store, clip_id: int, changes: list[dict], history: EditHistory, label: str, frame: int,
+            author: str, fill: bool) -> Step:
     keys, before, after = _write(store, clip_id, changes, author)
     boxes = [c for c in changes if c.get("box") is not None and c.get("kind", "box") == "box"]
     person = []
@@ -106,6 +135,7 @@ def record(store: Store, clip_id: int, changes: list[dict], history: EditHistory
         c = boxes[0]
         step.refill = [(int(c["track_id"]), str(c["part"]), int(c["frame"]))]
         step.run_id = _refill(store, clip_id, step.refill)
+        step.fills = history.touched(step.refill)
     history.undo.append(step)
     history.redo.clear()
     return step
@@ -129,27 +159,49 @@ def _rewrite(store: Store, clip_id: int, history: EditHistory, step: Step, conte
 
 def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
     """Take the newest step back: its keys get their human layer from before it (a key the
-    tracker had goes back to the tracker), and its tracker run is undone."""
-    step = history.undo[-1]
-    if step.run_id is not None:
-        store.undo_run(clip_id, step.run_id)
-    keys = _rewrite(store, clip_id, history, step, step.before, author)
-    history.undo.pop()
-    history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                             refill=step.refill))
+    tracker had goes back to the tracker), and its tracker runs are undone (newest first)."""
+    with history.lock:
+        step = history.undo[-1]
+        for run in [*reversed(step.refined), step.run_id]:
+            if run is not None:
+                store.undo_run(clip_id, run)
+        keys = _rewrite(store, clip_id, history, step, step.before, author)
+        history.undo.pop()
+        history.touched(step.refill)
+        history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label,
+                                 frame=step.frame, refill=step.refill))
     return step
 
 
 def redo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
-    step = history.redo[-1]
-    keys = _rewrite(store, clip_id, history, step, step.after, author)
-    history.redo.pop()
-    again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                 refill=step.refill)
-    if step.refill:
-        again.run_id = _refill(store, clip_id, step.refill)
-    history.undo.append(again)
-    return again
+    with history.lock:
+        step = history.redo[-1]
+        keys = _rewrite(store, clip_id, history, step, step.after, author)
+        history.redo.pop()
+        again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
+                     refill=step.refill)
+        if step.refill:
+            again.run_id = _refill(store, clip_id, step.refill)
+            again.fills = history.touched(step.refill)
+        history.undo.append(again)
+        return again
+
+
+def refine_step(store: Store, clip_id: int, history: EditHistory, step: Step, propose: trackops.Proposer,
+                progress: Callable[[int, int], None] | None = None) -> dict | None:
+    """Replace the straight in-between boxes ``step`` wrote with ``propose``'s (keyframe-guided
+    tracking) and add that run to the step, so that undoing the step undoes it too. Returns
+    ``{run_id, boxes}``, or None when the step was undone meanwhile or a later step refilled one
+    of its tracks and parts (then nothing is written)."""
+    proposals = [(t, p, *trackops.propose_fill(store, clip_id, t, p, f, propose, progress)) for t, p, f in step.refill]
+    with history.lock:
+        live = any(s is step for s in history.undo)
+        if not live or any(history.fills.get(k, 0) != n for k, n in step.fills.items()):
+            return None
+        runs = [trackops.write_fill(store, clip_id, t, p, spans, table) for t, p, spans, table in proposals]
+        step.refined.extend(r for r in runs if r is not None)
+    boxes = sum(len(table) for *_, table in proposals if table is not None)
+    return dict(run_id=step.refined[-1], boxes=boxes) if step.refined else None
 
 
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
@@ -175,8 +227,10 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                               box=_box(ev["box"]) if kind == "edit" else None)
                 if kind == "edit":
                     change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
-                record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
-                       author=author, fill=fill and kind == "edit")
+                step = record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}",
+                              frame, author=author, fill=fill and kind == "edit")
+                if step.run_id is not None:
+                    res.refills.append(step)
                 res.written += 1
             elif kind == "undo":
                 if not history.undo:
@@ -191,6 +245,8 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                     res.notes.append("nothing to redo")
                     continue
                 step = redo_step(store, clip_id, history, author=author)
+                if step.run_id is not None:
+                    res.refills.append(step)
                 res.frame = step.frame
                 res.written += 1
                 res.notes.append(f"redid the {step.label}")
