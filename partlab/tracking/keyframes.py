@@ -245,6 +245,19 @@ def stretch_proposer(read: Callable[[int], np.ndarray], *, tracker: str = "body"
     return propose
 
 
+def warm_up(tracker: str = "body") -> None:
+    """Run ``tracker`` once between two keyframes of a tiny drawn scene, so that its imports and
+    compiled kernels (numba's on-disk cache is read at a kernel's first call, which also sets up
+    numba's compiler: seconds on a busy machine) are loaded before a user waits for them."""
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 255, (64, 64, 3), dtype=np.uint8) for _ in range(3)]
+    for f in frames:
+        f[20:52, 24:40] = (40, 60, 200)
+    keys = pd.DataFrame({"frame": [0, 2], "track_id": 1, "part": "person", "x": 24.0, "y": 20.0, "w": 16.0,
+                         "h": 32.0})
+    track_between(MemoryTake(frames), keys, 1, 0, 2, tracker=tracker, frames=frames)
+
+
 class _FrameCache:
     """Frames of a take read in order once, kept while some stretch still needs them."""
 

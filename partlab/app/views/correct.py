@@ -114,6 +114,17 @@ def apply(events: list[dict]) -> None:
         jump(result.frame)
 
 
+@st.cache_resource(show_spinner=False)
+def warm_tracker() -> threading.Thread:
+    """Load the body tracker and its compiled kernels once per server process, in the
+    background, so that the first keyframe a user moves does not wait for them."""
+    from partlab.tracking.keyframes import warm_up
+
+    thread = threading.Thread(target=warm_up, name="partlab-warm-tracker", daemon=True)
+    thread.start()
+    return thread
+
+
 def refine(steps: list[Step]) -> None:
     """Keyframe-guided tracking of each refilled track and part, restricted to that track's region
     and stretch, as a background job; the straight line between the keyframes shows until it ends."""
@@ -172,6 +183,7 @@ def editor_panel() -> None:
         st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
 
+warm_tracker()
 editor_panel()
 job_panel("refine", limit=1, clip_id=clip.id)
 frame = current_frame()
