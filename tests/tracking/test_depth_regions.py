@@ -102,3 +102,27 @@ def test_elbow_found_on_the_depth_of_the_arm_and_fallback_when_hidden():
     got, ok = elbow(cam, hidden, shoulder, hand, 300.0, 260.0, 20.0, 60.0, 36)
     assert not ok and np.allclose(got, hand + [0, 0, 260.0])  # (X_h, Y_h, Z_h + l_f)
     assert Posture().upper_arm > Posture().forearm
+
+
+def test_hand_reference_with_its_other_bin_observes_the_scale():
+    """A round hand on pixels outside the hand mask: with the fill-weighted reference the window
+    of the hand's own size scores best; a pure-skin reference (fill 1) prefers the smallest."""
+    from partlab.tracking.core.hue_histogram import box_histograms, hue_confidence, integral_histogram
+    from partlab.tracking.depth.tracker import hand_reference
+
+    nb = 16
+    bins = np.full((80, 80), nb, np.int16)  # "other": not in front of the face
+    yy, xx = np.mgrid[:80, :80]
+    bins[(xx - 40) ** 2 + (yy - 40) ** 2 <= 10**2] = 2  # the hand, 20 px across, skin hue bin 2
+    skin = np.full((10, 10), 2, np.int16)  # the face's inner part
+    integral = integral_histogram(bins, nb + 1)
+    alphas = np.array([0.7, 0.85, 1.0, 1.15, 1.4])
+    boxes = np.stack([40 - 10 * alphas, 40 - 10 * alphas, 20 * alphas, 20 * alphas], axis=1)
+    for fill, best in ((0.785, 1.0), (1.0, 0.7)):
+        ref = hand_reference(skin, (0, 0, 10, 10), nb, fill)
+        assert ref.shape == (nb + 1,) and ref.sum() == pytest.approx(1.0)
+        conf = hue_confidence(box_histograms(integral, boxes), ref, 6.0)
+        assert alphas[np.argmax(conf)] == best, (fill, conf)
+    ref = hand_reference(skin, (0, 0, 10, 10), nb, 0.785)
+    conf = hue_confidence(box_histograms(integral, boxes), ref, 6.0)
+    assert conf[2] > 0.95 and conf[0] < conf[2] - 0.1 and conf[-1] < conf[2] - 0.1

@@ -21,7 +21,9 @@ World frame = the left camera (x right, y down, z forward, millimetres). The rig
 Truth (a tracks table): ``head``, ``left_hand``, ``right_hand`` boxes (tight extent of the pixels
 the left camera sees of them) with ``X,Y,Z`` the part's centre; ``left/right_shoulder`` and
 ``left/right_elbow`` joints (a small box around the projected joint) with their 3D centres;
-``torso`` box. ``occluded`` is the fraction of a part hidden by the person's other parts.
+``torso`` box. ``occluded`` is the fraction of a part's silhouette not seen (hidden by the
+person's other parts, or outside the frame); a part wholly outside the frame has no row (as in
+:mod:`.scene`): fast hands of a person near the camera leave the field of view now and then.
 """
 
 from __future__ import annotations
@@ -447,9 +449,11 @@ def _truth_rows(i: int, labels: np.ndarray, lay: _Layout, hands: np.ndarray, elb
             cols = np.flatnonzero(mask.any(axis=0))
             rws = np.flatnonzero(mask.any(axis=1))
             box = (cols[0], rws[0], cols[-1] - cols[0] + 1, rws[-1] - rws[0] + 1)
-        else:  # hidden: the projected extent
+        else:  # hidden: the projected extent; wholly outside the frame: no row (as in .scene)
             (u, v), = cam.project(c[None])
             r = radii[part] * cam.K[0, 0] / c[2]
+            if u + r <= 0 or v + r <= 0 or u - r >= cam.size[0] or v - r >= cam.size[1]:
+                continue
             box = (u - r, v - r, 2 * r, 2 * r)
         # occluded: the fraction of the part's own silhouette that something else covers
         occ = _occluded_fraction(cam, c, radii[part], mask) if part != "torso" else 0.0
@@ -505,12 +509,14 @@ def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 15
 
 
 def _occluded_fraction(cam: Camera, c: np.ndarray, r: float, visible: np.ndarray) -> float:
+    """The fraction of the part's projected disc not seen: hidden by something nearer, or outside
+    the frame (a hand at the image's edge is partly out of view)."""
     (u, v), = cam.project(c[None])
     rad = r * cam.K[0, 0] / c[2]
     h, w = visible.shape
     yy, xx = np.ogrid[:h, :w]
     disc = (xx - u) ** 2 + (yy - v) ** 2 <= rad ** 2
-    n = int(disc.sum())
+    n = max(float(np.pi * rad ** 2), float(disc.sum()))
     return round(1.0 - min(1.0, int((disc & visible).sum()) / n), 4) if n else 1.0
 
 
