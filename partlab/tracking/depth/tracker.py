@@ -420,8 +420,19 @@ class DepthTracker:
         hand_boxes = [self.hands[n].filter.box() if self.hands[n].initialised else None for n in HANDS]
         if self.head_mm is None:
             self.head_mm = head_width(camera, depth, fbox, p.posture)
-        pose = recover(camera, depth, fbox, hand_boxes, p.posture, self.head_mm)
+        pose = recover(camera, depth, fbox, [self._seen(n, b, camera) for n, b in zip(HANDS, hand_boxes)],
+                       p.posture, self.head_mm)
         return self._rows(index, view.stream, camera, fbox, hand_boxes, pose)
+
+    def _seen(self, name: str, box, camera) -> tuple | None:
+        """The hand's box for the posture when the hand is seen now: tracked with confidence (not
+        held, :meth:`_track_hand`) and at least half of its window inside the frame; else None
+        (no 3D point, no elbow: a stale or cut-off hand would place the arm wrongly)."""
+        h = self.hands[name]
+        if box is None or h.low > 0:
+            return None
+        shown = _in_frame(box, tuple(camera.size))
+        return box if shown is not None and shown[2] * shown[3] >= 0.5 * box[2] * box[3] else None
 
     def _rows(self, index, stream, camera, fbox, hand_boxes, pose) -> list[TrackRecord]:
         tid = self.track_id
