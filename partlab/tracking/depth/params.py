@@ -150,6 +150,11 @@ class Posture:
     # widths) under which a candidate "matches its corresponding point in the depth map"
     elbow_candidates: int = number(72, POSITIVE_COUNT)
     elbow_tolerance: float = number(0.6)
+    # the arm model: points sampled along each of the upper arm and forearm of a candidate
+    arm_samples: int = number(8, POSITIVE_COUNT)
+    # the factors tried on the arms' proportions (each person's arms fitted to the depth over the
+    # clip, posture.ArmFit): adults' arm-to-head ratios spread by several per cent
+    arm_scales: tuple[float, ...] = pair((0.88, 0.94, 1.0, 1.06, 1.12), n=5)
     # sec. 5's "rough range of elbow ... according to human kinetics": an elbow is not more than this
     # above its shoulder, nor more than this nearer the body's midline than its shoulder (head widths);
     # without it, candidates in front of the chest match the chest's depth as well as the arm's

@@ -77,11 +77,41 @@ def head_width(camera: Camera, depth: np.ndarray, head_box, p: Posture) -> float
     return float(head_box[2]) * zh / max(fx - float(head_box[2]) * p.head_depth, 1e-6)
 
 
+class ArmFit:
+    """The arms' lengths of one person (our addition to sec. 5's arm model): the paper fixes them in
+    proportion to the head; people's arms differ from the average by several per cent, and a
+    stretched arm 5 % shorter than the model puts the elbow ~50 mm off its line. Each frame, every
+    factor of ``Posture.arm_scales`` is tried on both arms (:func:`arm_cost` of its best elbow, or
+    1 when the hand is farther from the shoulder than that arm reaches); the factor with the least
+    summed cost so far gives the lengths (both arms: people are symmetric)."""
+
+    def __init__(self, p: Posture):
+        self.scales = np.asarray(p.arm_scales, float)
+        self.cost = np.zeros(len(self.scales))
+
+    @property
+    def scale(self) -> float:
+        return float(self.scales[int(np.argmin(self.cost))]) if self.cost.any() else 1.0
+
+    def update(self, camera: Camera, depth: np.ndarray, shoulder, hand, upper, fore, arm_depth, tolerance,
+               n, in_range, samples: int) -> None:
+        reach = float(np.linalg.norm(hand - shoulder))
+        for k, f in enumerate(self.scales):
+            if reach > 0.999 * f * (upper + fore):
+                self.cost[k] += 1.0
+                continue
+            cands = elbow_circle(shoulder, hand, f * upper, f * fore, n)
+            c = arm_cost(camera, depth, shoulder, cands, hand, arm_depth, tolerance, samples)
+            c[~in_range(cands)] = np.inf
+            self.cost[k] += min(float(c.min()), 1.0)
+
+
 def recover(camera: Camera, depth: np.ndarray, head_box, hand_boxes, p: Posture,
-            head_mm: float | None = None) -> Pose3D | None:
+            head_mm: float | None = None, arms: ArmFit | None = None) -> Pose3D | None:
     """The posture of one person: ``hand_boxes`` ``[left, right]``, each a box or None; ``head_mm``:
     the head's width measured once (a head does not change size; the filter's alpha does), else
-    from this box."""
+    from this box; ``arms``: the person's arm lengths, updated with this frame (else the
+    proportions as they are)."""
     zh = surface_depth(depth, head_box)
     if zh is None:
         return None
@@ -102,17 +132,26 @@ def recover(camera: Camera, depth: np.ndarray, head_box, hand_boxes, p: Posture,
     right_sh = shoulder_mid - p.shoulder_half * head_w * right
     tw, th = p.torso_size[0] * head_w, p.torso_size[1] * head_w
     torso = shoulder_mid + 0.5 * th * down
+    upper, fore = p.upper_arm * head_w, p.forearm * head_w
+    arm_depth, tol = p.arm_depth * head_w, p.elbow_tolerance * head_w
+    sides = []
+    for shoulder, hand, outward in ((left_sh, hands[0], right), (right_sh, hands[1], -right)):
+        def in_range(c, s=shoulder, o=outward):  # sec. 5's kinetic range: not above, not medial of it
+            return (((c - s) @ down) > -p.elbow_above * head_w) & (((c - s) @ o) > -p.elbow_medial * head_w)
+
+        sides.append((shoulder, hand, in_range))
+        if arms is not None and hand is not None:
+            arms.update(camera, depth, shoulder, hand, upper, fore, arm_depth, tol, p.elbow_candidates, in_range,
+                        p.arm_samples)
+    scale = arms.scale if arms is not None else 1.0
     elbows, matched = [], []
-    for shoulder, hand in ((left_sh, hands[0]), (right_sh, hands[1])):
+    for shoulder, hand, in_range in sides:
         if hand is None:
             elbows.append(None)
             matched.append(False)
             continue
-        outward = right if shoulder is left_sh else -right
-        e, ok = elbow(camera, depth, shoulder, hand, p.upper_arm * head_w, p.forearm * head_w,
-                      p.arm_depth * head_w, p.elbow_tolerance * head_w, p.elbow_candidates,
-                      in_range=lambda c, s=shoulder, o=outward: (((c - s) @ down) > -p.elbow_above * head_w)
-                      & (((c - s) @ o) > -p.elbow_medial * head_w))
+        e, ok = elbow(camera, depth, shoulder, hand, scale * upper, scale * fore, arm_depth, tol,
+                      p.elbow_candidates, in_range=in_range, samples=p.arm_samples)
         elbows.append(e)
         matched.append(ok)
     return Pose3D(head, hands[0], hands[1], torso, (tw, th), left_sh, right_sh, elbows[0], elbows[1], head_w,

@@ -38,7 +38,7 @@ from partlab.tracking.core.hue_histogram import (
 )
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthParams
-from partlab.tracking.depth.posture import head_width, recover
+from partlab.tracking.depth.posture import ArmFit, head_width, recover
 from partlab.tracking.depth.regions import HandRegion, depth_foreground, face_depth, hand_regions
 from partlab.tracking.depth.sampling import draw_importance, icondensation_correction
 from partlab.tracking.frame import FrameSet
@@ -128,6 +128,7 @@ class DepthTracker:
                 rows = init[(init["track_id"] == self.track_id) & (init["frame"] == self.start_frame)]
                 self._init_boxes = {r.part: (float(r.x), float(r.y), float(r.w), float(r.h)) for r in rows.itertuples()}
         self.hands = {h: _Hand(h, np.zeros(2)) for h in HANDS}
+        self.arms = ArmFit(params.posture)  # the person's arm lengths, fitted over the clip (sec. 5)
         self.stats = _Stats()
         self.events = None
 
@@ -421,7 +422,7 @@ class DepthTracker:
         if self.head_mm is None:
             self.head_mm = head_width(camera, depth, fbox, p.posture)
         pose = recover(camera, depth, fbox, [self._seen(n, b, camera) for n, b in zip(HANDS, hand_boxes)],
-                       p.posture, self.head_mm)
+                       p.posture, self.head_mm, self.arms)
         return self._rows(index, view.stream, camera, fbox, hand_boxes, pose)
 
     def _seen(self, name: str, box, camera) -> tuple | None:
