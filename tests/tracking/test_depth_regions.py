@@ -126,3 +126,30 @@ def test_hand_reference_with_its_other_bin_observes_the_scale():
     ref = hand_reference(skin, (0, 0, 10, 10), nb, 0.785)
     conf = hue_confidence(box_histograms(integral, boxes), ref, 6.0)
     assert conf[2] > 0.95 and conf[0] < conf[2] - 0.1 and conf[-1] < conf[2] - 0.1
+
+
+def test_arm_lengths_are_fitted_to_the_depth_of_a_shorter_arm():
+    """Arms 6 % shorter than the head's proportions: the stretched arm rules the longer factors
+    out, the bent ones fit best at the true factor, and the elbow then lands on the true one."""
+    from partlab.tracking.depth.posture import ArmFit
+
+    cam = Camera("c", [[300, 0, 160], [0, 300, 120], [0, 0, 1]], (320, 240))
+    p = Posture()
+    upper, fore, true_scale = 300.0, 260.0, 0.94
+    shoulder = np.array([0.0, 0.0, 1500.0])
+    fit = ArmFit(p)
+    for reach, turn in ((0.97, 0.0), (0.8, 0.5), (0.9, -0.4)):
+        direction = np.array([np.sin(turn), np.cos(turn), -0.3])
+        direction /= np.linalg.norm(direction)
+        hand = shoulder + reach * true_scale * (upper + fore) * direction
+        true = elbow_circle(shoulder, hand, true_scale * upper, true_scale * fore, 36)[9]
+        depth = np.full((240, 320), 3000.0, np.float32)
+        for a, b in ((shoulder, true), (true, hand)):
+            for s in np.linspace(0, 1, 200):
+                q = a + s * (b - a)
+                (u, v), = cam.project(q[None])
+                depth[int(v) - 4:int(v) + 5, int(u) - 4:int(u) + 5] = q[2] - 20.0
+        fit.update(cam, depth, shoulder, hand, upper, fore, 20.0, 60.0, 36, lambda c: np.ones(len(c), bool), 8)
+    assert fit.scale == true_scale, fit.cost
+    got, ok = elbow(cam, depth, shoulder, hand, fit.scale * upper, fit.scale * fore, 20.0, 60.0, 36)
+    assert ok and np.linalg.norm(got - true) < 40.0
