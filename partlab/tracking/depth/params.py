@@ -119,8 +119,8 @@ class Reacquisition:
     min_face: int = number(16, POSITIVE_COUNT)
     # "if average confidence of samples exceeds the threshold ... initialisation is successful".
     # Both hand thresholds sit above what a window with no hand pixel at all scores against the
-    # hands' reference, exp(-lam (1 - sqrt(1 - hand_fill))) = 0.04 at the defaults; half the
-    # window's share of skin scores about 0.35
+    # hands' reference, exp(-lam (1 - sqrt(1 - hand_fill))) = 0.04 at the defaults; a window a
+    # fifth of whose pixels are the hand's skin scores about 0.3, the hand's own window 1
     hand_confidence: float = number(0.2)
     # a hand whose best sample stays under this for hand_frames frames is re-initialised
     hand_lost: float = number(0.1)
