@@ -69,7 +69,7 @@ def score(tracks: pd.DataFrame, truth: pd.DataFrame, n: int) -> dict:
     rows whose hand is at least half in view (``occluded`` < 0.5: hidden or outside the frame)."""
     out = {}
     m = truth.merge(tracks, on=["frame", "part"], how="left", suffixes=("_t", ""))
-    for suffix, rows in (("", m), (" half", m[m["occluded"] < 0.5])):
+    for suffix, rows in (("", m), (" half", m[m["occluded_t"] < 0.5])):  # the truth's occluded
         wrong = np.zeros(n, bool)
         seen = np.zeros(n, bool)
         for part in HANDS:
