@@ -172,24 +172,27 @@ def figure(path: Path, seed: int = 0, frames: int = 40) -> None:
 
 def measure(args, counts: list[int], scenarios: list[str], results: dict[str, list[dict]]) -> None:
     """Run every take, resampling and cue of ``args`` into ``results`` (saved after every seed)."""
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    modes = args.modes.split(",")
     for scen in [s for s in scenarios if s in ("s1", "s2")]:
-        for seed in range(args.seeds):
+        for seed in seeds:
             scene = make_topview(f"topview_{scen}", seed, args.frames)
-            for mode in ("part", "global"):
+            for mode in modes:
                 for n in counts:
                     p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=n))
                     results.setdefault(f"{scen.upper()} {mode} colour", []).append({"n": n, **run(scene, p, seed)})
-                p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
-                                  likelihood=replace(LikelihoodParams(), use_colour=False))
-                results.setdefault(f"{scen.upper()} {mode} depth-only", []).append(
-                    {"n": args.default_particles, **run(scene, p, seed)})
+                if args.depth_only:
+                    p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
+                                      likelihood=replace(LikelihoodParams(), use_colour=False))
+                    results.setdefault(f"{scen.upper()} {mode} depth-only", []).append(
+                        {"n": args.default_particles, **run(scene, p, seed)})
             print(f"{scen} seed {seed} done", file=sys.stderr, flush=True)
             if args.json:  # after every seed, so that a long run interrupted keeps what it measured
                 args.json.write_text(json.dumps(results, indent=1))
     if "s3" in scenarios:
-        for seed in range(args.seeds):
+        for seed in seeds:
             scene = make_topview("topview_s3", seed, args.frames)
-            for mode in ("part", "global"):
+            for mode in modes:
                 p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles))
                 results.setdefault(f"S3 {mode} colour", []).append({"n": args.default_particles, **run(scene, p, seed)})
             print(f"s3 seed {seed} done", file=sys.stderr, flush=True)
@@ -248,6 +251,10 @@ def print_equal_time(results: dict[str, list[dict]]) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds first-seed .. first-seed + seeds - 1")
+    ap.add_argument("--modes", default="part,global", help="resamplings to run (part, global)")
+    ap.add_argument("--no-depth-only", dest="depth_only", action="store_false",
+                    help="leave out the runs without the colour term")
     ap.add_argument("--frames", type=int, default=50)
     ap.add_argument("--particles", default="50,100,200")
     ap.add_argument("--default-particles", type=int, default=200)
@@ -262,8 +269,9 @@ def main(argv=None) -> int:
         return 0
     counts = [int(x) for x in args.particles.split(",")]
     results: dict[str, list[dict]] = {}
-    for saved in args.from_json or ():
-        results.update(json.loads(saved.read_text()))
+    for saved in args.from_json or ():  # several files: their runs of one key are put together
+        for key, rows in json.loads(saved.read_text()).items():
+            results.setdefault(key, []).extend(rows)
     if args.from_json:
         counts = sorted({r["n"] for rows in results.values() for r in rows})
     else:
