@@ -16,11 +16,11 @@ from __future__ import annotations
 import numpy as np
 
 from partlab.tracking.core.resampling import systematic_resample
-from partlab.tracking.limbs3d.params import Limbs3DParams
+from partlab.tracking.limbs3d.params import Limbs3DDynamics
 
 
 class TargetFilter:
-    def __init__(self, position, params: Limbs3DParams, rng: np.random.Generator, spread: float | None = None):
+    def __init__(self, position, params: Limbs3DDynamics, rng: np.random.Generator, spread: float | None = None):
         self.params = params
         self.rng = rng
         self.particles = np.zeros((params.particles, 6))

@@ -99,11 +99,11 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
     dv_a = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 0], cands.blobs[:, 0])])
     dv_b = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 1], cands.blobs[:, 1])])
     ddv = dv_a - dv_b
-    p_o = np.exp(-ddv**2 / (2 * params.sigma_v**2))
-    p_t = np.exp(-cands.error**2 / (2 * params.sigma_d**2))
+    p_o = np.exp(-ddv**2 / (2 * params.priors.sigma_v**2))
+    p_t = np.exp(-cands.error**2 / (2 * params.priors.sigma_d**2))
     ds = np.stack([silhouette_distance(c, v, cands.points) if v.has_silhouette else np.zeros(len(cands))
                    for c, v in zip(cameras, views)], axis=1)
-    p_b = np.exp(-(ds**2).sum(axis=1) / (2 * params.sigma_s**2))
+    p_b = np.exp(-(ds**2).sum(axis=1) / (2 * params.priors.sigma_s**2))
     return Prior(p_o, p_t, p_b), {"dv": ddv, "d": cands.error, "ds": ds}
 
 
@@ -112,8 +112,8 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
     ``merge_boost`` times its prior to the one that absorbs it (capped at 1).
     Returns ``points (K, 3)`` and ``prior (K,)``, strongest first."""
-    keep = (prior >= params.prior_threshold) & np.isfinite(points).all(axis=1)
-    keep &= (points[:, 2] > 0) & (points[:, 2] < params.max_height)
+    keep = (prior >= params.priors.prior_threshold) & np.isfinite(points).all(axis=1)
+    keep &= (points[:, 2] > 0) & (points[:, 2] < params.priors.max_height)
     pts, pr = points[keep], prior[keep]
     order = np.argsort(-pr, kind="stable")
     pts, pr = pts[order], pr[order]
@@ -124,12 +124,12 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     for i in range(len(pr)):
         if not alive[i]:
             continue
-        near = alive & (dist[i] < params.merge_distance)
+        near = alive & (dist[i] < params.priors.merge_distance)
         near[i] = False
         absorbed = np.flatnonzero(near)
         alive[absorbed] = False
-        value = min(1.0, pr[i] + params.merge_boost * float(pr[absorbed].sum()))
-        if params.merge_average and len(absorbed):
+        value = min(1.0, pr[i] + params.priors.merge_boost * float(pr[absorbed].sum()))
+        if params.priors.merge_average and len(absorbed):
             idx = np.concatenate([[i], absorbed])
             p = (pts[idx] * pr[idx, None]).sum(0) / pr[idx].sum()
         else:
