@@ -38,6 +38,17 @@ class Limbs3DObservations:
     # blobs smaller than this many pixels are noise (a hand 3 m away at 640x480 is ~200 px)
     blob_min_area: float = number(12.0)
     skin_threshold: float = number(0.5, FRACTION)
+    # opening kernel (pixels, elliptic) on the skin mask before blobs, 1 = none: the anti-aliased
+    # rim of a yellow or orange shirt against a grey wall mixes to skin chroma, a 1-2 px line that
+    # joins head and hands into one blob through the torso's outline; a 5 px opening removes it
+    # while a hand 3 m away (~15 px across at 640x480) stays
+    skin_open: int = number(5, POSITIVE_COUNT)
+    # with --init: refit the skin model (core.skin.train_skin_model, a Bayes ratio over coarse luma
+    # bins shrunk to the rule) on the init targets' back-projected boxes in every view. A shaded
+    # olive or orange sleeve shares the rule's chroma with skin but not its brightness; its
+    # speckle otherwise joins the hand's blob and drags its centre ~100 mm up the arm
+    skin_adapt: bool = flag(True)
+    skin_ybins: int = number(8, POSITIVE_COUNT)
     # silhouettes (sec. 6.1, background subtraction): with an empty-scene plate per view (a take's
     # ``<stream>_background.png``), a pixel is a person's where a channel differs from the plate by
     # more than this (after a 2 x 2 area average; sensor noise is ~3 levels); without one, the run
@@ -53,12 +64,17 @@ class Limbs3DObservations:
 class Limbs3DPriors:
     """The candidate prior p(Z) = p_o p_t p_b (eq. 19, 25-27), pruning and merging (sec. 6.4)."""
 
-    # eq. 25 (fitted): spread of the difference of the two blobs' relative heights within their
-    # silhouettes
-    sigma_v: float = number(0.08, POSITIVE)
-    # eq. 26 (fitted): spread of the distance between the two lines of sight (mm); true pairs lie
-    # within a few cm (blob centroids are not projections of one 3D point: the head's hair, sec. 6.3)
-    sigma_d: float = number(30.0, POSITIVE)
+    # eq. 25 (fitted): spread (mm) of the difference of the two blobs' depths below the top of
+    # their silhouettes (priors.py: the paper's relative rows, turned into mm at the candidate's
+    # depth because a table hides the legs from some views); on seated takes true pairs differ by
+    # 30-45 mm (median) and 120-150 (90th percentile; cameras tilt down ~20 degrees, so a hand
+    # held forward reads lower in a frontal view), false ones by ~400
+    sigma_v: float = number(100.0, POSITIVE)
+    # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
+    # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
+    # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;
+    # 20 mm keeps the true ones (>= 0.75 at 15 mm) and halves those false ones
+    sigma_d: float = number(20.0, POSITIVE)
     # eq. 27 (fitted): spread of the distance (pixels) of the candidate's projection to each view's
     # silhouette
     sigma_s: float = number(6.0, POSITIVE)

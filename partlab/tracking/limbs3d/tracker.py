@@ -33,7 +33,7 @@ import pandas as pd
 
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
-from partlab.tracking.core.skin import SkinModel, find_blobs
+from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
 from partlab.tracking.limbs3d.filter import TargetFilter
@@ -83,6 +83,7 @@ class Limbs3DTracker:
         self.cameras = [cameras[s] for s in self.streams]
         self.plates = {s: self._half(b) for s, b in (backgrounds or {}).items() if b is not None}
         self.skin = SkinModel.default()
+        self._skin_fitted = False
         self.machine = LimbStateMachine(params)
         self.targets: dict[int, _Target] = {}
         self.pending: dict[int, _Target] = {}
@@ -158,8 +159,30 @@ class Limbs3DTracker:
         size = self.params.output.head_size_mm if t.part == "head" else self.params.output.hand_size_mm
         return camera.project(t.position[None])[0], 0.5 * camera.K[0, 0] * size / max(cam[2], 1.0)
 
+    def _adapt_skin(self, frames: FrameSet) -> None:
+        """Refit the skin model on the starting targets' boxes in every view (once)."""
+        images, boxes = [], []
+        for stream, cam in zip(self.streams, self.cameras):
+            view = frames.views.get(stream)
+            if view is None or view.color is None:
+                continue
+            b = []
+            for t in self.targets.values():
+                if t.position is not None and t.start_frame <= frames.index:
+                    uv, r = self._project(cam, t)
+                    if np.all(np.isfinite(uv)):
+                        b.append((uv[0] - r, uv[1] - r, 2 * r, 2 * r))
+            images.append(view.color)
+            boxes.append(np.array(b, float).reshape(-1, 4))
+        if sum(len(b) for b in boxes):
+            self.skin = train_skin_model(images, boxes, bins=self.skin.bins, ybins=self.params.observations.skin_ybins,
+                                         prior=self.skin)
+        self._skin_fitted = True
+
     def observe(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]):
         p = self.params
+        if p.observations.skin_adapt and not self._skin_fitted and self.targets:
+            self._adapt_skin(frames)
         people = max(1, len({t.track_id for t in self.targets.values()}))
         centres, views = [], []
         for stream, cam in zip(self.streams, self.cameras):
@@ -180,6 +203,9 @@ class Limbs3DTracker:
                 pad = self.skin.blur
                 x0, y0, x1, y1 = max(x - pad, 0), max(y - pad, 0), min(x + w + pad, W), min(y + h + pad, H)
                 crop = self.skin.mask(view.color[y0:y1, x0:x1], allowed[y0:y1, x0:x1], p.observations.skin_threshold)
+                k = p.observations.skin_open
+                if k > 1:
+                    crop = cv2.morphologyEx(crop, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
             centres.append(blobs.centres)
