@@ -255,7 +255,10 @@ class Limbs3DTracker:
             else:
                 mine = np.ones(len(points), bool)
             est = t.filter.update(points[mine], weights[mine])
-            t.position = est
+            if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
+                t.position = est  # a lost target stays where it was lost until something is found there
+            else:
+                est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
                 obs["modes"] = self._modes(est, points[mine], weights[mine])
