@@ -163,6 +163,9 @@ def _training_inputs(store: Store, project_id: int, clip_ids: list[int], name: s
         if not len(truth):
             raise ValueError(f"clip {clip.name!r} has no corrected frames yet")
         clips.append((frames_factory(clip.path), clip.fps, truth))
+    from partlab.models import training
+
+    training.check_span(clips, [store.clip(cid).name for cid in clip_ids], training.TrainingOptions().dt)
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
@@ -199,6 +202,8 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
         progress(0, total)
         bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names,
                                        start=start)
+        if bundle.summary["nothing_learnt"]:  # never saved, never a project's default
+            raise training.NothingLearnt(f"learnt nothing: {bundle.summary['nothing_learnt']}")
         bundle_mod.save_bundle(bundle, out)
         record = store.add_bundle(project_id, name, out, summary=bundle.summary)
         if make_default:

@@ -8,6 +8,7 @@ from partlab.app import state
 from partlab.app.runs import SHIPPED, bundle_choices, start_training
 from partlab.app.views.common import job_panel, plain, require_project
 from partlab.labelling.store import StoreError
+from partlab.models.training import NothingLearnt
 
 s = state.store()
 st.title("Train")
@@ -39,6 +40,8 @@ if go_train:
         job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default,
                              start_path=starts[start_label])
         st.success(f"Started: {plain(job.label)}")
+    except NothingLearnt as exc:
+        st.error(f"Nothing to learn yet: {exc}.")
     except (RuntimeError, ValueError) as exc:
         st.error(str(exc))
 
