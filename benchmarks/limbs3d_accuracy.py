@@ -9,7 +9,11 @@ clap/handshake (a hand nearer the other hand's truth than its own for 10+ frames
 a run with camera 0 hidden for 30 frames (frames 60-89, 3+ cameras: targets in the lost state at
 frame 100, error over the hidden stretch) and CPU frames/s of the tracker alone.
 
-    nice python benchmarks/limbs3d_accuracy.py --seeds 3 --scenarios standing seated
+With ``--learn K`` the prior variances are first fitted (sec. 6.4, :mod:`partlab.models.limbs3d`)
+on K held-apart seeds per scenario (seeds 1000, 1001, ...: never among the evaluated ones) and every
+evaluated take is tracked again with them (``learnt_mean``: mean 3D error of all parts).
+
+    nice python benchmarks/limbs3d_accuracy.py --seeds 10 --cams 2 3 --learn 1
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.labelling.synth.multiview import make_multiview_scene
+from partlab.models.limbs3d import PairErrors, fit_sigmas, true_pair_errors
 from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.tracker import Limbs3DTracker
@@ -63,34 +68,56 @@ def swaps(e: pd.DataFrame, after: int = 85, frames: int = 10) -> int:
     return n
 
 
+def learn(scenarios, k: int, n_cams: int, frames: int) -> Limbs3DParams:
+    """Sigmas fitted on ``k`` held-apart seeds per scenario (``n_cams`` views)."""
+    errors = []
+    for name in scenarios:
+        for seed in range(1000, 1000 + k):
+            scene = make_multiview_scene(name, n_cams, seed=seed, n_frames=frames)
+            cams = {c.name: c for c in scene.cameras}
+            sets = (FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams})
+                    for i in range(frames))
+            errors.append(true_pair_errors(sets, cams, scene.truth3d, backgrounds=scene.backgrounds))
+    fitted, table = fit_sigmas(PairErrors.concat(errors))
+    print(table.to_string(index=False), flush=True)
+    return fitted
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=10)
-    ap.add_argument("--scenarios", nargs="+", default=["standing", "seated"])
+    ap.add_argument("--scenarios", nargs="+", default=["standing", "seated", "handshake"])
+    ap.add_argument("--cams", type=int, nargs="+", default=[2, 3, 4])
     ap.add_argument("--frames", type=int, default=150)
+    ap.add_argument("--learn", type=int, default=0, help="fit the sigmas on this many held-apart seeds per scenario")
     args = ap.parse_args()
+    learnt = learn(args.scenarios, args.learn, 3, args.frames) if args.learn else None
     rows = []
     for name in args.scenarios:
         for seed in range(args.seeds):
-            scene = make_multiview_scene(name, 4, seed=seed, n_frames=args.frames)
-            for n_cams in (2, 3, 4):
+            scene = make_multiview_scene(name, max(args.cams), seed=seed, n_frames=args.frames)
+            for n_cams in args.cams:
                 e, fps = run(scene, n_cams, Limbs3DParams(), seed=seed)
                 row = {"scenario": name, "seed": seed, "cams": n_cams, "fps": fps, "swaps": swaps(e)}
                 for part, g in e.groupby("part"):
                     row[f"{part}_mean"] = g["err"].mean()
                     row[f"{part}_median"] = g["err"].median()
                     row[f"{part}_within100"] = (g["err"] < 100).mean()
+                if learnt is not None:
+                    row["learnt_mean"] = run(scene, n_cams, learnt, seed=seed)[0]["err"].mean()
                 if n_cams >= 3:
                     eh, _ = run(scene, n_cams, Limbs3DParams(), hide=(60, 90), seed=seed)
                     stretch = eh[(eh["frame"] >= 60) & (eh["frame"] < 90)]
                     row["hidden_mean"] = stretch["err"].mean()
                     row["hidden_lost_at_100"] = int(((eh["frame"] == 100) & (eh["state"] == "lost")).sum())
+                    # the same take with every camera: targets that were lost anyway (a hand hidden by a body)
+                    row["unhidden_lost_at_100"] = int(((e["frame"] == 100) & (e["state"] == "lost")).sum())
                     row["hidden_within100_after"] = (eh[eh["frame"] >= 90]["err"] < 100).mean()
                 rows.append(row)
                 print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
     df = pd.DataFrame(rows)
     cols = [c for c in df.columns if c.endswith(("_mean", "_median", "_within100")) or c in
-            ("fps", "swaps", "hidden_lost_at_100", "hidden_within100_after")]
+            ("fps", "swaps", "hidden_lost_at_100", "unhidden_lost_at_100", "hidden_within100_after")]
     summary = df.groupby(["scenario", "cams"])[cols].agg(["mean", "std"])
     pd.set_option("display.width", 250)
     pd.set_option("display.max_columns", 60)

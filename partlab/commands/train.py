@@ -1,4 +1,5 @@
-"""``partlab train --clip VIDEO --truth TRUTH.csv [...] -o BUNDLE_DIR``.
+"""``partlab train --clip VIDEO --truth TRUTH.csv [...] -o BUNDLE_DIR``
+(or ``--take TAKE --truth TRUTH.csv [...]``: the multi-camera tracker's prior variances).
 
 Fits the four failure SVMs and the variance parameters from corrected clips
 (:func:`partlab.models.training.train_bundle`), writes a model bundle and prints the
@@ -14,9 +15,12 @@ from partlab.cli import CommandError, seed
 
 
 def add_arguments(p) -> None:
-    p.add_argument("--clip", metavar="VIDEO", action="append", required=True, help="a corrected clip (repeatable)")
+    p.add_argument("--clip", metavar="VIDEO", action="append", help="a corrected clip (repeatable)")
+    p.add_argument("--take", metavar="TAKE", action="append",
+                   help="a corrected multi-camera take (repeatable; instead of --clip): fits the limbs3d "
+                        "tracker's prior variances sigma_v, sigma_d, sigma_s from its heads' and hands' X, Y, Z")
     p.add_argument("--truth", metavar="TRUTH.csv", action="append", required=True,
-                   help="its corrected boxes, one per --clip in the same order")
+                   help="its corrected boxes, one per --clip (or --take) in the same order")
     p.add_argument("-o", "--output", metavar="BUNDLE_DIR", required=True, help="model bundle directory to write")
     p.add_argument("--seed", type=seed, default=0)
     p.add_argument("--from", dest="start", metavar="MODEL", default="default",
@@ -39,6 +43,14 @@ def _tracker_runner():
 
 
 def run(args) -> int:
+    if args.take:
+        return _train_takes(args)
+    if not args.clip:
+        raise CommandError("give --clip VIDEO (or --take TAKE) with each --truth")
+    return _train_clips(args)
+
+
+def _train_clips(args) -> int:
     import pandas as pd
     from tqdm import tqdm
 
@@ -112,4 +124,44 @@ def run(args) -> int:
         print(f"\nvalidation on the training clips, starting from {args.start!r} (tracking rate per part; noise "
               "and extent are kept only if they raise the mean, the new detector unless it lowers it):")
         print(selection_table(bundle.summary["selection"]))
+    return 0
+
+
+def _train_takes(args) -> int:
+    """The limbs3d prior variances from corrected takes (:func:`partlab.models.limbs3d.fit_from_takes`),
+    written as a bundle whose other parameters are the defaults."""
+    from partlab.labelling.take import open_take
+    from partlab.models.bundle import Bundle, BundleError, save_bundle
+    from partlab.models.limbs3d import fit_from_takes
+    from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
+
+    if args.clip:
+        raise CommandError("give either --clip or --take, not both")
+    if len(args.take) != len(args.truth):
+        raise CommandError(f"{len(args.take)} --take but {len(args.truth)} --truth; give one --truth per --take")
+    out = Path(args.output)
+    if out.exists() and (not out.is_dir() or (any(out.iterdir()) and not (out / "bundle.json").is_file())):
+        raise CommandError(f"{out}: exists and is not a model bundle; choose another --output")
+    try:
+        truths = [read_tracks_csv(t) for t in args.truth]
+    except TracksCSVError as exc:
+        raise CommandError(str(exc)) from None
+    takes = [open_take(t) for t in args.take]
+    try:
+        params, table = fit_from_takes(takes, truths)
+    except ValueError as exc:
+        raise CommandError(str(exc)) from None
+    finally:
+        for take in takes:
+            take.close()
+    if table["fitted"].isna().all():
+        raise CommandError(f"learnt nothing from {', '.join(args.take)}: too few true candidate pairs; "
+                           f"no bundle written to {out}")
+    summary = {"learnt": ["limbs3d sigmas"], "limbs3d_sigmas": table.to_dict("records")}
+    try:
+        save_bundle(Bundle(summary=summary, more_params={"limbs3d": params}), out)
+    except BundleError as exc:
+        raise CommandError(str(exc)) from None
+    print(f"wrote {out}; limbs3d prior variances (sec. 6.4, maximum likelihood over true candidate pairs):")
+    print(table.to_string(index=False))
     return 0

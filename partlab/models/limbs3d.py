@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.tracking.camera import Camera
-from partlab.tracking.frame import Frame, FrameSet
+from partlab.tracking.frame import FrameSet
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.tracker import LIMB_PARTS, Limbs3DTracker
 
@@ -48,11 +48,11 @@ class PairErrors:
         return PairErrors(*(np.concatenate([getattr(i, k) for i in items] or [np.zeros(0)]) for k in ("dv", "d", "ds")))
 
 
-def true_pair_errors(frames: Mapping[str, Iterable[np.ndarray]], cameras: Mapping[str, Camera], truth3d: pd.DataFrame,
+def true_pair_errors(framesets: Iterable[FrameSet], cameras: Mapping[str, Camera], truth3d: pd.DataFrame,
                      params: Limbs3DParams | None = None, backgrounds: Mapping[str, np.ndarray] | None = None,
                      every: int = 2, match_mm: float = MATCH_MM) -> PairErrors:
-    """Run the tracker over a take (``frames``: per stream an iterable of BGR frames) with the truth's
-    first frame as its init and collect the raw errors of the true pairs of every ``every``-th frame."""
+    """Run the tracker over a take's frames with the truth's first frame as its init and collect
+    the raw errors of the true pairs of every ``every``-th frame."""
     params = params or Limbs3DParams()
     truth = truth3d[truth3d["part"].isin(LIMB_PARTS)]
     first = int(truth["frame"].min())
@@ -60,10 +60,9 @@ def true_pair_errors(frames: Mapping[str, Iterable[np.ndarray]], cameras: Mappin
     tr = Limbs3DTracker(params, np.random.default_rng(0), cameras, init=init, backgrounds=backgrounds)
     by_frame = {f: g[["X", "Y", "Z"]].to_numpy(float) for f, g in truth.groupby("frame")}
     dv, d, ds = [], [], []
-    streams = list(cameras)
-    for i, images in enumerate(zip(*(frames[s] for s in streams))):
-        tr.step(FrameSet(i, {s: Frame(i, img, None, s, cameras[s]) for s, img in zip(streams, images)}),
-                {s: None for s in streams})
+    for fs in framesets:
+        i = fs.index
+        tr.step(fs, {s: None for s in cameras})
         if i % every or i not in by_frame or not tr.last:
             continue
         cands, raw = tr.last["candidates"], tr.last["raw"]
@@ -97,3 +96,29 @@ def fit_sigmas(errors: PairErrors, defaults: Limbs3DParams | None = None) -> tup
             changes[f"priors.{name}"] = fitted
         rows.append({"term": name, "default": default, "fitted": fitted, "samples": int(len(x))})
     return defaults.updated(changes), pd.DataFrame(rows)
+
+
+def truth3d_of(truth: pd.DataFrame) -> pd.DataFrame:
+    """A take's 3D truth from its corrected tracks: head and hand rows with ``X, Y, Z`` (one per
+    target and frame)."""
+    if not {"X", "Y", "Z"} <= set(truth.columns):
+        raise ValueError("the truth has no X, Y, Z columns (3D positions of heads and hands)")
+    rows = truth[truth["part"].isin(LIMB_PARTS)].dropna(subset=["X", "Y", "Z"])
+    if rows.empty:
+        raise ValueError("the truth has no head or hand rows with X, Y, Z (3D positions)")
+    return rows.drop_duplicates(["frame", "track_id", "part"])[["frame", "track_id", "part", "X", "Y", "Z"]]
+
+
+def fit_from_takes(takes: list, truths: list[pd.DataFrame], defaults: Limbs3DParams | None = None,
+                   progress=None) -> tuple[Limbs3DParams, pd.DataFrame]:
+    """:func:`fit_sigmas` over the true pairs of several opened takes (:func:`partlab.labelling.take.open_take`)
+    and their corrected tracks (with ``X, Y, Z``)."""
+    errors = []
+    for take, truth in zip(takes, truths):
+        cams = {s: c for s, c in take.cameras.items() if c is not None}
+        if len(cams) < 2:
+            raise ValueError(f"{take.path}: needs two or more calibrated views, has {len(cams)}")
+        errors.append(true_pair_errors(take.frames(), cams, truth3d_of(truth), defaults, take.backgrounds))
+        if progress:
+            progress(str(take.path))
+    return fit_sigmas(PairErrors.concat(errors), defaults)

@@ -5,6 +5,7 @@ import pytest
 
 from partlab.labelling.synth.multiview import make_multiview_scene
 from partlab.models.limbs3d import MIN_PAIRS, PairErrors, fit_sigmas, true_pair_errors
+from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.limbs3d.params import Limbs3DParams
 
 
@@ -24,7 +25,8 @@ def test_fit_is_the_rms_of_each_error_and_keeps_defaults_without_samples():
 def test_true_pairs_of_a_rendered_take_give_tight_sigmas():
     scene = make_multiview_scene("seated", 3, seed=3, n_frames=16)
     cams = {c.name: c for c in scene.cameras}
-    err = true_pair_errors({c: scene.frames[c] for c in cams}, cams, scene.truth3d, backgrounds=scene.backgrounds)
+    frames = (FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}) for i in range(16))
+    err = true_pair_errors(frames, cams, scene.truth3d, backgrounds=scene.backgrounds)
     assert len(err.d) >= 3 * 8  # 3 parts x 8 frames, each seen by at least one pair of views
     fitted, _ = fit_sigmas(err)
     # true pairs' lines of sight pass within a few mm; their Dv agree within ~a hand
