@@ -11,7 +11,7 @@ looking at seeds 0-3, so those four are not unseen). Variants (Table 2's rows):
 - ``stereo``: the full tracker on depth from the rendered stereo pair (``StereoRig``: rectify,
   SGBM, reprojectImageTo3D) instead of the z-buffer.
 
-A hand is right when the seed 002 rule holds (half of the box on the true box and its centre inside;
+A hand is right when Zhao & Lee's rule holds (half of the box on the true box and its centre inside;
 :func:`partlab.labelling.evaluation.box_correct`). Printed: the rate at frame 105 over seeds, the
 fraction of frames right over the clip (mean and standard deviation over seeds), the fraction of
 frames with both hands right, 3D errors (mm) of the head, hands, shoulders and elbows, and the

@@ -187,7 +187,7 @@ class DepthTracker:
 
         Leaving such pixels out of the histogram (as eq. 1-2 do for grey pixels) makes every window
         that holds the hand score alike, however large: the scale alpha then drifts freely and the
-        box outgrows the hand (seed 002's box rule fails with the centre on the hand). Counted in a
+        box outgrows the hand (Zhao & Lee's box rule fails with the centre on the hand). Counted in a
         bin the reference (the face's skin) hardly has, they lower the confidence of a window by the
         share of it that is not hand, as background of another hue does in colour alone."""
         nb = self.params.appearance.hue_bins
