@@ -155,7 +155,8 @@ def test_arm_lengths_are_fitted_to_the_depth_of_a_shorter_arm():
     assert ok and np.linalg.norm(got - true) < 40.0
 
 
-def test_hands_bins_other_behind_the_hand_plane_and_colour_alone_where_depth_is_missing():
+
+def test_hands_bins_other_behind_the_hand_plane_and_where_depth_is_missing():
     from partlab.tracking.depth.params import DepthParams
     from partlab.tracking.depth.regions import FaceDepth
     from partlab.tracking.depth.tracker import DepthTracker
@@ -165,4 +166,5 @@ def test_hands_bins_other_behind_the_hand_plane_and_colour_alone_where_depth_is_
     bins = np.array([[3, 3, 3, -1]], np.int16)
     depth = np.array([[900.0, 1500.0, np.nan, 900.0]], np.float32)  # near, at the face, unmeasured, near
     got = tracker._hand_bins(bins, depth, FaceDepth(1500.0, 5.0, 160.0))
-    assert got.tolist() == [[3, nb, 3, nb]]
+    assert got.tolist() == [[3, nb, nb, nb]]
+    assert tracker._hand_bins(bins, depth, None).tolist() == [[3, 3, 3, nb]]  # colour alone: only hue counts
