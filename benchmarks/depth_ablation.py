@@ -149,8 +149,9 @@ def main() -> None:
 
 def summarise(df: pd.DataFrame, args) -> None:
     seeds = sorted(df["seed"].unique())
+    sizes = ", ".join(sorted(set(df["size"]))) if "size" in df else f"{args.width}x{args.height}"
     print(f"\nTable 2 (hands right; seeds {seeds[0]}..{seeds[-1]} ({len(seeds)}), {args.frames} frames, "
-          f"{args.width}x{args.height}): mean (sd over seeds)")
+          f"{sizes}): mean (sd over seeds)")
     cols = [f"left_hand@{AT}", f"right_hand@{AT}", "left_hand clip", "right_hand clip", "both clip",
             "both clip half", "scored half"]
     for variant in [v for v in VARIANTS if v in set(df["variant"])]:
@@ -158,7 +159,7 @@ def summarise(df: pd.DataFrame, args) -> None:
         cells = "  ".join(f"{c} {d[c].mean():.3f} ({d[c].std():.3f})" for c in cols)
         print(f"  {variant:9s} {cells}")
     print("\n3D errors, mm: mean over frames, then mean (sd) over seeds")
-    for variant in ("all", "stereo", "color_ms"):
+    for variant in [v for v in ("all", "stereo", "color_ms") if v in set(df["variant"])]:
         d = df[df["variant"] == variant]
         print(f"  {variant:9s} " + "  ".join(f"{p} {d[p + ' mm'].mean():.0f} ({d[p + ' mm'].std():.0f})"
                                              for p in POINTS))
