@@ -11,7 +11,7 @@ looking at seeds 0-3, so those four are not unseen). Variants (Table 2's rows):
 - ``stereo``: the full tracker on depth from the rendered stereo pair (``StereoRig``: rectify,
   SGBM, reprojectImageTo3D) instead of the z-buffer.
 
-A hand is right when the seed 002 rule holds (half of the box on the true box and its centre inside;
+A hand is right when Zhao & Lee's rule holds (half of the box on the true box and its centre inside;
 :func:`partlab.labelling.evaluation.box_correct`). Printed: the rate at frame 105 over seeds, the
 fraction of frames right over the clip (mean and standard deviation over seeds), the fraction of
 frames with both hands right, 3D errors (mm) of the head, hands, shoulders and elbows, and the
@@ -47,6 +47,14 @@ VARIANTS = ("color_ms", "color_is", "all", "stereo")
 HANDS = ("left_hand", "right_hand")
 POINTS = ("head", "left_hand", "right_hand", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow")
 AT = 105
+
+
+# webcam-like sizes for --random-size (the paper's is 320x240)
+RANDOM_SIZES = ((256, 192), (320, 240), (400, 300), (480, 360))
+
+
+def random_size(seed: int) -> tuple[int, int]:
+    return RANDOM_SIZES[int(np.random.default_rng([seed, 99]).integers(len(RANDOM_SIZES)))]
 
 
 def run_variant(scene, depth, variant: str, seed: int):
@@ -97,6 +105,8 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=150)
     ap.add_argument("--width", type=int, default=320)
     ap.add_argument("--height", type=int, default=240)
+    ap.add_argument("--random-size", action="store_true",
+                    help="render each seed at a size drawn from RANDOM_SIZES (by the seed) instead of --width/--height")
     ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=VARIANTS)
     ap.add_argument("--csv", help="also write the per-seed rows to this CSV (rewritten after every seed)")
     ap.add_argument("--summarise", nargs="+", metavar="CSV", help="only print the summary of these rows")
@@ -108,7 +118,8 @@ def main() -> None:
     results = []
     for seed in range(args.first_seed, args.first_seed + args.seeds):
         name = "desk_depth" if seed % 2 == 0 else "standing_depth"
-        scene = make_depth_scene(name, seed, args.frames, args.width, args.height)
+        width, height = random_size(seed) if args.random_size else (args.width, args.height)
+        scene = make_depth_scene(name, seed, args.frames, width, height)
         if "stereo" in args.variants:
             rig = StereoRig(scene.cameras["cam0"], scene.cameras["cam0_right"])
             t = time.process_time()
@@ -118,13 +129,13 @@ def main() -> None:
             err = np.abs(stereo - scene.depth)[person]
         for variant in args.variants:
             tracks, fps = run_variant(scene, stereo if variant == "stereo" else scene.depth, variant, seed)
-            row = {"seed": seed, "scene": name, "variant": variant, "fps": fps,
+            row = {"seed": seed, "scene": name, "variant": variant, "size": f"{width}x{height}", "fps": fps,
                    **score(tracks, scene.truth, args.frames)}
             if variant == "stereo":
                 row.update({"stereo fps": stereo_fps, "stereo valid": float(np.isfinite(err).mean()),
                             "stereo median mm": float(np.nanmedian(err))})
             results.append(row)
-            print(f"seed {seed} {name:15s} {variant:9s} hands clip "
+            print(f"seed {seed} {name:15s} {width}x{height} {variant:9s} hands clip "
                   f"{row['left_hand clip']:.2f}/{row['right_hand clip']:.2f}"
                   f" both {row['both clip']:.2f} (half in view {row['both clip half']:.2f})"
                   f"  elbows {row['left_elbow mm']:.0f}/{row['right_elbow mm']:.0f} mm"
@@ -138,8 +149,9 @@ def main() -> None:
 
 def summarise(df: pd.DataFrame, args) -> None:
     seeds = sorted(df["seed"].unique())
+    sizes = ", ".join(sorted(set(df["size"]))) if "size" in df else f"{args.width}x{args.height}"
     print(f"\nTable 2 (hands right; seeds {seeds[0]}..{seeds[-1]} ({len(seeds)}), {args.frames} frames, "
-          f"{args.width}x{args.height}): mean (sd over seeds)")
+          f"{sizes}): mean (sd over seeds)")
     cols = [f"left_hand@{AT}", f"right_hand@{AT}", "left_hand clip", "right_hand clip", "both clip",
             "both clip half", "scored half"]
     for variant in [v for v in VARIANTS if v in set(df["variant"])]:
@@ -147,7 +159,7 @@ def summarise(df: pd.DataFrame, args) -> None:
         cells = "  ".join(f"{c} {d[c].mean():.3f} ({d[c].std():.3f})" for c in cols)
         print(f"  {variant:9s} {cells}")
     print("\n3D errors, mm: mean over frames, then mean (sd) over seeds")
-    for variant in ("all", "stereo", "color_ms"):
+    for variant in [v for v in ("all", "stereo", "color_ms") if v in set(df["variant"])]:
         d = df[df["variant"] == variant]
         print(f"  {variant:9s} " + "  ".join(f"{p} {d[p + ' mm'].mean():.0f} ({d[p + ' mm'].std():.0f})"
                                              for p in POINTS))

@@ -153,3 +153,18 @@ def test_arm_lengths_are_fitted_to_the_depth_of_a_shorter_arm():
     assert fit.scale == true_scale, fit.cost
     got, ok = elbow(cam, depth, shoulder, hand, fit.scale * upper, fit.scale * fore, 20.0, 60.0, 36)
     assert ok and np.linalg.norm(got - true) < 40.0
+
+
+
+def test_hands_bins_other_behind_the_hand_plane_and_where_depth_is_missing():
+    from partlab.tracking.depth.params import DepthParams
+    from partlab.tracking.depth.regions import FaceDepth
+    from partlab.tracking.depth.tracker import DepthTracker
+
+    tracker = DepthTracker(DepthParams(), np.random.default_rng(0))
+    nb = DepthParams().appearance.hue_bins
+    bins = np.array([[3, 3, 3, -1]], np.int16)
+    depth = np.array([[900.0, 1500.0, np.nan, 900.0]], np.float32)  # near, at the face, unmeasured, near
+    got = tracker._hand_bins(bins, depth, FaceDepth(1500.0, 5.0, 160.0))
+    assert got.tolist() == [[3, nb, nb, nb]]
+    assert tracker._hand_bins(bins, depth, None).tolist() == [[3, 3, 3, nb]]  # colour alone: only hue counts
