@@ -550,3 +550,56 @@ def test_sign_in_and_a_second_browser_without_credentials_sees_no_project(store,
             except playwright.Error:
                 pass
             browser.close()
+
+
+def test_an_event_is_added_stretched_and_undone_on_the_timeline_and_exported(server, page, store, tmp_path):
+    """On the Correct page's timeline: E adds a clap from the shown frame, dragging its right end
+    stretches it, Ctrl+Z takes the stretch back; the CVAT export holds the event as tags."""
+    import pandas as pd
+
+    from partlab.labelling import formats
+    from partlab.labelling.video import write_video
+    from tests.app.conftest import walker_boxes, walker_frames
+
+    url, _ = server
+    clip_file = write_video(tmp_path / "walk40.mp4", walker_frames(40), fps=10.0)
+    project = store.create_project("events")
+    clip = store.add_clip(project.id, clip_file)
+    store.save_tracker_run(clip.id, walker_boxes(40), tracker="import")
+    page.goto(url + "/correct")
+    page.wait_for_function("() => window.partlabEditor && window.partlabEditor.stats.ready === 0", timeout=90_000)
+    _settled(page)
+    page.select_option(".pl-event-type", "clap")
+    _focus_editor(page)
+    page.keyboard.press("e")  # a clap over frames 0..9 (one second at 10 fps)
+
+    def stored():
+        ev = store.events(clip.id)
+        return [(int(r.start_frame), int(r.end_frame), r.type, int(r.revision)) for r in ev.itertuples()]
+
+    _wait_for(lambda: stored() == [(0, 9, "clap", 1)], what="the new event in the store")
+    # the editor shows the stored event (with its id) on the timeline's event row
+    page.wait_for_function("() => { const e = window.partlabEditor; return e.events.length === 1 && "
+                           "e.events[0].id !== null && e.tlGeom && e.tlGeom.lanes.count === 1; }")
+    _settled(page)
+    x0, x1, y = page.evaluate("""() => {
+        const e = window.partlabEditor, g = e.tlGeom, r = e.timeline.getBoundingClientRect();
+        return [r.left + g.X(10), r.left + g.X(19) + 0.5 * (g.X(1) - g.X(0)), r.top + g.evTop + g.laneH / 2]; }""")
+    page.mouse.move(x0 - 1, y)
+    page.mouse.down()
+    page.mouse.move((x0 + x1) / 2, y, steps=3)
+    page.mouse.move(x1, y, steps=3)
+    page.mouse.up()
+    _wait_for(lambda: stored() == [(0, 19, "clap", 2)], what="the stretched event in the store")
+    assert page.evaluate("() => window.partlabEditor.eventInfo.textContent") == "#1 clap 0-19"
+
+    _settled(page)
+    _focus_editor(page)
+    page.keyboard.press("Control+z")
+    _wait_for(lambda: stored() == [(0, 9, "clap", 3)], what="the stretch undone")
+    page.wait_for_function("() => window.partlabEditor.events.length === 1 && window.partlabEditor.events[0].end === 9")
+
+    out = formats.export_clip(store, clip.id, "cvat", tmp_path / "cvat", frames=False)
+    csv = pd.read_csv(out / "events.csv")
+    assert csv[["start_frame", "end_frame", "kind"]].values.tolist() == [[0, 9, "clap"]]
+    assert (out / "events.xml").read_text().count('<tag label="clap"') == 10

@@ -4,6 +4,7 @@ import streamlit as st
 
 from partlab.app import auth
 from partlab.app.views.common import plain
+from partlab.app.views.depth_skeleton import skeleton_section
 from partlab.errors import UserError
 from partlab.labelling.depth_view import depth_colours
 from partlab.labelling.take import open_take
@@ -35,3 +36,4 @@ with take:
         if view.depth is not None:
             right.image(depth_colours(view.depth)[..., ::-1],
                         caption=f"{name} depth (near red, far blue, missing black)")
+    skeleton_section(take, path, index, frames)
