@@ -47,8 +47,13 @@ MAX_NAME = 100
 #: default (RFC 9106 low-memory, 64 MiB, t=3, p=4) took 1.5-1.9 s per sign-in on our loaded 2-core machine.
 #: Hashes made with other parameters still verify and are rehashed at the next sign-in.
 _HASHER = PasswordHasher(time_cost=2, memory_cost=19 * 1024, parallelism=1)
-#: hashed once so that a sign-in with an unknown name costs as much as one with a wrong password
-_DUMMY_HASH = _HASHER.hash("partlab: no such user")
+
+
+@functools.lru_cache(maxsize=1)
+def _dummy_hash() -> str:
+    """Hashed once (on the first unknown name) so that a sign-in with an unknown name costs as much as
+    one with a wrong password."""
+    return _HASHER.hash("partlab: no such user")
 
 
 class AccessError(StoreError):
@@ -191,7 +196,7 @@ def authenticate(store: Store, name: str, password: str) -> User | None:
     with store._session() as s:
         row = s.scalar(select(UserRow).where(UserRow.name == str(name)))
         if row is None:
-            verify_password(_DUMMY_HASH, str(password))
+            verify_password(_dummy_hash(), str(password))
             return None
         if not verify_password(row.password, str(password)):
             return None
