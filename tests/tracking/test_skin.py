@@ -118,3 +118,25 @@ def test_keep_mass_keeps_a_box_colour_that_fills_more_of_the_frame_elsewhere():
     assert small.probability(_px(skin))[0, 0] == plain.probability(_px(skin))[0, 0]
     with pytest.raises(ValueError, match="keep_mass"):
         train_skin_model([f], box, bins=32, keep_mass=1.5)
+
+
+def test_find_blobs_region_by_region_equals_the_whole_mask():
+    from partlab.tracking.limbs.people import merge_boxes
+
+    rng = np.random.default_rng(4)
+    mask = np.zeros((120, 200), np.uint8)
+    for _ in range(12):
+        x, y = int(rng.integers(5, 190)), int(rng.integers(5, 110))
+        cv2.circle(mask, (x, y), int(rng.integers(2, 9)), 1, -1)
+    regions = merge_boxes(np.array([[0, 0, 100, 60], [90, 50, 110, 70], [0, 60, 80, 60]]), mask.shape)
+    inside = np.zeros(mask.shape, bool)
+    for x1, y1, x2, y2 in regions:
+        inside[y1:y2, x1:x2] = True
+    mask[~inside] = 0
+    whole, parts = find_blobs(mask, 3, 1.5, 5), find_blobs(mask, 3, 1.5, 5, regions)
+    assert len(whole) == len(parts) > 3
+    np.testing.assert_allclose(parts.centres, whole.centres)
+    np.testing.assert_array_equal(parts.boxes, whole.boxes)
+    np.testing.assert_array_equal(parts.areas, whole.areas)
+    for i, j in zip(whole.ids, parts.ids):  # the same pixels under each blob's id
+        np.testing.assert_array_equal(whole.labels == i, parts.labels == j)

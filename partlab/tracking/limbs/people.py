@@ -44,11 +44,10 @@ def foreground_people(foreground: np.ndarray, params: LimbParams) -> np.ndarray:
     fg = np.asarray(foreground)
     hgt, wid = fg.shape
     f = max(int(pp.shrink), 1)
-    small = (fg > 0).astype(np.uint8)
-    if f > 1:  # max over f x f cells
-        padded = np.zeros((-(-hgt // f) * f, -(-wid // f) * f), np.uint8)
-        padded[:hgt, :wid] = small
-        small = padded.reshape(padded.shape[0] // f, f, padded.shape[1] // f, f).max(axis=(1, 3))
+    small = (fg > 0).astype(np.uint8) * 255
+    if f > 1:  # a cell with any foreground pixel is foreground (its area mean is over 255 / f^2 >= 1)
+        small = cv2.resize(small, (-(-wid // f), -(-hgt // f)), interpolation=cv2.INTER_AREA)
+    small = (small > 0).astype(np.uint8)
     k = max(int(round(pp.close * hgt / f)) | 1, 3)
     small = cv2.morphologyEx(small, cv2.MORPH_CLOSE, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
     n, _, stats, _ = cv2.connectedComponentsWithStats(small, connectivity=8)
@@ -73,8 +72,9 @@ def in_regions(points: np.ndarray, boxes: np.ndarray, top: float = 1.0, margin: 
 
 def merge_boxes(boxes: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     """Boxes ``(B, 4) x, y, w, h`` as disjoint-ish regions ``(R, 4) int [x1, y1, x2, y2]`` clipped to
-    a frame of ``shape (H, W)``: overlapping boxes are merged into their common bounding box (until
-    none overlap), so no pixel is computed twice; empty boxes are dropped."""
+    a frame of ``shape (H, W)``: overlapping or touching boxes are merged into their common bounding
+    box (until none do), so no pixel is computed twice and no connected region is cut in two;
+    empty boxes are dropped."""
     hgt, wid = shape
     b = np.asarray(boxes, float).reshape(-1, 4)
     r = np.column_stack([np.floor(b[:, 0]), np.floor(b[:, 1]), np.ceil(b[:, 0] + b[:, 2]),
@@ -87,7 +87,7 @@ def merge_boxes(boxes: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         for i in range(len(regions)):
             for j in range(i + 1, len(regions)):
                 a, c = regions[i], regions[j]
-                if a[0] < c[2] and c[0] < a[2] and a[1] < c[3] and c[1] < a[3]:
+                if a[0] <= c[2] and c[0] <= a[2] and a[1] <= c[3] and c[1] <= a[3]:  # touching too
                     regions[i] = [min(a[0], c[0]), min(a[1], c[1]), max(a[2], c[2]), max(a[3], c[3])]
                     del regions[j]
                     merged = True

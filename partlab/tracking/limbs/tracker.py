@@ -306,7 +306,7 @@ class LimbTracker:
             kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin.open, p.skin.open))
             skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
         n_people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
-        blobs = find_blobs(skin_mask.astype(np.uint8), n_people, p.blobs.alpha, self._min_area(starting))
+        blobs = find_blobs(skin_mask.astype(np.uint8), n_people, p.blobs.alpha, self._min_area(starting), rois)
         cands = candidate_terms(blobs, fg, skin_prob, p)
         a = p.appearance
 
