@@ -75,6 +75,9 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     synthetic scene's init.csv).
     """
     from partlab.app import pipeline
+    from partlab.labelling import access
+
+    access.require(store, clip.project_id)  # the job stores its run through a store of its own
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
     stop, track_ids = None, None
@@ -163,6 +166,9 @@ def _training_inputs(store: Store, project_id: int, clip_ids: list[int], name: s
         if not len(truth):
             raise ValueError(f"clip {clip.name!r} has no corrected frames yet")
         clips.append((frames_factory(clip.path), clip.fps, truth))
+    from partlab.models import training
+
+    training.check_span(clips, [store.clip(cid).name for cid in clip_ids], training.TrainingOptions().dt)
     out = data_dir() / "bundles" / str(project_id) / folder
     if out.exists():
         raise ValueError(f"{out} exists already; choose another bundle name")
@@ -174,7 +180,10 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     """Train a bundle from corrected clips in the background, save it and register it.
     ``start_path``: the bundle to improve on (its detector stays unless the new one does no
     worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    from partlab.labelling import access
     from partlab.models import bundle as bundle_mod
+
+    access.require(store, project_id)  # the job registers its bundle through a store of its own
     from partlab.models import training
     from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
 
@@ -199,6 +208,8 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
         progress(0, total)
         bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner, names=names,
                                        start=start)
+        if bundle.summary["nothing_learnt"]:  # never saved, never a project's default
+            raise training.NothingLearnt(f"learnt nothing: {bundle.summary['nothing_learnt']}")
         bundle_mod.save_bundle(bundle, out)
         record = store.add_bundle(project_id, name, out, summary=bundle.summary)
         if make_default:

@@ -45,7 +45,7 @@ def run(args) -> int:
     from partlab.labelling.video import VideoClip, VideoError
     from partlab.models.bundle import BundleError, save_bundle
     from partlab.models.failure_svm import SVMReport, report_table
-    from partlab.models.training import train_bundle, training_steps
+    from partlab.models.training import NothingLearnt, train_bundle, training_steps
     from partlab.models.variance import comparison_table
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
 
@@ -80,14 +80,19 @@ def run(args) -> int:
         try:
             bundle = train_bundle(clips, seed=args.seed, progress=progress, tracker_runner=runner, names=names,
                                   start=start)
+        except NothingLearnt as exc:
+            raise CommandError(f"learnt nothing from {', '.join(names)}: {exc}; no bundle written to {out}") from None
         except ValueError as exc:
             raise CommandError(str(exc)) from None
+    if bundle.summary["nothing_learnt"]:
+        raise CommandError(f"learnt nothing from {', '.join(names)}: {bundle.summary['nothing_learnt']}; "
+                           f"no bundle written to {out}")
     try:
         save_bundle(bundle, out)
     except BundleError as exc:
         raise CommandError(str(exc)) from None
     reports = {n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}
-    print(f"wrote {out}  ({bundle.summary['samples']})")
+    print(f"wrote {out}  ({bundle.summary['samples']}); learnt: {', '.join(bundle.summary['learnt'])}")
     print("\nfailure SVMs (5-fold cross-validation; negative = failure):")
     print(report_table(reports))
     print("\nvariance parameters (fitted vs default; '-' = default kept):")

@@ -53,6 +53,8 @@ def train_bundle(progress, *, url: str, project_id: int, clip_ids: list[int], na
     progress(0, total)
     bundle = training.train_bundle(clips=clips, seed=seed, progress=step, tracker_runner=runner,
                                    names=names, start=start)
+    if bundle.summary["nothing_learnt"]:  # never saved, never a project's default
+        raise training.NothingLearnt(f"learnt nothing: {bundle.summary['nothing_learnt']}")
     bundle_mod.save_bundle(bundle, out)
     record = store.add_bundle(project_id, name, out, summary=bundle.summary)
     if make_default:

@@ -189,15 +189,17 @@ def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
     if opts.fit_sharpness is None:
         opts = replace(opts, fit_sharpness=sharpness_available())
+    check_span(clips, names, opts.dt)
     step = progress or (lambda _msg: None)
     rng = np.random.default_rng(opts.seed)
     got = _Samples()
     for i, ((factory, fps, truth), name) in enumerate(zip(clips, names)):
         _clip_samples(got, i, factory, fps, truth, name, opts, rng, step, tracker_runner, body)
-    x_all = np.concatenate(got.xs, axis=0)
-    y_all = np.concatenate(got.ys, axis=0)
+    x_all = np.concatenate(got.xs, axis=0) if got.xs else np.zeros((0, 0))
+    y_all = np.concatenate(got.ys, axis=0) if got.ys else np.zeros(0)
     if len(x_all) == 0:
-        raise ValueError("no training samples: the truth has no person with head, torso and hip-leg boxes")
+        raise NothingLearnt("no training samples: the truth has no person with head, torso and hip-leg boxes "
+                            "(person boxes alone teach the failure SVMs nothing)")
     models, reports = train_failure_svms(x_all, y_all, seed=opts.seed, progress=lambda n: step(f"SVM {n}"))
     body_p, limb_p, table = _fit_parameters(got, body, limb, opts, step)
     detector = SVMFailureDetector(models, dt=opts.dt) if models else None
@@ -218,7 +220,66 @@ def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
     }
     if selection is not None:
         summary["selection"] = selection
+    new_detector = detector is not None and detector is not start_detector
+    summary["learnt"], summary["nothing_learnt"] = learnt(summary, new_detector)
     return Bundle(body_p, limb_p, detector, summary)
+
+
+def check_span(clips: list[Clip], names: list[str], dt: float) -> None:
+    """Refuse truth too short to learn from: the failure features compare each frame with the
+    one ``dt`` seconds before, and the variances need consecutive frames."""
+    spans = []
+    for _factory, fps, truth in clips:
+        frames = normalise_tracks(truth)["frame"]
+        spans.append(int(frames.max() - frames.min()) + 1 if len(frames) else 0)
+        if spans[-1] > dt * fps:
+            return
+    need = max(int(np.ceil(dt * clips[0][1])) + 1, 2)
+    raise NothingLearnt(f"the corrections span {max(spans)} frame(s) ({', '.join(names)}): that teaches neither "
+                        f"the dynamics nor the failures; correct at least {need} consecutive frames ({dt:g} s)")
+
+
+def _differs(a, b) -> bool:
+    try:
+        return bool(np.isfinite(a) and np.isfinite(b) and abs(float(a) - float(b)) > 1e-9)
+    except TypeError:
+        return False
+
+
+class NothingLearnt(ValueError):
+    """Training ran but the bundle would be its start again: nothing to save or make a default."""
+
+
+def learnt(summary: dict, new_detector: bool) -> tuple[list[str], str]:
+    """What a trained bundle holds beyond the model it started from, and, when that is nothing,
+    why (in a sentence). Validation decides where it ran; without it, every fitted component
+    (a trained SVM, a noise or ``lam`` other than its default) counts."""
+    got = []
+    selection = summary.get("selection")
+    if selection is not None:
+        got += [f"{c} (validated)" for c, kept in selection.get("kept", {}).items() if kept and c != "detector"]
+        if selection.get("detector") == "new":
+            got.append("failure detector (validated)")
+    else:
+        got += [f"SVM {n}" for n, r in summary.get("svms", {}).items() if r.get("trained")] if new_detector else []
+        got += sorted({f"{r['tracker']} {r['part']} {r['parameter']}" for r in summary.get("variances", [])
+                       if r.get("n") and _differs(r.get("applied"), r.get("default"))})
+    if got:
+        return got, ""
+    samples = summary.get("samples", {})
+    untrained = [n for n, r in summary.get("svms", {}).items() if not r.get("trained")]
+    why = []
+    if untrained:
+        counts = ", ".join(f"{n} {summary['svms'][n].get('n_positive', 0)}/{summary['svms'][n].get('n_negative', 0)}"
+                           for n in untrained)
+        why.append(f"too few samples for the failure SVMs (right/failed: {counts}; 5 of each are needed)")
+    if not any(r.get("n") for r in summary.get("variances", [])):
+        why.append("too few corrected frames per track to fit the variances")
+    if selection is not None and not why:
+        why.append("nothing fitted tracked the training clips better than the model it started from")
+    if not why:
+        why.append(f"every fitted value equals the model it started from ({samples.get('total', 0)} samples)")
+    return [], "; ".join(why)
 
 
 def _clip_samples(got: _Samples, i: int, factory: FramesFactory, fps: float, truth: pd.DataFrame, name: str,

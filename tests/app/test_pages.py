@@ -3,6 +3,7 @@ a tracking run stored, corrections shown, a training run producing a bundle, exp
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -22,7 +23,8 @@ def page(name: str, **session) -> AppTest:
 
 
 def texts(at: AppTest, kind: str) -> list[str]:
-    return [e.value for e in getattr(at, kind)]
+    """The texts of one kind of element as a reader sees them (names are escaped Markdown: ``\\:`` shows ``:``)."""
+    return [re.sub(r"\\(.)", r"\1", e.value) for e in getattr(at, kind)]
 
 
 def test_projects_page_creates_a_project_and_accepts_a_clip(store, clip_file):
@@ -97,7 +99,7 @@ def test_names_are_shown_as_text_not_markdown(store):
     at.text_input[0].input("**big** :red[x]")
     at.button[0].click().run()
     escaped = "\\*\\*big\\*\\* \\:red\\[x\\]"  # what Markdown shows as **big** :red[x]
-    assert texts(at, "success") == [f"Created project '{escaped}'."]
+    assert [e.value for e in at.success] == [f"Created project '{escaped}'."]
     assert [h.value for h in at.subheader] == [f"Project: {escaped}"]
 
 
@@ -111,7 +113,11 @@ def test_evaluate_page_plots_trajectories(store, tracked_clip):
 
 def test_train_page_produces_a_bundle(store, tracked_clip, boxes):
     project, clip = tracked_clip
-    for r in boxes.itertuples():  # correct every frame: the truth is the walker's boxes
+    # correct every frame: the walker's boxes, with its torso and hip-leg drawn (a head and a person
+    # box alone teach the failure SVMs nothing: the page would refuse, as the test below shows)
+    parts = boxes[boxes.part == "person"].copy()
+    body = [parts.assign(part="torso", y=parts.y + 10, h=16), parts.assign(part="hipleg", y=parts.y + 26, h=18)]
+    for r in pd.concat([boxes, *body]).itertuples():
         store.edit_box(clip.id, r.frame, r.track_id, r.part, Box(r.x, r.y, r.w, r.h),
                        expected_revision=store.revision(clip.id, r.frame, r.track_id, r.part))
     at = page("train", project_id=project.id)
@@ -129,6 +135,21 @@ def test_train_page_produces_a_bundle(store, tracked_clip, boxes):
     svms = at.dataframe[0].value
     assert svms.svm.tolist() == list(bundle.summary["svms"]) and {"CV TNR", "CV TPR"} <= set(svms.columns)
     assert len(at.get("plotly_chart")) >= 1
+
+
+def test_train_page_refuses_to_learn_from_one_corrected_frame(store, tracked_clip, boxes):
+    project, clip = tracked_clip
+    for r in boxes[boxes.frame == 0].itertuples():
+        store.edit_box(clip.id, r.frame, r.track_id, r.part, Box(r.x, r.y, r.w, r.h),
+                       expected_revision=store.revision(clip.id, r.frame, r.track_id, r.part))
+    at = page("train", project_id=project.id)
+    [go] = [b for b in at.button if b.label == "Train"]
+    go.click().run()
+    assert not at.exception
+    assert any("Nothing to learn yet: the corrections span 1 frame(s)" in t for t in texts(at, "error")), \
+        texts(at, "error")
+    assert not jobs.jobs("train", project_id=project.id) and not store.bundles(project.id)
+    assert store.project(project.id).default_bundle_id is None
 
 
 def test_export_page_builds_an_archive_and_marks_clips_exported(store, tracked_clip):

@@ -49,3 +49,19 @@ def test_train_refuses_bad_arguments(tmp_path, capsys):
     assert (tmp_path / "docs" / "notes.txt").read_text() == "mine"
     assert main(["train", "--clip", str(tmp_path / "nope.mp4"), "--truth", t1, "-o", str(tmp_path / "o")]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def test_training_that_learns_nothing_says_so_and_writes_no_bundle(tmp_path, capsys):
+    v1, t1 = _clip(tmp_path, "a", 1)
+    import pandas as pd
+
+    truth = pd.read_csv(t1)
+    for name, rows in (("one frame", truth[truth.frame == 0]),
+                       ("person boxes only", truth.assign(part="person").drop_duplicates(["frame", "track_id"]))):
+        path = tmp_path / f"{name}.csv"
+        rows.to_csv(path, index=False)
+        out = tmp_path / name.replace(" ", "_")
+        assert main(["train", "--clip", v1, "--truth", str(path), "-o", str(out), "--no-tracker"]) == 2, name
+        err = capsys.readouterr().err
+        assert "learnt nothing from a.mp4" in err and "no bundle written" in err, (name, err)
+        assert not out.exists(), name

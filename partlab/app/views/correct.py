@@ -16,7 +16,7 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.box_editor import box_editor, encode_image, pack_boxes, pending_events, track_colour, view
-from partlab.app.editing import apply_events, record
+from partlab.app.editing import Step, apply_events, record, refine_step
 from partlab.app.runs import start_tracking
 from partlab.app.views.common import job_panel, pick_clip, plain, require_project
 from partlab.labelling import trackops
@@ -117,9 +117,38 @@ def apply(events: list[dict]) -> None:
     """Write the editor's events; the messages show above the editor on this run."""
     fill = any(e.get("fill") for e in events if e.get("kind") == "edit")
     result = apply_events(s, clip.id, events, history, author=state.author(), fill=fill)
+    refine(result.refills)
     st.session_state.setdefault("correct_messages", []).extend(result.errors + result.notes)
     if result.frame is not None and any(e.get("kind") in ("undo", "redo") for e in events):
         jump(result.frame)
+
+
+@st.cache_resource(show_spinner=False)
+def warm_tracker() -> threading.Thread:
+    """Load the body tracker and its compiled kernels once per server process, in the
+    background, so that the first keyframe a user moves does not wait for them."""
+    from partlab.tracking.keyframes import warm_up
+
+    thread = threading.Thread(target=warm_up, name="partlab-warm-tracker", daemon=True)
+    thread.start()
+    return thread
+
+
+def refine(steps: list[Step]) -> None:
+    """Keyframe-guided tracking of each refilled track and part, restricted to that track's region
+    and stretch, as a background job; the straight line between the keyframes shows until it ends."""
+    from partlab.app import jobs
+    from partlab.tracking.keyframes import stretch_proposer
+
+    for step in steps:
+        tid, part, _ = step.refill[0]
+
+        def work(progress, step=step):
+            with VideoClip(clip.path) as video:
+                return refine_step(Store(s.url), clip.id, history, step, stretch_proposer(video.read, fps=clip.fps),
+                                   progress)
+
+        jobs.submit("refine", f"Tracker boxes between the keyframes of {part} #{tid}", work, clip_id=clip.id)
 
 
 def current_frame() -> int:
@@ -147,7 +176,7 @@ def editor_panel() -> None:
         cache = frame_cache(str(clip.path))
         cache.url(frame)
     except (VideoError, IndexError, ValueError) as exc:
-        st.error(f"Cannot show frame {frame}: {exc}")
+        st.error(plain(f"Cannot show frame {frame}: {exc}"))
         return
     tracks = [dict(id=t, colour=track_colour(t)) for t in data["ids"]]
     late = box_editor(key=editor_key, width=clip.width, height=clip.height, frame_count=clip.frame_count,
@@ -164,7 +193,9 @@ def editor_panel() -> None:
         st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
 
+warm_tracker()
 editor_panel()
+job_panel("refine", limit=1, clip_id=clip.id)
 frame = current_frame()
 version = s.data_version(clip.id)
 data = clip_boxes(s.url, clip.id, version)
@@ -202,7 +233,7 @@ with tab_tracks:
                 jump(frame)
                 st.rerun()
             except StoreError as exc:
-                st.error(f"Not saved: {exc}")
+                st.error(plain(f"Not saved: {exc}"))
         st.caption(f"Operations apply at the frame shown (frame {frame}); each is one step of undo (Ctrl+Z in the "
                    "editor) and is stored as revisions of the boxes it changes.")
 
@@ -221,7 +252,7 @@ with tab_review:
                     st.session_state[f"last_review:{clip.id}"] = rid
                     st.rerun()
                 except StoreError as exc:
-                    st.error(str(exc))
+                    st.error(plain(exc))
         rid = st.session_state.get(f"last_review:{clip.id}")
         if rid is not None and st.button("Undo my last verdict", key=f"rv_undo:{clip.id}"):
             s.undo_review(clip.id, rid)
@@ -249,7 +280,7 @@ with tab_retrack:
                                                    if b.id == project.default_bundle_id), None))
             st.success(f"Started: {plain(job.label)}")
         except (RuntimeError, ValueError) as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     runs = s.runs(clip.id)
     if len(runs):
         r = runs.iloc[-1]

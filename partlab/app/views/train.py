@@ -8,6 +8,7 @@ from partlab.app import state
 from partlab.app.runs import SHIPPED, bundle_choices, start_training
 from partlab.app.views.common import job_panel, plain, require_project
 from partlab.labelling.store import StoreError
+from partlab.models.training import NothingLearnt
 
 s = state.store()
 st.title("Train")
@@ -39,8 +40,10 @@ if go_train:
         job = start_training(s, project.id, picked, name.strip(), seed=int(seed), make_default=make_default,
                              start_path=starts[start_label])
         st.success(f"Started: {plain(job.label)}")
+    except NothingLearnt as exc:
+        st.error(f"Nothing to learn yet: {exc}.")
     except (RuntimeError, ValueError) as exc:
-        st.error(str(exc))
+        st.error(plain(exc))
 
 
 job_panel("train", limit=3, project_id=project.id)
@@ -94,7 +97,7 @@ if bundles:
             s.set_default_bundle(project.id, chosen)
             st.success(f"Default bundle: {plain(labels[chosen])}")
         except StoreError as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     for b in reversed(bundles):
         with st.expander(f"{plain(b.name)} · {b.created:%Y-%m-%d %H:%M} · {plain(b.path)}", expanded=b is bundles[-1]):
             show_summary(b.summary, key=str(b.id))
