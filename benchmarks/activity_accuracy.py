@@ -145,8 +145,8 @@ def main() -> int:
 
 def report(args, w: int, h: int, hands: str) -> None:
     truths, preds, recalls, swaps, spf = [], [], {}, 0, []
-    for name in SCENES if args.cameras == 1 else SCENES_3D:
-        for seed in _seeds(args.seeds):
+    for seed in _seeds(args.seeds):  # seed by seed, so that a run cut short covers every scene
+        for name in SCENES if args.cameras == 1 else SCENES_3D:
             if args.cameras == 1:
                 truth, pred, s = run_one(name, seed, args.frames, w, h, hands)
             else:

@@ -278,8 +278,9 @@ def apply_event_edit(store: Store, clip_id: int, ev: dict, history: EditHistory,
     shown = change[2] or change[1]
     step = Step(keys=[], before=[], after=[], label=label, frame=int(ev.get("frame", shown["start_frame"])),
                 events=[change])
-    history.undo.append(step)
-    history.redo.clear()
+    with history.lock:  # a refinement job may push steps from another thread
+        history.undo.append(step)
+        history.redo.clear()
     return step
 
 

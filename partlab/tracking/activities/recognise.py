@@ -212,8 +212,9 @@ def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, 
                   params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
     """The two decision windows of a join: ending at the last frame before ``start`` and starting at
     the first frame after ``end`` where the hands are ``apart_size`` hand sides apart (the gap
-    windows of :func:`_windows` where they never are). The activity itself is reported over the
-    touch (the join's frames), where annotators put it."""
+    windows of :func:`_windows` where they never are). The activity lasts from the first to the
+    second decision point (a touch the tracker saw only briefly, a hand lost while the hands were
+    together, still lasts as long as the hands were near)."""
     d = params.decision
 
     def apart(f: int) -> bool:
@@ -268,6 +269,7 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
             (b0, b1), (a0, a1) = apart_windows(centres.get(a, {}), centres.get(b, {}), start, end, params)
+            base.update(start_frame=min(start, b1 + 1), end_frame=max(end, a0 - 1))
             worn = np.union1d(clothes.get(a[0], np.zeros(0, int)), clothes.get(b[0], np.zeros(0, int)))
             seen = [_without(_held(colours.get(k, {}), lo, hi, params), worn)
                     for k in (a, b) for lo, hi in ((b0, b1), (a0, a1))]
