@@ -15,7 +15,8 @@ on PETS09-S2L1 (person boxes of every walker), OTB Human3 and Crossing (one walk
 a randomized synthetic suite (``partlab.labelling.synth`` scenario ``random``: proportions,
 clothing and skin colours, lighting, camera height and tilt, resolution, 1-12 people; truth
 person boxes). Tracker rows are over ``--seeds`` (mean and standard deviation); ms/frame is
-the tracker's wall time per frame (pessimistic on a shared machine).
+the tracker's wall time per frame (pessimistic on a shared machine), cpu ms/frame its CPU time
+(all threads of the process; steadier under load, and what to compare with HOG+SORT's).
 
     nice python benchmarks/annotation_effort.py                      # everything, seeds 1-4
     nice python benchmarks/annotation_effort.py --skip-synth --skip-otb --pets-frames 300
@@ -98,9 +99,11 @@ def methods(truth: pd.DataFrame, auto: bool, keys: tuple[int, ...], init: pd.Dat
 
 
 def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[pd.DataFrame, float, int]:
+    """(proposals, seconds per frame, keyframe boxes) of one method; the CPU seconds per frame (all
+    threads of this process, steadier than wall time on a shared machine) go to ``CPU[-1]``."""
     n_keys = table["track_id"].nunique() if kind == "init" else None
-    """(proposals, seconds per frame, keyframe boxes) of one method."""
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
+    CPU.append(0.0)
     if kind == "interp":
         props = interpolate_keyframes(table)
         return props, 0.0, len(table)
@@ -121,9 +124,11 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
     else:
         props = track(take, "body", seed=seed).tracks
         n = 0
+    CPU[-1] = (time.process_time() - c0) / max(take.frame_count, 1)
     return props, (time.perf_counter() - t0) / max(take.frame_count, 1), n
 
 
+CPU: list[float] = []
 PART_RATES = ("head", "torso", "hipleg")
 ONLY: list[str] = []  # --methods
 
@@ -142,6 +147,7 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
         for seed in (seeds if kind not in ("interp", "hog_sort") else seeds[:1]):
             props, spf, n = run_method(take, truth, kind, table, seed)
             rows.append({"clip": name, "method": label, "seed": seed, "ms/frame": 1000 * spf,
+                         "cpu ms/frame": 1000 * CPU[-1],
                          **measure(truth, props, n)})
             if part_truth is not None and kind == "init":
                 rep = evaluate(part_truth, props, hota=False)
@@ -155,7 +161,7 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
 
 
 def summarise(df: pd.DataFrame) -> pd.DataFrame:
-    cols = ["rate", "mota", "idf1", "edits/100", "ms/frame", "tracks"]
+    cols = ["rate", "mota", "idf1", "edits/100", "ms/frame", "cpu ms/frame", "tracks"]
     g = df.groupby(["clip", "method"], sort=False)[cols]
     mean, std = g.mean(), g.std(ddof=1).fillna(0.0)
     out = pd.DataFrame(index=mean.index)

@@ -11,6 +11,8 @@ paper's order:
 - ``decomposition`` (sec. 4.1): cutting a person into head, torso and hip-leg;
 - ``background`` (sec. 4): OpenCV's MOG2 adaptive Gaussian mixture, the foreground masks;
 - ``detection`` (sec. 4, 5): where new people start and when a track ends;
+- ``detector`` (not in the paper): a people detector as a cue for starting, re-acquiring, re-sizing
+  and ending tracks (Breitenstein et al. 2009);
 - ``occlusion`` (sec. 4.3.1-4.3.2): between people and behind fixed occluders;
 - ``adjustment`` (sec. 4.3): rebuilding failed parts and the failure detector's input;
 - ``output``: how the tracked inner rectangles are reported (fitted).
@@ -20,7 +22,7 @@ docs/parameters.md lists every field with its default and why.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import ClassVar
 
 from partlab.tracking.core.params import (
@@ -238,6 +240,94 @@ class BodyDetection:
 
 
 @dataclass(frozen=True)
+class BodyDetector:
+    """People detection as a cue for starting, re-acquiring, re-sizing and ending tracks
+    (Breitenstein et al. 2009 guide their particle filters by a detector's confidence; here the
+    colour part filters stay, and OpenCV's HOG people detector, Dalal & Triggs, run only around
+    foreground blobs and tracks (:mod:`partlab.tracking.core.people`), starts, corrects and ends
+    them). Not in Zhao & Lee."""
+
+    # Off: the paper's tracker (tracks start from foreground blobs only).
+    enabled: bool = flag(True)
+    # Automatic mode: foreground blobs still start tracks too (``body.detection``), for people
+    # the detector does not see (small, seen from above, unusual clothing: on the synthetic
+    # figures HOG finds 5-60% of the people). False: tracks start from detections only.
+    blob_starts: bool = flag(True)
+    # The detector runs on every ``every``-th frame: a walker moves a few pixels a frame, and one
+    # scan costs several times the part filters of a frame (PETS09, 2 cores: ~150-300 ms a scan).
+    every: int = number(3, POSITIVE_COUNT)
+    # Scanned regions: foreground blobs at least this tall (pixels) and every track's box.
+    min_region_height: float = number(25.0)
+    # How a region is scanned (partlab.tracking.core.people.RegionScan). fill 1.2: people down to
+    # ~0.8 of the region's height are found (PETS09 frames 60-300 every 5th, blobs as regions:
+    # recall 0.83, precision 0.91 at IoU 0.5; fill 0.95: recall 0.75; fill 0.8: 0.36).
+    fill: float = number(1.2, POSITIVE)
+    margin: float = number(0.25)
+    # Pyramid step: 1.05 gains ~0.07 recall at ~2.5x the time.
+    scale_step: float = number(1.1, Rule(lo=1, lo_open=True))
+    # The SVM margin a window needs (OpenCV's detectMultiScale weights) and the IoU of the
+    # non-maximum suppression.
+    min_score: float = number(0.3, Rule())
+    nms: float = number(0.4, FRACTION)
+    # The 64 x 128 window's person is about 0.6 x 0.75 of it (body box = window shrunk by this).
+    shrink: tuple[float, float] = pair((0.6, 0.75), rule=UNIT)
+    max_upscale: float = number(3.0, POSITIVE)
+    # A detection belongs to a track when their boxes overlap at IoU >= match_iou (Hungarian
+    # assignment over all pairs).
+    match_iou: float = number(0.3, FRACTION)
+    # A matched detection moves and re-sizes the track's parts this share of the way to where it
+    # puts them (the part boxes keep their places inside the person box): colour likelihoods hardly
+    # constrain a box's size, a detector's window does.
+    steer: float = number(0.5, FRACTION)
+    # ... only when the two overlap at IoU below ``steer_below`` (1: every match). Steering only
+    # tracks below IoU 0.5 (wrong by the MOT rule) cost PETS09 (frames 0-300, seed 1) MOTA 0.63 ->
+    # 0.33 automatic, 0.57 -> 0.27 from the first boxes.
+    steer_below: float = number(1.0, FRACTION)
+    # The head is steered like the other parts (True) or moved with the torso's correction only,
+    # keeping its size and place on the torso (False): a detector's window is only roughly a
+    # person's box, and a few pixels are a head's whole height (synthetic walkers, head rate:
+    # 0.59 without detection, 0.12 with the head steered, 0.66 with it following the torso).
+    steer_head: bool = flag(False)
+    # Automatic mode: a detection no track explains starts a track once seen again
+    # (``confirm_distance``) in ``confirm_hits`` of the last ``confirm_window`` scans (a single false
+    # window does not).
+    confirm_hits: int = number(2, POSITIVE_COUNT)
+    confirm_window: int = number(3, POSITIVE_COUNT)
+    # A detection continues a candidate of an earlier scan when their centres lie within this
+    # many detection heights (and their heights within 1.5x): a walker moves ~0.1-0.3 heights
+    # between scans, and a fast one's boxes three frames apart need not overlap.
+    confirm_distance: float = number(0.5)
+    # A lost track (or one no detection has matched for ``reacquire_after`` frames) is re-acquired by
+    # an unmatched detection whose centre lies within ``reacquire_distance`` of its height from the
+    # track's prediction and whose torso region matches the torso's model at least
+    # ``reacquire_similarity`` (Bhattacharyya coefficient): behind a pillar, out of a group.
+    reacquire_after: int = number(12, COUNT)
+    reacquire_distance: float = number(1.0)
+    reacquire_similarity: float = number(0.6, FRACTION)
+    # Two tracks whose person boxes overlap at IoU >= duplicate_iou (neither marked behind the
+    # other) are one person twice: the one a detection matched less recently (then the younger)
+    # ends; a track given with --init is not ended but goes lost (coasts, may be re-acquired).
+    # 1 turns it off.
+    duplicate_iou: float = number(0.5, FRACTION)
+    # Automatic mode: a track no detection has matched for ``undetected_frames`` frames ends (a ghost
+    # of the background model, a shadow). 0: never for this reason (foreground support still ends
+    # tracks).
+    undetected_frames: int = number(0, COUNT)
+
+    def check(self, path: str) -> None:
+        if self.confirm_hits > self.confirm_window:
+            raise ValueError(f"{path}.confirm_hits: must be <= {path}.confirm_window ({self.confirm_window}), "
+                             f"got {self.confirm_hits}")
+
+    def scan(self):
+        """The region scan these numbers describe."""
+        from partlab.tracking.core.people import RegionScan
+
+        return RegionScan(self.fill, self.margin, self.scale_step, self.min_score, self.nms, self.shrink,
+                          self.max_upscale)
+
+
+@dataclass(frozen=True)
 class BodyOcclusion:
     """Occlusion between people and behind fixed occluders (sec. 4.3.1-4.3.2)."""
 
@@ -301,9 +391,13 @@ class BodyParams(Parameters):
     decomposition: BodyDecomposition = group_field(BodyDecomposition)
     background: BodyBackground = group_field(BodyBackground)
     detection: BodyDetection = group_field(BodyDetection)
+    detector: BodyDetector = group_field(BodyDetector)
     occlusion: BodyOcclusion = group_field(BodyOcclusion)
     adjustment: BodyAdjustment = group_field(BodyAdjustment)
     output: BodyOutput = group_field(BodyOutput)
+
+    #: fields added after partlab 0.2 (no flat name)
+    ADDED: ClassVar[tuple[str, ...]] = tuple(f"detector.{f.name}" for f in fields(BodyDetector))
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {

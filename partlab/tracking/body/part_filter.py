@@ -223,6 +223,23 @@ class PartFilter:
         self.state[0:2] += delta
         self.particles[:, 0:2] += np.asarray(delta, dtype=np.float32)
 
+    def steer(self, target: Box, gain: float) -> None:
+        """Move the estimate ``gain`` of the way to ``target`` (centre and size), the particles with
+        it (shifted, sizes scaled), and let the size bounds follow (a detection re-sizes the part;
+        ``dynamics.size_range`` then holds it near its new size)."""
+        t = box_to_state(target)
+        old = self.state[2:4].astype(np.float64).copy()
+        delta = gain * (t[0:2] - self.state[0:2])
+        self.shift(delta)
+        new = np.maximum(old + gain * (t[2:4] - old), 2.0)
+        self.state[2:4] = new
+        self.particles[:, 2:4] *= (new / np.maximum(old, 1e-6)).astype(np.float32)
+        self.base_size = new.astype(np.float64)
+        lo, hi = self.params.dynamics.size_range
+        self._size_lo = (lo * self.base_size).astype(np.float32)
+        self._size_hi = (hi * self.base_size).astype(np.float32)
+        self._clip_sizes()
+
     def _stride(self) -> int:
         """2 (every second pixel) for parts at least ``histogram_stride_min`` wide and tall."""
         m = self.params.appearance.histogram_stride_min

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from partlab.tracking.body.cue import DetectionCue
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
 from partlab.tracking.body.part_filter import PartFilter
@@ -177,6 +178,7 @@ class BodyTracker:
         self.frames_seen = 0
         self.withdrawn: list[tuple[int, int]] = []  # (track_id, first frame): rows of a lost track that ended
         self._ycc = LazyYcc()
+        self.cue = DetectionCue(self) if self.params.detector.enabled else None
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -302,7 +304,9 @@ class BodyTracker:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
                 person.centres.append((index, *person.box().centre))
         self._end_tracks(active, mask, W, H, index)
-        if self.auto and mask is not None:
+        if self.cue is not None:
+            self.cue.step(index, frame, ycc, mask)
+        if self.auto and mask is not None and (self.cue is None or self.params.detector.blob_starts):
             self._detect(index, frame, ycc, mask)
         return self._records(index, new_ids)
 

@@ -1,0 +1,230 @@
+"""Detection as a cue for the body tracker (not in Zhao & Lee; after Breitenstein et al. 2009).
+
+Breitenstein et al. ("Robust tracking-by-detection using a detector confidence particle filter")
+let a people detector decide where tracks start, end and re-appear, and keep a particle filter per
+person in between. Here the colour part filters of Zhao & Lee stay as they are; every
+``detector.every`` frames OpenCV's HOG people detector scans the foreground blobs and the tracks'
+boxes (:mod:`partlab.tracking.core.people`, not the whole frame) and its detections
+
+1. are assigned to tracks (Hungarian method on IoU): a matched detection re-sizes and moves the
+   track's parts towards it (``steer``), because colour hardly constrains a box's size;
+2. re-acquire lost tracks (no foreground support, behind an obstacle nobody listed) and tracks no
+   detection has matched for a while, when near their prediction and alike in colour;
+3. start tracks (automatic mode) once confirmed in several scans; blobs still start people the
+   detector does not see;
+4. end duplicate tracks (one person tracked twice), and optionally tracks never detected.
+
+All numbers come from ``BodyParams.detector``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from partlab.tracking.body.decomposition import minimum_bounding_rectangle
+from partlab.tracking.core.box import Box, iou_xywh
+from partlab.tracking.core.lazy_ycc import as_array
+from partlab.tracking.core.people import PeopleDetector, associate, associate_near
+
+
+@dataclass
+class Candidate:
+    """An unexplained detection seen in recent scans: its latest box and the scans it was in."""
+
+    box: Box
+    hits: int
+    last_scan: int
+
+
+def _blob_regions(mask: np.ndarray | None, min_height: float) -> list[Box]:
+    if mask is None or not mask.any():
+        return []
+    n, _, stats, _ = cv2.connectedComponentsWithStats((mask > 0).astype(np.uint8), connectivity=8)
+    return [Box(*(float(v) for v in stats[i, :4])) for i in range(1, n) if stats[i, 3] >= min_height]
+
+
+def _target(part: Box, person: Box, det: Box) -> Box:
+    """Where ``part`` goes when ``person`` becomes ``det`` (scaled about the person's centre,
+    moved with it)."""
+    sx, sy = det.w / max(person.w, 1e-6), det.h / max(person.h, 1e-6)
+    (pcx, pcy), (dcx, dcy), (cx, cy) = person.centre, det.centre, part.centre
+    w, h = part.w * sx, part.h * sy
+    return Box(dcx + (cx - pcx) * sx - w / 2, dcy + (cy - pcy) * sy - h / 2, w, h)
+
+
+class DetectionCue:
+    """The detector, the unconfirmed detections and, per track, the frame a detection last
+    matched it."""
+
+    def __init__(self, tracker):
+        self.tracker = tracker
+        self.p = tracker.params.detector
+        self.detector = PeopleDetector(self.p.scan())
+        self.candidates: list[Candidate] = []
+        self.last_match: dict[int, int] = {}
+        self.scans = 0
+        self.detections = np.zeros((0, 5))
+
+    def step(self, index: int, frame: np.ndarray, ycc, mask: np.ndarray | None) -> None:
+        """One frame: scan (every ``every`` frames), then assign, re-acquire, start and end."""
+        t = self.tracker
+        for tid, person in t.people.items():
+            self.last_match.setdefault(tid, person.started)
+        if (t.frames_seen - 1) % self.p.every:
+            return
+        self.scans += 1
+        people = [t.people[k] for k in sorted(t.people)]
+        boxes = [t._reported_person_box(q) for q in people]
+        regions = _blob_regions(mask, self.p.min_region_height) + boxes
+        dets = self.detector.detect(frame, regions)
+        self.detections = dets
+        pairs = associate(np.array([b.as_tuple() for b in boxes]).reshape(-1, 4), dets, self.p.match_iou)
+        used = set()
+        for i, j in pairs:
+            det = Box(*dets[j, :4])
+            if det.iou(boxes[i]) < self.p.steer_below:
+                self._steer(people[i], boxes[i], det, self.p.steer)
+            self.last_match[people[i].track_id] = index
+            if people[i].lost_since is not None:
+                people[i].lost_since = None
+                people[i].unsupported = 0
+            used.add(j)
+        matched = {i for i, _ in pairs}
+        free = [j for j in range(len(dets)) if j not in used]
+        free = self._reacquire(index, [q for i, q in enumerate(people) if i not in matched], dets, free, ycc)
+        if t.auto:
+            self._confirm(index, dets, free, ycc, mask)
+        self._end(index)
+
+    def _steer(self, person, reported: Box, det: Box, gain: float) -> None:
+        if gain <= 0:
+            return
+        # the reported boxes are the tracked inner rectangles widened (output.extent, scales and
+        # shifts relative to the part): mapping the reported person box onto the detection maps
+        # each part's inner rectangle with it
+        torso = person.filters.get("torso")
+        follows = not self.p.steer_head and torso is not None and "head" in person.filters
+        before = torso.state[0:2].copy() if torso is not None else None
+        for name, f in person.filters.items():
+            if name != "head" or not follows:
+                f.steer(_target(f.box, reported, det), gain)
+        if follows:  # the head moves with the torso's correction, keeping its size and place on it
+            person.filters["head"].shift(torso.state[0:2] - before)
+
+    def _reacquire(self, index: int, unmatched: list, dets: np.ndarray, free: list[int], ycc) -> list[int]:
+        """Lost tracks, and tracks unmatched for ``reacquire_after`` frames, jump to a free detection
+        near their prediction whose torso region matches the torso's model; the free rest."""
+        t, p = self.tracker, self.p
+        for person in unmatched:
+            if not free:
+                break
+            lost = person.lost_since is not None
+            if not lost and index - self.last_match.get(person.track_id, index) < p.reacquire_after:
+                continue
+            reported = t._reported_person_box(person)
+            cx, cy = reported.centre
+            best, best_rho = None, p.reacquire_similarity
+            f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
+            for j in free:
+                det = Box(*dets[j, :4])
+                dx, dy = det.centre[0] - cx, det.centre[1] - cy
+                if np.hypot(dx, dy) > p.reacquire_distance * det.h:
+                    continue
+                if any(det.iou(t._reported_person_box(q)) >= p.match_iou for q in t.people.values() if q is not person):
+                    continue  # someone else's
+                target = _target(f.box, reported, det)
+                state = np.array([[*target.centre, target.w, target.h, 0.0, 0.0]], dtype=np.float32)
+                rho = float(f.similarities(as_array(ycc), state)[0])
+                if rho >= best_rho:
+                    best, best_rho = j, rho
+            if best is None:
+                continue
+            for g in person.filters.values():
+                g.set_velocity(np.zeros(2))
+            self._steer(person, reported, Box(*dets[best, :4]), 1.0)
+            person.lost_since = None
+            person.unsupported = 0
+            person.occluded_by = None
+            self.last_match[person.track_id] = index
+            free = [j for j in free if j != best]
+        return free
+
+    def _confirm(self, index: int, dets: np.ndarray, free: list[int], ycc, mask) -> None:
+        """Free detections matched to candidates of earlier scans; confirmed ones start tracks."""
+        t, p = self.tracker, self.p
+        self.candidates = [c for c in self.candidates if self.scans - c.last_scan < p.confirm_window]
+        boxes = dets[free, :4] if free else np.zeros((0, 4))
+        prev = np.array([c.box.as_tuple() for c in self.candidates]).reshape(-1, 4)
+        pairs = dict((d, c) for c, d in associate_near(prev, boxes, p.confirm_distance))
+        fresh = []
+        for k, j in enumerate(free):
+            det = Box(*dets[j, :4])
+            if k in pairs:
+                c = self.candidates[pairs[k]]
+                c.box, c.hits, c.last_scan = det, c.hits + 1, self.scans
+            else:
+                c = Candidate(det, 1, self.scans)
+                fresh.append(c)
+            if c.hits >= p.confirm_hits and self._clear(det):
+                W, H = t.frame_size
+                box = det.clip(W, H)
+                if box.w >= 4 and box.h >= 8:
+                    t.start_track(t.next_id, {"person": box}, ycc, mask, index, from_mask=True)
+                    self.last_match[t.next_id] = index
+                    t.next_id += 1
+                c.hits = -10 ** 6  # started (or refused): never again from this candidate
+        self.candidates = [c for c in self.candidates + fresh if c.hits > 0]
+
+    def _clear(self, det: Box) -> bool:
+        """No tracked person covers the detection (IoU below match_iou, nor a third of it)."""
+        t = self.tracker
+        for q in t.people.values():
+            b = t._reported_person_box(q)
+            if det.iou(b) >= self.p.match_iou or det.intersection(b) > det.area / 3:
+                return False
+        return True
+
+    def _end(self, index: int) -> None:
+        """Duplicates end (the one matched less recently, then the younger); automatic tracks no
+        detection has matched for ``undetected_frames`` frames end."""
+        t, p = self.tracker, self.p
+        ids = sorted(t.people)
+        if p.duplicate_iou < 1 and len(ids) > 1:
+            boxes = np.array([minimum_bounding_rectangle(f.box for f in t.people[k].filters.values()).as_tuple()
+                              for k in ids])
+            for k in self._duplicates(ids, iou_xywh(boxes, boxes)):
+                if t.auto:
+                    self._drop(k)
+                elif t.people[k].lost_since is None:  # a given person is not dropped: it coasts, lost
+                    t.people[k].lost_since = index
+        if t.auto and p.undetected_frames > 0:
+            for k in sorted(t.people):
+                if index - self.last_match.get(k, index) >= p.undetected_frames:
+                    self._drop(k)
+
+    def _duplicates(self, ids: list[int], iou: np.ndarray) -> set[int]:
+        """Of each pair of tracks overlapping at ``duplicate_iou`` or more (neither behind the
+        other), the one a detection matched less recently, then the younger."""
+        t, gone = self.tracker, set()
+        for a in range(len(ids)):
+            for b in range(a + 1, len(ids)):
+                ka, kb = ids[a], ids[b]
+                if iou[a, b] < self.p.duplicate_iou or ka in gone or kb in gone:
+                    continue
+                if t.people[ka].occluded_by is not None or t.people[kb].occluded_by is not None:
+                    continue
+                rank_a, rank_b = (self.last_match.get(ka, -1), -ka), (self.last_match.get(kb, -1), -kb)
+                gone.add(ka if rank_a < rank_b else kb)
+        return gone
+
+    def _drop(self, track_id: int) -> None:
+        t = self.tracker
+        person = t.people.pop(track_id)
+        if person.lost_since is not None:
+            t.withdrawn.append((track_id, person.lost_since))
+        for q in t.people.values():
+            if q.occluded_by == track_id:
+                q.occluded_by = None
