@@ -200,3 +200,44 @@ def test_params_round_trip():
     assert TopViewParams.from_dict(p.to_dict()) == p
     with pytest.raises(ValueError, match="topview.resampling.mode"):
         TopViewParams(resampling=ResamplingParams(mode="both"))
+
+
+def _cast(state, body, cam):
+    g = Geometry(cam)
+    prims = primitives(state[None], body)[0]
+    hit = np.full(len(g.rays), np.inf)
+    for k, prim in enumerate(prims):
+        hit = np.minimum(hit, ray_cast(cam.centre, g.rays, prim, int(KINDS[k])))
+    on = np.isfinite(hit)
+    return cam.centre + hit[on, None] * g.rays[on]
+
+
+def test_start_fits_the_bend_and_stature_that_joints_alone_leave_open():
+    from partlab.tracking.topview.start import fit_person
+
+    body = Body().scaled(1800.0)
+    state = neutral_state(150.0, -80.0, body, yaw=0.7)
+    state[4] = 0.5                      # bent over a shelf
+    state[2] = body.pelvis_height - 15  # the hips sink a little
+    state[[7, 10, 12, 15]] = 0.6, 0.9, 0.2, 0.4
+    js = dict(zip(JOINTS, joints(state[None], body)[0]))
+    pts = _cast(state, body, topview_camera(160, 120, 2900.0))
+    fitted, got = fit_person(js, pts)
+    assert got[4] == pytest.approx(0.5, abs=0.08)
+    assert fitted.stature == pytest.approx(1800.0, rel=0.03)
+    assert np.hypot(*(got[:2] - state[:2])) < 40.0
+    assert np.abs(joints(got[None], fitted)[0] - np.array(list(js.values()))).max() < 20.0
+
+
+def test_eq5_prediction_extrapolates_the_last_two_estimates():
+    p = TopViewParams(resampling=ResamplingParams(n_particles=8))
+    f = PersonFilter(p, np.random.default_rng(0), Body(), neutral_state(0.0, 0.0, Body()))
+    f.previous = neutral_state(0.0, 0.0, Body(), yaw=np.pi - 0.05)
+    f.estimate = neutral_state(30.0, 0.0, Body(), yaw=-np.pi + 0.05)  # across the wrap: +0.1 rad
+    f.previous[10], f.estimate[10] = 0.3, 0.5
+    pred = f.predicted(1.0)
+    assert pred[0] == pytest.approx(60.0) and pred[10] == pytest.approx(0.7)
+    assert pred[3] == pytest.approx(-np.pi + 0.15)
+    assert f.predicted(0.0) == pytest.approx(f.estimate)
+    f.estimate[10] = 2.45  # clipped at the elbow's limit
+    assert f.predicted(1.0)[10] == pytest.approx(2.5)

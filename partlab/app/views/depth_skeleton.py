@@ -12,6 +12,7 @@ from pathlib import Path
 import streamlit as st
 
 from partlab.app.box_editor import track_colour
+from partlab.app.views.common import plain
 from partlab.errors import UserError
 from partlab.labelling.depth_view import depth_colours
 from partlab.labelling.topview_view import draw_skeletons, joint_pixel, joint_rows, move_joint, refit_from
@@ -54,13 +55,13 @@ def skeleton_section(take, take_path: str, index: int, frames) -> None:
     try:
         tracks = _load(path)
     except (OSError, TracksCSVError, UserError) as exc:
-        st.error(f"{path}: {exc}" if not str(exc).startswith(str(path)) else str(exc))
+        st.error(plain(f"{path}: {exc}" if not str(exc).startswith(str(path)) else exc))
         return
     view = next((v for v in frames.views.values() if v.depth is not None), None)
     camera = view.camera or take.cameras.get(view.stream) if view is not None else None
     rows = joint_rows(tracks, index)
     if camera is None or rows.empty:
-        st.info(f"frame {index}: no joints with X,Y,Z in {path.name}" if camera is not None
+        st.info(plain(f"frame {index}: no joints with X,Y,Z in {path.name}") if camera is not None
                 else "this take has no calibration for its depth stream: joints cannot be drawn")
         return
     ids = sorted(int(t) for t in rows["track_id"].unique())
@@ -83,7 +84,7 @@ def skeleton_section(take, take_path: str, index: int, frames) -> None:
         try:
             moved = move_joint(tracks, index, tid, part, (u, v), view.depth, camera)
         except UserError as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
         else:
             _save(moved, path)
             st.session_state["skel_message"] = f"moved {part} of track {tid} at frame {index}; saved {path.name}"
@@ -93,10 +94,10 @@ def skeleton_section(take, take_path: str, index: int, frames) -> None:
             try:
                 refit = refit_from(take, tracks, index)
             except UserError as exc:
-                st.error(str(exc))
+                st.error(plain(exc))
             else:
                 _save(refit, path)
                 st.session_state["skel_message"] = f"re-fitted from frame {index}; saved {path.name}"
                 st.rerun()
     if "skel_message" in st.session_state:
-        st.success(st.session_state.pop("skel_message"))
+        st.success(plain(st.session_state.pop("skel_message")))
