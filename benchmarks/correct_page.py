@@ -29,8 +29,8 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 # ../shared/data beside the repository (or beside the folder of worktrees holding it)
-PETS = next((p / "shared" / "data" / "pets09_s2l1_vtest" for p in (ROOT.parent, ROOT.parent.parent)
-             if (p / "shared" / "data" / "pets09_s2l1_vtest").is_dir()), ROOT.parent / "shared" / "data" / "pets09_s2l1_vtest")
+_PETS_UNDER = [p / "shared" / "data" / "pets09_s2l1_vtest" for p in (ROOT.parent, ROOT.parent.parent)]
+PETS = next((p for p in _PETS_UNDER if p.is_dir()), _PETS_UNDER[0])
 ARGS = ["--headless", "--no-sandbox", "--disable-gpu"]
 
 
@@ -88,8 +88,13 @@ def main() -> None:
             proc.wait(10)
         except subprocess.TimeoutExpired:
             proc.kill()
-    print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores "
-          f"(commit {subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], capture_output=True, text=True, cwd=ROOT).stdout.strip()})")
+    print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (commit {commit()})")
+
+
+def commit() -> str:
+    """The short hash of the commit measured."""
+    return subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                          cwd=ROOT).stdout.strip()
 
 
 def ev(page, expr):
@@ -101,7 +106,8 @@ def run(page, url: str, shots: bool, rep: int) -> None:
     page.wait_for_function("() => window.partlabEditor && window.partlabEditor.stats.ready === 0")
     start = 100
     page.evaluate(f"() => window.partlabEditor.show({start}, true)")
-    page.wait_for_function(f"() => window.partlabEditor.stats.ready === {start} && window.partlabEditor.frames.size >= 45")
+    page.wait_for_function(f"() => window.partlabEditor.stats.ready === {start} "
+                           "&& window.partlabEditor.frames.size >= 45")
     page.locator(".pl-frame").click()
     for i in range(1, 21):
         page.keyboard.press("ArrowRight")

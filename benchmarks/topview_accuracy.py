@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT))
 from partlab.labelling.synth.topview import make_topview  # noqa: E402
 from partlab.tracking.frame import FrameSet  # noqa: E402
 from partlab.tracking.topview.likelihood import nearest  # noqa: E402
-from partlab.tracking.topview.model import WEIGHT_PARTS, joints, primitives  # noqa: E402
+from partlab.tracking.topview.model import JOINTS, WEIGHT_PARTS, joints, primitives  # noqa: E402
 from partlab.tracking.topview.params import LikelihoodParams, ResamplingParams, TopViewParams  # noqa: E402
 from partlab.tracking.topview.tracker import Geometry, TopViewTracker  # noqa: E402
 
@@ -59,14 +59,16 @@ def run(scene, params: TopViewParams, seed: int) -> dict:
             cpu += time.process_time() - c0
             wall += time.perf_counter() - w0
         truth_roi = tr.roi(fs.first).mask & (scene.person[f] > 0)
-        assign.append(np.mean(tr.assignment[truth_roi] == scene.person[f][truth_roi]) if truth_roi.any() else np.nan)
+        right = tr.assignment[truth_roi] == scene.person[f][truth_roi]
+        assign.append(np.mean(right) if truth_roi.any() else np.nan)
         for t in tr.targets:
             k = t.track_id
             person = scene.people[k - 1]
             arm_px = np.flatnonzero(((scene.person[f] == k) & (scene.part[f] >= 4)).ravel()
                                     & np.isfinite(scene.depth[f]).ravel())
             if len(arm_px):
-                d, _ = nearest(geo.points(scene.depth[f], arm_px), primitives(t.filter.estimate[None], t.filter.body)[0])
+                model = primitives(t.filter.estimate[None], t.filter.body)[0]
+                d, _ = nearest(geo.points(scene.depth[f], arm_px), model)
                 eps.append(float(d.mean()))
             e = np.linalg.norm(joints(t.filter.estimate[None], t.filter.body)[0]
                                - joints(person.states[f][None], person.body)[0], axis=1)
@@ -79,12 +81,15 @@ def run(scene, params: TopViewParams, seed: int) -> dict:
     return {"eps": float(np.mean(eps)), "cpu_ms": 1000 * cpu / frames, "wall_ms": 1000 * wall / frames,
             "cpu_ms_per_person": 1000 * cpu / n, "arm80": float((arm < 80).mean()),
             "frames80": float((arm.max(1) < 80).mean()), "head_mm": float(e[:, 0].mean()),
-            "arm_mm": float(arm.mean()), "survival": np.mean(surv, 0).tolist(), "assign": float(np.nanmean(assign))}
+            "arm_mm": float(arm.mean()), "survival": np.mean(surv, 0).tolist(), "assign": float(np.nanmean(assign)),
+            "joint_mm": e.mean(0).tolist(), "joint80": (e < 80).mean(0).tolist()}
 
 
 def summary(rows: list[dict], key: str) -> str:
     v = np.array([r[key] for r in rows])
-    return f"{v.mean():.3f} +- {v.std():.3f}" if key in ("arm80", "frames80", "assign") else f"{v.mean():.1f} +- {v.std():.1f}"
+    if key in ("arm80", "frames80", "assign"):
+        return f"{v.mean():.3f} +- {v.std():.3f}"
+    return f"{v.mean():.1f} +- {v.std():.1f}"
 
 
 def plot(results: dict, path: Path) -> None:
@@ -106,7 +111,8 @@ def plot(results: dict, path: Path) -> None:
         cv2.putText(img, f"{y:.0f}", (m - 30, sy(y) + 4), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (0, 0, 0), 1)
     cv2.putText(img, "CPU ms per frame", (W // 2 - 60, H - 20), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1)
     cv2.putText(img, "eps (mm)", (8, m - 20), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1)
-    colours = {"S1 part": (200, 60, 0), "S1 global": (200, 160, 120), "S2 part": (0, 0, 200), "S2 global": (120, 140, 230)}
+    colours = {"S1 part": (200, 60, 0), "S1 global": (200, 160, 120), "S2 part": (0, 0, 200),
+               "S2 global": (120, 140, 230)}
     legend = 0
     for name, col in colours.items():
         scen, mode = name.split()
@@ -148,9 +154,10 @@ def figure(path: Path, seed: int = 0, frames: int = 40) -> None:
         truth = scene.camera.project(joints(scene.people[t.track_id - 1].states[-1][None],
                                             scene.people[t.track_id - 1].body)[0])
         for a, b in BONES:
-            cv2.line(left, tuple(np.rint(truth[a]).astype(int)), tuple(np.rint(truth[b]).astype(int)), (255, 255, 255), 1,
-                     cv2.LINE_AA)
-            cv2.line(left, tuple(np.rint(uv[a]).astype(int)), tuple(np.rint(uv[b]).astype(int)), (0, 0, 0), 2, cv2.LINE_AA)
+            ta, tb = (tuple(np.rint(truth[i]).astype(int)) for i in (a, b))
+            cv2.line(left, ta, tb, (255, 255, 255), 1, cv2.LINE_AA)
+            ea, eb = (tuple(np.rint(uv[i]).astype(int)) for i in (a, b))
+            cv2.line(left, ea, eb, (0, 0, 0), 2, cv2.LINE_AA)
         for p in uv:
             cv2.circle(left, tuple(np.rint(p).astype(int)), 3, (255, 255, 255), -1, cv2.LINE_AA)
     right = np.zeros_like(left)
@@ -163,70 +170,66 @@ def figure(path: Path, seed: int = 0, frames: int = 40) -> None:
     cv2.imwrite(str(path), img)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--seeds", type=int, default=10)
-    ap.add_argument("--frames", type=int, default=50)
-    ap.add_argument("--particles", default="50,100,200")
-    ap.add_argument("--default-particles", type=int, default=200)
-    ap.add_argument("--scenarios", default="s1,s2,s3")
-    ap.add_argument("--json", type=Path, help="write every run's figures here")
-    ap.add_argument("--plot", type=Path, help="draw epsilon against time per frame here (PNG)")
-    ap.add_argument("--figure", type=Path, help="only draw an S3 frame (skeletons on depth, eq. 5 assignment) here")
-    ap.add_argument("--from-json", type=Path, nargs="*", help="only print and plot the runs saved by --json")
-    args = ap.parse_args(argv)
-    if args.figure:
-        figure(args.figure)
-        return 0
-    counts = [int(x) for x in args.particles.split(",")]
-    scenarios = args.scenarios.split(",")
-    results: dict[str, list[dict]] = {}
-    for saved in args.from_json or ():
-        results.update(json.loads(saved.read_text()))
-    if args.from_json:
-        scenarios = []
-        counts = sorted({r["n"] for rows in results.values() for r in rows})
-        args.seeds = max(len(rows) for rows in results.values()) // max(1, len(counts))
+def measure(args, counts: list[int], scenarios: list[str], results: dict[str, list[dict]]) -> None:
+    """Run every take, resampling and cue of ``args`` into ``results`` (saved after every seed)."""
+    seeds = range(args.first_seed, args.first_seed + args.seeds)
+    modes = args.modes.split(",")
     for scen in [s for s in scenarios if s in ("s1", "s2")]:
-        for seed in range(args.seeds):
+        for seed in seeds:
             scene = make_topview(f"topview_{scen}", seed, args.frames)
-            for mode in ("part", "global"):
+            for mode in modes:
                 for n in counts:
                     p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=n))
                     results.setdefault(f"{scen.upper()} {mode} colour", []).append({"n": n, **run(scene, p, seed)})
-                p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
-                                  likelihood=replace(LikelihoodParams(), use_colour=False))
-                results.setdefault(f"{scen.upper()} {mode} depth-only", []).append(
-                    {"n": args.default_particles, **run(scene, p, seed)})
+                if args.depth_only:
+                    p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
+                                      likelihood=replace(LikelihoodParams(), use_colour=False))
+                    results.setdefault(f"{scen.upper()} {mode} depth-only", []).append(
+                        {"n": args.default_particles, **run(scene, p, seed)})
             print(f"{scen} seed {seed} done", file=sys.stderr, flush=True)
             if args.json:  # after every seed, so that a long run interrupted keeps what it measured
                 args.json.write_text(json.dumps(results, indent=1))
     if "s3" in scenarios:
-        for seed in range(args.seeds):
+        for seed in seeds:
             scene = make_topview("topview_s3", seed, args.frames)
-            for mode in ("part", "global"):
+            for mode in modes:
                 p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles))
                 results.setdefault(f"S3 {mode} colour", []).append({"n": args.default_particles, **run(scene, p, seed)})
             print(f"s3 seed {seed} done", file=sys.stderr, flush=True)
             if args.json:
                 args.json.write_text(json.dumps(results, indent=1))
-    print(f"seeds 0.. x {args.frames} frames at 320x240, started from the frame-0 truth; mean +- sd over seeds")
-    print(f"{'take / resampling / cue':28s} {'N':>4s} {'seeds':>5s} {'eps mm':>14s} {'cpu ms':>14s} {'wall ms':>14s} "
-          f"{'arm<80':>16s} {'frames<80':>16s} {'assign':>16s}")
+
+
+def print_tables(results: dict[str, list[dict]], args) -> None:
+    """The accuracy and time table, survival per part and each joint's share within 80 mm."""
+    print(f"{args.frames} frames at 320x240, started from the frame-0 truth; mean +- sd over seeds")
+    print(f"{'take / resampling / cue':28s} {'N':>4s} {'seeds':>5s} {'eps mm':>14s} {'cpu ms':>14s} "
+          f"{'wall ms':>14s} {'arm<80':>16s} {'frames<80':>16s} {'assign':>16s}")
     for key, rows in results.items():
         for n in sorted({r["n"] for r in rows}):
             sel = [r for r in rows if r["n"] == n]
-            print(f"{key:28s} {n:4d} {len(sel):5d} {summary(sel, 'eps'):>14s} {summary(sel, 'cpu_ms'):>14s} "
-                  f"{summary(sel, 'wall_ms'):>14s} {summary(sel, 'arm80'):>16s} {summary(sel, 'frames80'):>16s} "
-                  f"{summary(sel, 'assign') if key.startswith('S3') else '':>16s}")
+            cells = [summary(sel, k) for k in ("eps", "cpu_ms", "wall_ms")]
+            cells += [summary(sel, k) for k in ("arm80", "frames80")]
+            cells.append(summary(sel, "assign") if key.startswith("S3") else "")
+            widths = (14, 14, 14, 16, 16, 16)
+            print(f"{key:28s} {n:4d} {len(sel):5d} " + " ".join(f"{c:>{w}s}" for c, w in zip(cells, widths)))
     print("\nsurvival (distinct particles kept / N, mean over frames and seeds) at N =", args.default_particles)
     print(f"{'':28s} " + " ".join(f"{p:>10s}" for p in WEIGHT_PARTS))
     for key, rows in results.items():
         sel = [r for r in rows if r["n"] == args.default_particles]
         if sel:
-            s = np.mean([r["survival"] for r in sel], 0)
-            print(f"{key:28s} " + " ".join(f"{v:10.3f}" for v in s))
-    # equal time: each part-based count against the global count whose CPU time is nearest
+            print(f"{key:28s} " + " ".join(f"{v:10.3f}" for v in np.mean([r["survival"] for r in sel], 0)))
+    print("\nshare of frames each joint is within 80 mm (min over seeds in brackets) at N =", args.default_particles)
+    print(f"{'':28s} " + " ".join(f"{j:>16s}" for j in JOINTS))
+    for key, rows in results.items():
+        sel = [r["joint80"] for r in rows if r["n"] == args.default_particles and "joint80" in r]
+        if sel:
+            m, lo = np.mean(sel, 0), np.min(sel, 0)
+            print(f"{key:28s} " + " ".join(f"{a:9.3f} ({b:4.2f})" for a, b in zip(m, lo)))
+
+
+def print_equal_time(results: dict[str, list[dict]]) -> None:
+    """Each part-based count against the global count whose CPU time is nearest."""
     for scen in ("S1", "S2"):
         pk, gk = f"{scen} part colour", f"{scen} global colour"
         if pk not in results or gk not in results:
@@ -240,10 +243,42 @@ def main(argv=None) -> int:
             pe = [r["eps"] for r in by[(pk, n)]]
             ge = [r["eps"] for r in by[(gk, m)]]
             lower = sum(a < b for a, b in zip(pe, ge))
-            lines.append(f"part N={n} {np.mean(pe):.1f} mm in {t[(pk, n)]:.0f} ms vs global N={m} {np.mean(ge):.1f} mm "
-                         f"in {t[(gk, m)]:.0f} ms: part lower on {lower}/{len(pe)} seeds")
+            lines.append(f"part N={n} {np.mean(pe):.1f} mm in {t[(pk, n)]:.0f} ms vs global N={m} "
+                         f"{np.mean(ge):.1f} mm in {t[(gk, m)]:.0f} ms: part lower on {lower}/{len(pe)} seeds")
         print(f"\n{scen} at about equal CPU time:\n  " + "\n  ".join(lines))
-    if args.json:
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds first-seed .. first-seed + seeds - 1")
+    ap.add_argument("--modes", default="part,global", help="resamplings to run (part, global)")
+    ap.add_argument("--no-depth-only", dest="depth_only", action="store_false",
+                    help="leave out the runs without the colour term")
+    ap.add_argument("--frames", type=int, default=50)
+    ap.add_argument("--particles", default="50,100,200")
+    ap.add_argument("--default-particles", type=int, default=200)
+    ap.add_argument("--scenarios", default="s1,s2,s3")
+    ap.add_argument("--json", type=Path, help="write every run's figures here")
+    ap.add_argument("--plot", type=Path, help="draw epsilon against time per frame here (PNG)")
+    ap.add_argument("--figure", type=Path, help="only draw an S3 frame (skeletons on depth, eq. 5 assignment) here")
+    ap.add_argument("--from-json", type=Path, nargs="*", help="only print and plot the runs saved by --json")
+    args = ap.parse_args(argv)
+    if args.figure:
+        figure(args.figure)
+        return 0
+    counts = [int(x) for x in args.particles.split(",")]
+    results: dict[str, list[dict]] = {}
+    for saved in args.from_json or ():  # several files: their runs of one key are put together
+        for key, rows in json.loads(saved.read_text()).items():
+            results.setdefault(key, []).extend(rows)
+    if args.from_json:
+        counts = sorted({r["n"] for rows in results.values() for r in rows})
+    else:
+        measure(args, counts, args.scenarios.split(","), results)
+    print_tables(results, args)
+    print_equal_time(results)
+    if args.json and not args.from_json:
         args.json.write_text(json.dumps(results, indent=1))
     if args.plot:
         plot(results, args.plot)

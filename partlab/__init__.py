@@ -11,12 +11,20 @@ per tracker), :mod:`partlab.models` (failure SVMs, variance parameters, bundles)
 :mod:`partlab.app` (the Streamlit pages). Importing ``partlab`` loads none of them.
 """
 
-from importlib.metadata import PackageNotFoundError
-from importlib.metadata import version as _version
-
-try:
-    __version__ = _version("partlab")
-except PackageNotFoundError:  # running from a source tree that was never installed
-    __version__ = "0.2.0"
-
 __all__ = ["__version__"]
+
+
+def __getattr__(name: str):
+    """``__version__`` is read from the installed metadata on first use: importing
+    :mod:`importlib.metadata` costs more than the rest of ``import partlab``, and ``partlab track``
+    never needs it."""
+    if name != "__version__":
+        raise AttributeError(f"module 'partlab' has no attribute {name!r}")
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        value = version("partlab")
+    except PackageNotFoundError:  # running from a source tree that was never installed
+        value = "0.2.0"
+    globals()["__version__"] = value
+    return value

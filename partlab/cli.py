@@ -25,6 +25,7 @@ COMMANDS: dict[str, str] = {
     "synth": "render a synthetic scene with exact ground truth",
     "calibrate": "calibrate cameras from chessboard clips (or import OpenCV/PETS XML) into calibration.json",
     "app": "start the Streamlit labelling app (headless)",
+    "users": "add users who sign in to the app and grant them roles in projects",
     "serve-ml": "serve partlab as a Label Studio ML backend (predict part boxes, retrain from annotations)",
 }
 

@@ -7,10 +7,22 @@ killed app loses nothing that was shown as saved. Undo/redo walk this session's 
 from it, the in-between boxes refilled from it, every box of a merged track), undone
 together. The store keeps every revision, so an undo is itself a new revision
 (``Store.undo_many``) and a redo writes the undone content again.
+
+Events (activities over a range of frames, ``Store.add_event``) are edited the same way: adding,
+stretching, retyping or deleting one is a step whose undo writes the event's fields from before it
+as a new revision (an added event is deleted, a deleted one comes back).
+
+Track mode refills in two passes: the straight line between the keyframes at once (part of the
+edit's step), then keyframe-guided tracking of that one track (:func:`refine_step`, which the page
+runs as a background job: about 1-2 s a stretch) written into the same step, so one undo takes
+back the edit, the line and the tracker's boxes. A refinement is dropped unwritten when its step
+was undone meanwhile or a later step refilled the same track and part (the newer boxes stay).
 """
 
 from __future__ import annotations
 
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from partlab.labelling import trackops
@@ -25,7 +37,8 @@ class Step:
     """One undoable action: the keys it wrote ``(frame, track_id, part, revision)``, the
     human layer of those keys before and after it (changes for ``Store.edit_boxes``), the
     tracker run it wrote (in-between boxes; None: none), the keys whose in-betweens it
-    refilled ``(track_id, part, frame)``, a label for the messages and the frame to show."""
+    refilled ``(track_id, part, frame)``, a label for the messages and the frame to show;
+    ``refined``: the runs :func:`refine_step` added later (undone first)."""
 
     keys: list[tuple[int, int, str, int]]
     before: list[dict]
@@ -34,16 +47,33 @@ class Step:
     frame: int
     run_id: int | None = None
     refill: list[tuple[int, str, int]] = field(default_factory=list)
+    #: events the step changed: ``(event_id, fields before, fields after)``; None = no such event
+    events: list[tuple[int, dict | None, dict | None]] = field(default_factory=list)
+    refined: list[int] = field(default_factory=list)
+    fills: dict[tuple[int, str], int] = field(default_factory=dict)  # EditHistory.fills when it refilled
 
 
 @dataclass
 class EditHistory:
     """Undo/redo stacks of one session and clip (newest last); ``revs``: the revision this
-    session wrote last for each key (what its next undo or redo of that key expects)."""
+    session wrote last for each key (what its next undo or redo of that key expects);
+    ``fills``: how often each ``(track_id, part)`` was refilled or un-refilled (a refinement
+    started at one count is stale at another); ``lock``: held while the stacks change (a
+    refinement job writes from another thread)."""
 
     undo: list[Step] = field(default_factory=list)
     redo: list[Step] = field(default_factory=list)
     revs: dict[tuple[int, int, str], int] = field(default_factory=dict)
+    #: the revision this session wrote last for each event
+    event_revs: dict[int, int] = field(default_factory=dict)
+    fills: dict[tuple[int, str], int] = field(default_factory=dict)
+    lock: threading.RLock = field(default_factory=threading.RLock, repr=False, compare=False)
+
+    def touched(self, refill: list[tuple[int, str, int]]) -> dict[tuple[int, str], int]:
+        """Count a refill (or its undo) of these tracks and parts; returns their new counts."""
+        for tid, part, _ in refill:
+            self.fills[(tid, part)] = self.fills.get((tid, part), 0) + 1
+        return {(tid, part): self.fills[(tid, part)] for tid, part, _ in refill}
 
     def wrote(self, keys: list[tuple[int, int, str, int]]) -> None:
         for f, t, p, r in keys:
@@ -59,6 +89,7 @@ class ApplyResult:
     written: int = 0
     errors: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    refills: list[Step] = field(default_factory=list)  # steps whose straight lines a tracker may refine
 
 
 def _box(values) -> Box:
@@ -91,6 +122,12 @@ def record(store: Store, clip_id: int, changes: list[dict], history: EditHistory
            author: str = "", fill: bool = False) -> Step:
     """Write ``changes`` as one step (plus the person boxes recomputed from body-part edits
     and, with ``fill``, the in-between boxes of the edited key) and push it on the undo stack."""
+    with history.lock:
+        return _record(store, clip_id, changes, history, label, frame, author, fill)
+
+
+def _record(store: Store, clip_id: int, changes: list[dict], history: EditHistory, label: str, frame: int,
+            author: str, fill: bool) -> Step:
     keys, before, after = _write(store, clip_id, changes, author)
     boxes = [c for c in changes if c.get("box") is not None and c.get("kind", "box") == "box"]
     person = []
@@ -106,6 +143,7 @@ def record(store: Store, clip_id: int, changes: list[dict], history: EditHistory
         c = boxes[0]
         step.refill = [(int(c["track_id"]), str(c["part"]), int(c["frame"]))]
         step.run_id = _refill(store, clip_id, step.refill)
+        step.fills = history.touched(step.refill)
     history.undo.append(step)
     history.redo.clear()
     return step
@@ -129,27 +167,136 @@ def _rewrite(store: Store, clip_id: int, history: EditHistory, step: Step, conte
 
 def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
     """Take the newest step back: its keys get their human layer from before it (a key the
-    tracker had goes back to the tracker), and its tracker run is undone."""
-    step = history.undo[-1]
-    if step.run_id is not None:
-        store.undo_run(clip_id, step.run_id)
-    keys = _rewrite(store, clip_id, history, step, step.before, author)
-    history.undo.pop()
-    history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                             refill=step.refill))
+    tracker had goes back to the tracker), its tracker runs are undone (newest first) and its
+    events get their fields from before it."""
+    with history.lock:
+        step = history.undo[-1]
+        for run in [*reversed(step.refined), step.run_id]:
+            if run is not None:
+                store.undo_run(clip_id, run)
+        keys = _rewrite(store, clip_id, history, step, step.before, author) if step.keys else []
+        for event_id, before, _after in step.events:
+            _set_event(store, clip_id, history, event_id, before, author)
+        history.undo.pop()
+        history.touched(step.refill)
+        history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label,
+                                 frame=step.frame, refill=step.refill, events=step.events))
     return step
 
 
 def redo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
-    step = history.redo[-1]
-    keys = _rewrite(store, clip_id, history, step, step.after, author)
-    history.redo.pop()
-    again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                 refill=step.refill)
-    if step.refill:
-        again.run_id = _refill(store, clip_id, step.refill)
-    history.undo.append(again)
-    return again
+    with history.lock:
+        step = history.redo[-1]
+        keys = _rewrite(store, clip_id, history, step, step.after, author) if step.keys else []
+        for event_id, _before, after in step.events:
+            _set_event(store, clip_id, history, event_id, after, author)
+        history.redo.pop()
+        again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
+                     refill=step.refill, events=step.events)
+        if step.refill:
+            again.run_id = _refill(store, clip_id, step.refill)
+            again.fills = history.touched(step.refill)
+        history.undo.append(again)
+        return again
+
+
+def refine_step(store: Store, clip_id: int, history: EditHistory, step: Step, propose: trackops.Proposer,
+                progress: Callable[[int, int], None] | None = None) -> dict | None:
+    """Replace the straight in-between boxes ``step`` wrote with ``propose``'s (keyframe-guided
+    tracking) and add that run to the step, so that undoing the step undoes it too. Returns
+    ``{run_id, boxes}``, or None when the step was undone meanwhile or a later step refilled one
+    of its tracks and parts (then nothing is written)."""
+    proposals = [(t, p, *trackops.propose_fill(store, clip_id, t, p, f, propose, progress)) for t, p, f in step.refill]
+    with history.lock:
+        live = any(s is step for s in history.undo)
+        if not live or any(history.fills.get(k, 0) != n for k, n in step.fills.items()):
+            return None
+        runs = [trackops.write_fill(store, clip_id, t, p, spans, table) for t, p, spans, table in proposals]
+        step.refined.extend(r for r in runs if r is not None)
+    boxes = sum(len(table) for *_, table in proposals if table is not None)
+    return dict(run_id=step.refined[-1], boxes=boxes) if step.refined else None
+
+
+def _event_now(store: Store, clip_id: int, event_id: int) -> tuple[int, dict | None]:
+    """The newest revision of an event and its fields (None when it is deleted)."""
+    hist = store.events(clip_id, history=True)
+    rows = hist[hist.event_id == event_id]
+    if not len(rows):
+        raise StoreError(f"no event {event_id} in clip {clip_id}")
+    last = rows.iloc[-1]
+    conf = float(last.confidence)
+    fields = dict(start_frame=int(last.start_frame), end_frame=int(last.end_frame), type=str(last.type),
+                  tracks=[int(t) for t in last.tracks], parts=[str(p) for p in last.parts],
+                  confidence=None if conf != conf else conf, attributes=dict(last.attributes))
+    return int(last.revision), (None if bool(last.deleted) else fields)
+
+
+def _set_event(store: Store, clip_id: int, history: EditHistory, event_id: int, fields: dict | None,
+               author: str) -> None:
+    """Give an event ``fields`` (None: delete it) as a new revision, expecting the one this session wrote."""
+    revision, _ = _event_now(store, clip_id, event_id)
+    expected = history.event_revs.get(event_id, revision)
+    if fields is None:
+        rev = store.edit_event(clip_id, event_id, expected_revision=expected, author=author, delete=True)
+    else:
+        rev = store.edit_event(clip_id, event_id, expected_revision=expected, author=author, **fields)
+    history.event_revs[event_id] = rev
+
+
+def _frames(ev: dict, before: dict | None = None) -> tuple[int, int]:
+    start = int(ev.get("start_frame", before["start_frame"] if before else 0))
+    end = int(ev.get("end_frame", before["end_frame"] if before else start))
+    return min(start, end), max(start, end)
+
+
+def apply_event_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author: str = "") -> Step:
+    """One event action of the editor (``event_add``, ``event_edit``, ``event_delete``) as one step."""
+    kind = ev["kind"]
+    if kind == "event_add":
+        start, end = _frames(ev)
+        etype = str(ev.get("type") or "").strip()
+        event_id = store.add_event(clip_id, start, end, etype, tracks=ev.get("tracks") or (),
+                                   parts=ev.get("parts") or (), source="human", author=author)
+        revision, after = _event_now(store, clip_id, event_id)
+        history.event_revs[event_id] = revision
+        change, label = (event_id, None, after), f"new {etype} event {start}-{end}"
+    else:
+        event_id = int(ev["event_id"])
+        revision, before = _event_now(store, clip_id, event_id)
+        if ev.get("revision") is not None:
+            history.event_revs[event_id] = int(ev["revision"])  # what the user saw: a stale edit is refused
+        if before is None:
+            raise StoreError(f"event {event_id} was deleted")
+        if kind == "event_delete":
+            after, label = None, f"deletion of the {before['type']} event {before['start_frame']}-{before['end_frame']}"
+        else:
+            start, end = _frames(ev, before)
+            after = dict(before, start_frame=start, end_frame=end, type=str(ev.get("type") or before["type"]))
+            label = f"change of the {after['type']} event to {start}-{end}"
+        _set_event(store, clip_id, history, event_id, after, author)
+        change = (event_id, before, after)
+    shown = change[2] or change[1]
+    step = Step(keys=[], before=[], after=[], label=label, frame=int(ev.get("frame", shown["start_frame"])),
+                events=[change])
+    history.undo.append(step)
+    history.redo.clear()
+    return step
+
+
+def _box_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author: str, fill: bool) -> Step:
+    """One box moved, resized, flagged or deleted in the editor, as a step."""
+    kind = ev["kind"]
+    frame, tid, part = int(ev["frame"]), int(ev["track_id"]), str(ev["part"])
+    expected = ev.get("revision")
+    if expected is None or ev.get("added"):
+        # a new key: nobody's edit to be stale against, unless one appeared meanwhile
+        expected = store.revision(clip_id, frame, tid, part)
+    change = dict(frame=frame, track_id=tid, part=part, expected_revision=int(expected),
+                  box=_box(ev["box"]) if kind == "edit" else None)
+    if kind == "edit":
+        change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
+    return record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
+                  author=author, fill=fill and kind == "edit")
 
 
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
@@ -166,17 +313,12 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 store.set_occluders(clip_id, [_box(b) for b in ev.get("boxes", [])])
                 res.written += 1
             elif kind in ("edit", "delete"):
-                frame, tid, part = int(ev["frame"]), int(ev["track_id"]), str(ev["part"])
-                expected = ev.get("revision")
-                if expected is None or ev.get("added"):
-                    # a new key: nobody's edit to be stale against, unless one appeared meanwhile
-                    expected = store.revision(clip_id, frame, tid, part)
-                change = dict(frame=frame, track_id=tid, part=part, expected_revision=int(expected),
-                              box=_box(ev["box"]) if kind == "edit" else None)
-                if kind == "edit":
-                    change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
-                record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
-                       author=author, fill=fill and kind == "edit")
+                step = _box_edit(store, clip_id, ev, history, author, fill)
+                if step.run_id is not None:
+                    res.refills.append(step)
+                res.written += 1
+            elif kind in ("event_add", "event_edit", "event_delete"):
+                apply_event_edit(store, clip_id, ev, history, author=author)
                 res.written += 1
             elif kind == "undo":
                 if not history.undo:
@@ -191,6 +333,8 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                     res.notes.append("nothing to redo")
                     continue
                 step = redo_step(store, clip_id, history, author=author)
+                if step.run_id is not None:
+                    res.refills.append(step)
                 res.frame = step.frame
                 res.written += 1
                 res.notes.append(f"redid the {step.label}")

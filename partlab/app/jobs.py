@@ -73,7 +73,8 @@ def journal_path() -> Path:
 def _journal(job: Job) -> None:
     """Append the job's state to the journal; never lets a journal problem fail the job."""
     entry = {"id": job.id, "pid": os.getpid(), "kind": job.kind, "label": job.label, "status": job.status,
-             "done": job.done, "total": job.total, "error": job.error, "time": time.time()}
+             "done": job.done, "total": job.total, "error": job.error, "time": time.time(),
+             "meta": job.meta}
     try:
         with _JOURNAL_LOCK, open(journal_path(), "a", encoding="utf-8") as f:
             f.write(json.dumps(entry) + "\n")

@@ -75,6 +75,9 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
     synthetic scene's init.csv).
     """
     from partlab.app import pipeline
+    from partlab.labelling import access
+
+    access.require(store, clip.project_id)  # the job stores its run through a store of its own
     if tracker not in TRACKERS:
         raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {tracker!r}")
     stop, track_ids = None, None
@@ -177,7 +180,10 @@ def start_training(store: Store, project_id: int, clip_ids: list[int], name: str
     """Train a bundle from corrected clips in the background, save it and register it.
     ``start_path``: the bundle to improve on (its detector stays unless the new one does no
     worse, :func:`partlab.models.training.train_bundle`); None: the built-in parameters."""
+    from partlab.labelling import access
     from partlab.models import bundle as bundle_mod
+
+    access.require(store, project_id)  # the job registers its bundle through a store of its own
     from partlab.models import training
     from partlab.models.runner import body_tracker_runner as runner  # the tracker's own failures: the paper's samples
 

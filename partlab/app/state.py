@@ -18,8 +18,11 @@ AUTHOR = "author"
 
 
 def store() -> Store:
-    """The annotation store (cheap: engines are shared per database URL)."""
-    return Store()
+    """The annotation store (cheap: engines are shared per database URL); with sign-in on, the
+    signed-in user's view of it, and the page stops when nobody is signed in (:mod:`partlab.app.auth`)."""
+    from partlab.app import auth
+
+    return auth.signed_in_store()
 
 
 def frame_key(clip_id: int) -> str:
@@ -83,4 +86,7 @@ def history(clip_id: int) -> EditHistory:
 
 
 def author() -> str:
-    return str(st.session_state.get(AUTHOR, ""))
+    """The name saved with edits: the signed-in user's, else the one typed in the sidebar."""
+    from partlab.app import auth
+
+    return auth.user() or str(st.session_state.get(AUTHOR, ""))

@@ -10,17 +10,18 @@ import streamlit as st
 
 st.set_page_config(page_title="partlab", layout="wide")
 
-from partlab.app import jobs, prefs, state  # noqa: E402
+from partlab.app import auth, jobs, prefs, state  # noqa: E402
 from partlab.app.demo import ensure_demo, track_demo  # noqa: E402
-from partlab.app.views.common import bound_widget, plain  # noqa: E402
+from partlab.app.views.common import bound_widget, plain, storage_message  # noqa: E402
 from partlab.labelling.config import data_dir  # noqa: E402
+from partlab.labelling.store import StoreError  # noqa: E402
 
 
 @st.cache_resource(show_spinner="Preparing the demo project (synthetic scenes)...")
 def _demo_ready(data: str) -> bool:
     """Once per server process and data directory; the demo clips are tracked in the background.
     ``PARTLAB_DEMO=0`` leaves the demo out (a shared server, or a test that measures speed)."""
-    if os.environ.get("PARTLAB_DEMO", "1") == "0":
+    if os.environ.get("PARTLAB_DEMO", "1") == "0" or auth.enabled():  # with sign-in: nobody's project
         return False
     ready = ensure_demo()
     if ready:
@@ -28,8 +29,6 @@ def _demo_ready(data: str) -> bool:
     return ready
 
 
-_demo_ready(str(data_dir()))
-store = state.store()
 
 PROJECTS = st.Page("views/projects.py", title="Projects and clips", icon=":material/folder:", url_path="projects")
 PAGES = [
@@ -41,6 +40,24 @@ PAGES = [
     st.Page("views/export.py", title="Export", icon=":material/download:", url_path="export"),
     st.Page("views/depth.py", title="Depth", icon=":material/layers:", url_path="depth"),
 ]
+
+
+def _sign_in():
+    auth.sign_in_form()
+
+
+try:  # a read-only or full data directory, an unreachable database: a sentence, not a traceback
+    if auth.enabled() and not auth.user():
+        # every address (a link to /correct too) shows the sign-in form, and stays where it was after it
+        st.navigation([st.Page(_sign_in, title="Sign in", default=True)]
+                      + [st.Page(_sign_in, title="Sign in", url_path=p.url_path) for p in PAGES],
+                      position="hidden").run()
+        st.stop()
+    _demo_ready(str(data_dir()))
+    store = state.store()
+except (StoreError, OSError) as exc:
+    st.error(storage_message(exc))
+    st.stop()
 
 
 def _home():
@@ -64,14 +81,23 @@ with st.sidebar:
         state.project_id(store)
         names = {p.id: p.name for p in projects}
         bound_widget(st.selectbox, state.PROJECT, "project_select", "Project", list(names), format_func=names.get)
-    st.session_state.setdefault(state.AUTHOR, "")
-    bound_widget(st.text_input, state.AUTHOR, "author_input", "Your name (saved with your edits)")
+    if auth.enabled():  # edits are saved under the signed-in name
+        st.caption(f"Signed in as {plain(auth.user())}")
+        st.button("Sign out", on_click=auth.sign_out, type="tertiary")
+    else:
+        st.session_state.setdefault(state.AUTHOR, "")
+        bound_widget(st.text_input, state.AUTHOR, "author_input", "Your name (saved with your edits)")
+    visible = {p.id for p in projects}
+
+    def _mine(job_meta: dict) -> bool:
+        """Without sign-in every job; with it, the jobs of the user's projects only."""
+        return not auth.enabled() or job_meta.get("project_id") in visible
 
     @st.fragment(run_every=2 if jobs.active() else None)
     def _job_list():
-        running = jobs.active()
-        recent = [j for j in jobs.jobs() if not j.active][:3]
-        stopped = jobs.interrupted()[:3]
+        running = [j for j in jobs.active() if _mine(j.meta)]
+        recent = [j for j in jobs.jobs() if not j.active and _mine(j.meta)][:3]
+        stopped = [e for e in jobs.interrupted() if _mine(e.get("meta") or {})][:3]
         if running or recent or stopped:
             st.caption("Background jobs")
         for j in running:
@@ -82,7 +108,7 @@ with st.sidebar:
         for j in recent:
             word = j.status if j.status in ("done", "cancelled") else "FAILED"
             st.caption(f"{word}: {plain(j.label)}" +
-                       (f" ({j.error})" if j.error else ""))
+                       (f" ({plain(j.error)})" if j.error else ""))
         for e in stopped:
             st.caption(f"INTERRUPTED: {plain(e['label'])} (the app stopped at {e['done']}/{e['total'] or '?'}; "
                        "start it again from its page)")
@@ -92,4 +118,7 @@ with st.sidebar:
     _job_list()
     st.caption(f"Data: {data_dir()}")
 
-current.run()
+try:
+    current.run()
+except (StoreError, OSError) as exc:  # what a page did not catch: a refused write, a full disk
+    st.error(storage_message(exc))

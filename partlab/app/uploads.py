@@ -13,7 +13,7 @@ import tempfile
 from pathlib import Path
 
 from partlab.labelling.config import data_dir
-from partlab.labelling.store import Clip, Store
+from partlab.labelling.store import Clip, Store, StoreError
 from partlab.labelling.video import VideoError
 
 #: what the uploader offers (the issue's list plus common aliases OpenCV reads), and a zip of JPEG/PNG
@@ -55,24 +55,37 @@ def check_upload(name: str, size: int, limit_mb: int | None = None) -> None:
 def save_upload(store: Store, project_id: int, name: str, data) -> Clip:
     """Check, write to a temporary file, and add the clip to the project (copied by hash).
 
-    ``data`` is a binary file object (Streamlit's ``UploadedFile``) or bytes.
+    ``data`` is a binary file object (Streamlit's ``UploadedFile``) or bytes. A full disk, a
+    read-only data directory or a refusal by the store (a viewer's upload) is an
+    :class:`UploadRefused` saying so; the temporary file goes, earlier clips stay as they were.
     """
     content = data if isinstance(data, (bytes, bytearray)) else None
     size = len(content) if content is not None else int(getattr(data, "size", 0))
     check_upload(name, size)
-    tmp_dir = data_dir() / "uploads"
-    tmp_dir.mkdir(parents=True, exist_ok=True)
-    with tempfile.NamedTemporaryFile(dir=tmp_dir, suffix=Path(name).suffix.lower(), delete=False) as tmp:
-        if content is not None:
-            tmp.write(content)
-        else:
-            data.seek(0)
-            shutil.copyfileobj(data, tmp, length=1 << 20)
-        tmp_path = Path(tmp.name)
+    tmp_path = None
     try:
+        tmp_dir = data_dir() / "uploads"
+        tmp_dir.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=tmp_dir, suffix=Path(name).suffix.lower(), delete=False) as tmp:
+            tmp_path = Path(tmp.name)
+            if content is not None:
+                tmp.write(content)
+            else:
+                data.seek(0)
+                shutil.copyfileobj(data, tmp, length=1 << 20)
         return store.add_clip(project_id, tmp_path, name=Path(name).name)
     except VideoError as exc:
         reason = str(exc).replace(str(tmp_path), name)
         raise UploadRefused(f"refused: {reason}") from None
+    except OSError as exc:
+        from partlab.cli import describe_os_error
+
+        raise UploadRefused(f"{name}: not stored, {describe_os_error(exc)}") from None
+    except StoreError as exc:
+        raise UploadRefused(f"{name}: not stored, {exc}") from None
     finally:
-        tmp_path.unlink(missing_ok=True)
+        if tmp_path is not None:
+            try:
+                tmp_path.unlink(missing_ok=True)
+            except OSError:
+                pass

@@ -1,4 +1,10 @@
-"""``partlab app``: start the Streamlit labelling app, headless (no browser opened)."""
+"""``partlab app``: start the Streamlit labelling app, headless (no browser opened).
+
+Sign-in (``--auth``): ``none`` is partlab as a single-user tool and is allowed on a loopback address
+only; ``password`` asks every browser session to sign in as a user made with ``partlab users add``
+and shows each user only the projects they hold a role in. The default is ``none`` on loopback and
+``password`` anywhere else; ``--host 0.0.0.0 --auth none`` is refused (exit 2).
+"""
 
 from __future__ import annotations
 
@@ -21,6 +27,10 @@ def add_arguments(p) -> None:
     p.add_argument("--allowed-hosts", metavar="NAMES", default=os.environ.get("PARTLAB_ALLOWED_HOSTS", ""),
                    help="comma-separated host names the app may be reached by besides localhost and --host "
                         "(PARTLAB_ALLOWED_HOSTS); requests naming any other host are refused (DNS rebinding)")
+    p.add_argument("--auth", choices=("none", "password"), default=os.environ.get("PARTLAB_AUTH") or None,
+                   help="'password': every browser signs in as a user of `partlab users` and sees only their "
+                        "projects; 'none': no sign-in, allowed on loopback only (default: none on loopback, "
+                        "password on any other address; PARTLAB_AUTH)")
     p.add_argument("--jobs", choices=("engine", "threads"), default=os.environ.get("PARTLAB_JOBS", "engine"),
                    help="where tracking and training run: 'engine' (default) on Dask workers outside the server, "
                         "so they survive a restart and can be cancelled; 'threads' inside the server process")
@@ -67,9 +77,65 @@ def streamlit_command(host: str, port: int, extra_hosts: str = "") -> list[str]:
     ] + [arg for name in allowed_hosts(host, extra_hosts) for arg in ("--server.allowedHosts", name)]
 
 
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` is reachable from this machine only (a loopback name or address)."""
+    import ipaddress
+
+    if host in LOOPBACK_NAMES:
+        return True
+    try:
+        return ipaddress.ip_address(host.strip("[]")).is_loopback
+    except ValueError:
+        return False
+
+
+def auth_mode(host: str, asked: str | None) -> str:
+    """The sign-in mode to serve with; no sign-in on an address other machines reach is refused."""
+    mode = asked or ("none" if is_loopback(host) else "password")
+    if mode == "none" and not is_loopback(host):
+        raise CommandError(f"refusing to serve {host} without sign-in (--auth none is for loopback only); "
+                           "add users with `partlab users add NAME --project P --role owner` and use --auth password")
+    return mode
+
+
+def check_data_dir() -> None:
+    """Refuse to start when the data directory or the database cannot be written (a sentence, exit 2)."""
+    import tempfile
+
+    from partlab.cli import describe_os_error
+    from partlab.labelling.config import data_dir
+
+    try:
+        where = data_dir()
+        with tempfile.TemporaryFile(dir=where):
+            pass
+    except OSError as exc:
+        raise CommandError(f"the data directory {os.environ.get('PARTLAB_DATA', 'partlab-data')} cannot be written "
+                           f"({describe_os_error(exc)}); set PARTLAB_DATA to a writable directory") from None
+
+
+def check_users() -> None:
+    from partlab.labelling.access import has_users
+    from partlab.labelling.store import Store, StoreError
+
+    try:
+        found = has_users(Store())
+    except StoreError as exc:
+        raise CommandError(str(exc)) from None
+    if not found:
+        raise CommandError("sign-in is on but there are no users yet: add one with "
+                           "`partlab users add NAME --project P --create-project --role owner`")
+
+
 def run(args) -> int:
-    print(f"partlab app: serving on http://{args.host}:{args.port} (Ctrl+C to stop)", flush=True)
+    mode = auth_mode(args.host, args.auth)
+    check_data_dir()  # clips, uploads and exports live there whatever the database
+    if mode == "password":
+        check_users()
+    print(f"partlab app: serving on http://{args.host}:{args.port} "
+          f"({'sign-in on' if mode == 'password' else 'no sign-in'}; Ctrl+C to stop)", flush=True)
     env = os.environ.copy()
+    env["PARTLAB_AUTH"] = mode
     env["PARTLAB_JOBS"] = args.jobs
     if args.scheduler:
         env["PARTLAB_SCHEDULER"] = args.scheduler

@@ -18,7 +18,7 @@ def add_arguments(p) -> None:
                    help="single, pair_cross, pillar, distractors, crowd, bend or desk (default: single); "
                         "activities with event truth: pick_place, exchange, handshake, clap; with depth and a "
                         "stereo pair: desk_depth or standing_depth; seen from the ceiling with depth: topview_s1, "
-                        "topview_s2, topview_s3 (docs/synthetic.md)")
+                        "topview_s2, topview_s3, topview_group (docs/synthetic.md)")
     p.add_argument("--seed", type=seed, default=0, help="random seed; the same seed gives the same scene")
     p.add_argument("--frames", type=int, default=150, help="number of frames (default: 150, 6 s at 25 fps)")
     p.add_argument("--size", default=None,

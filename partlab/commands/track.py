@@ -92,8 +92,6 @@ def write_events(events, args) -> None:
 
 
 def run(args) -> int:
-    from tqdm import tqdm
-
     from partlab.app.pipeline import track_path
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv, write_tracks_csv
 
@@ -122,6 +120,8 @@ def run(args) -> int:
     def progress(done: int, total: int) -> None:
         nonlocal bar
         if bar is None:
+            from tqdm import tqdm  # only with --progress
+
             bar = tqdm(total=total, unit="frame", desc="tracking")
         bar.update(done - bar.n)
 

@@ -104,3 +104,50 @@ def evaluate_events(truth: pd.DataFrame, predicted: pd.DataFrame, iou: float = 0
         rows.append(dict(kind=k, truth=nt, predicted=npred, matched=tp,
                          precision=tp / npred if npred else float("nan"), recall=tp / nt if nt else float("nan")))
     return pd.DataFrame(rows).set_index("kind")
+
+
+#: the events CSV's columns, in order (what ``partlab track --events`` writes)
+CSV_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b",
+                                "ended_by", "object_colour", "confidence")
+
+
+def _pair(values, k: int, default):
+    values = list(values) if isinstance(values, (list, tuple)) else []
+    return values[k] if len(values) > k else default
+
+
+def from_store(stored: pd.DataFrame) -> pd.DataFrame:
+    """The events CSV table (:data:`CSV_COLUMNS` plus ``event_id`` and ``source``) of
+    :meth:`~partlab.labelling.store.Store.events` rows: ``type`` is the kind, the first two
+    ``tracks``/``parts`` are the a and b sides, ``ended_by`` and ``object_colour`` come from the
+    attributes."""
+    rows = []
+    for r in stored.itertuples(index=False):
+        attrs = r.attributes if isinstance(r.attributes, dict) else {}
+        tracks, parts = list(r.tracks or []), list(r.parts or [])
+        if len(tracks) == 1 and len(parts) == 2:  # one person's two hands (a clap)
+            tracks = tracks * 2
+        conf = r.confidence
+        rows.append(dict(start_frame=int(r.start_frame), end_frame=int(r.end_frame), kind=str(r.type),
+                         track_id_a=int(_pair(tracks, 0, 0)), part_a=str(_pair(parts, 0, "")),
+                         track_id_b=int(_pair(tracks, 1, 0)), part_b=str(_pair(parts, 1, "")),
+                         ended_by=str(attrs.get("ended_by", "")), object_colour=str(attrs.get("object_colour", "")),
+                         confidence=float("nan") if conf is None else float(conf), event_id=int(r.event_id),
+                         source=str(r.source)))
+    return pd.DataFrame(rows, columns=list(CSV_COLUMNS) + ["event_id", "source"])
+
+
+def to_store(store, clip_id: int, events: pd.DataFrame, source: str = "tracker", author: str = "") -> list[int]:
+    """Record the rows of an events table (:data:`CSV_COLUMNS`) in the store; returns their event ids."""
+    ids = []
+    for r in events.itertuples(index=False):
+        two = bool(str(getattr(r, "part_b", "") or ""))  # side b is there when it names a part (0 is a track id)
+        tracks = [int(r.track_id_a)] + ([int(r.track_id_b)] if two else [])
+        parts = [str(getattr(r, c)) for c in ("part_a", "part_b") if str(getattr(r, c, "") or "")]
+        attrs = {k: str(getattr(r, k)) for k in ("ended_by", "object_colour") if str(getattr(r, k, "") or "")}
+        conf = getattr(r, "confidence", None)
+        ids.append(store.add_event(clip_id, int(r.start_frame), int(r.end_frame), str(r.kind),
+                                   tracks=list(dict.fromkeys(tracks)), parts=parts, source=source, author=author,
+                                   confidence=None if conf is None or conf != conf else float(conf),
+                                   attributes=attrs))
+    return ids

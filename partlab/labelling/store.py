@@ -277,6 +277,32 @@ class JobRow(Base):
     finished: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
 
 
+#: what a user may do in one project (revision 5), weakest first: a ``viewer`` reads, an ``annotator``
+#: also edits, tracks, trains and uploads, an ``owner`` also grants roles (:mod:`partlab.labelling.access`)
+ROLES: tuple[str, ...] = ("viewer", "annotator", "owner")
+
+
+class UserRow(Base):
+    """A user who signs in to the app (revision 5); ``password`` is an Argon2id hash, never the password."""
+
+    __tablename__ = "users"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    name: Mapped[str] = mapped_column(String(100), unique=True)
+    password: Mapped[str] = mapped_column(Text)
+    created: Mapped[datetime] = mapped_column(DateTime(timezone=True), default=_now)
+
+
+class RoleRow(Base):
+    """One user's role in one project (revision 5)."""
+
+    __tablename__ = "project_roles"
+    id: Mapped[int] = mapped_column(Integer, primary_key=True)
+    user_id: Mapped[int] = mapped_column(ForeignKey("users.id"), index=True)
+    project_id: Mapped[int] = mapped_column(ForeignKey("projects.id"), index=True)
+    role: Mapped[str] = mapped_column(String(20))
+    __table_args__ = (UniqueConstraint("user_id", "project_id"),)
+
+
 @dataclass(frozen=True)
 class Project:
     id: int
@@ -373,6 +399,34 @@ def connect_timeout() -> int:
     return value
 
 
+#: what SQLite and PostgreSQL say when the database cannot be written, in words a user can act on
+_STORAGE_FAILURES = (
+    ("database or disk is full", "the disk holding the database is full"),
+    ("could not extend file", "the disk holding the database is full"),
+    ("no space left on device", "the disk holding the database is full"),
+    ("attempt to write a readonly database", "the database is read-only (file or data directory)"),
+    ("read-only transaction", "the database server only allows reading"),
+    ("readonly database", "the database is read-only (file or data directory)"),
+    ("unable to open database file", "the database file cannot be opened (a missing or read-only data directory?)"),
+    ("disk i/o error", "the disk reported an I/O error"),
+)
+
+
+def storage_failure(exc: BaseException) -> str | None:
+    """The reason, in words, when ``exc`` (a DBAPI error, or SQLAlchemy's wrapper of one) is a full
+    disk or a read-only database; None for anything else."""
+    text = " ".join(str(getattr(exc, "orig", None) or exc).split()).lower()
+    code = getattr(getattr(exc, "orig", exc), "sqlstate", None)
+    if code == "53100":  # PostgreSQL disk_full
+        return "the disk holding the database is full"
+    return next((said for found, said in _STORAGE_FAILURES if found in text), None)
+
+
+def _storage_error(url: str, reason: str) -> StoreError:
+    shown = make_url(url).render_as_string(hide_password=True)
+    return StoreError(f"{shown}: {reason}; this change was not saved (what was saved before is intact)")
+
+
 def _engine(url: str):
     """One engine per URL per process (Streamlit reruns must not open new pools)."""
     with _ENGINES_LOCK:
@@ -384,6 +438,13 @@ def _engine(url: str):
             elif url.startswith("postgresql"):  # a server that never answers fails in seconds, not minutes
                 kwargs["connect_args"] = {"connect_timeout": connect_timeout()}
             eng = create_engine(url, **kwargs)
+
+            @event.listens_for(eng, "handle_error")
+            def _full_or_read_only(ctx):  # a full disk is a sentence, not a driver traceback
+                reason = storage_failure(ctx.original_exception)
+                if reason is not None:
+                    raise _storage_error(url, reason) from ctx.original_exception
+
             if url.startswith("sqlite"):
                 @event.listens_for(eng, "connect")
                 def _pragmas(dbapi_conn, _record):
@@ -398,8 +459,14 @@ def _engine(url: str):
             except migrations.SchemaError as exc:
                 eng.dispose()
                 raise StoreError(str(exc)) from None
+            except StoreError:
+                eng.dispose()
+                raise
             except OperationalError as exc:
                 eng.dispose()
+                reason = storage_failure(exc)
+                if reason is not None:
+                    raise _storage_error(url, reason) from None
                 shown = make_url(url).render_as_string(hide_password=True)
                 reason = " ".join(str(getattr(exc, "orig", exc)).split())[:200]
                 raise StoreError(f"cannot reach the database {shown} within {connect_timeout()} s ({reason}); "

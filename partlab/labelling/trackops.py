@@ -13,7 +13,9 @@ transaction, so an operation is one step of undo (``Store.undo_many`` of its key
   parts (Zhao & Lee sec. 5.3) after one of them was edited;
 - :func:`fill_between`: the in-between boxes of one track and part between two keyframes
   (a keyframe is a human box in effect, ``Store.keyframes``), stored as a tracker run of
-  that track and part only.
+  that track and part only; they come from a :data:`Proposer` (the app passes keyframe-guided
+  tracking, :func:`partlab.tracking.keyframes.track_stretch`; :func:`linear_proposer` is the
+  straight line).
 
 Identity operations write revisions of kind ``track`` (the tracker's boxes moved, not
 checked), except for human boxes, which stay ``box``: a keyframe moved to another id is
@@ -21,6 +23,8 @@ still a keyframe.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import pandas as pd
@@ -122,7 +126,7 @@ def person_update(store: Store, clip_id: int, frame: int, track_id: int) -> list
 
 def linear_in_between(first: tuple[int, Box], last: tuple[int, Box]) -> np.ndarray:
     """Boxes ``(n, 4)`` [x, y, w, h] of the frames strictly between two keyframes, by linear
-    interpolation of corners and size: the fallback until keyframe-guided tracking lands."""
+    interpolation of corners and size."""
     (f0, b0), (f1, b1) = first, last
     t = (np.arange(f0 + 1, f1, dtype=float) - f0) / float(f1 - f0)
     a = np.array([b0.x, b0.y, b0.w, b0.h])
@@ -130,9 +134,19 @@ def linear_in_between(first: tuple[int, Box], last: tuple[int, Box]) -> np.ndarr
     return a[None, :] + t[:, None] * (b - a)[None, :]
 
 
-#: how in-between boxes are made from two keyframes ``(frame, Box)``; the one line to swap
-#: for keyframe-guided tracking
-in_between = linear_in_between
+#: ``propose(keys, track_id, part, start, end)``: the in-between boxes of one track and part, rows
+#: ``frame, x, y, w, h`` (optionally ``score, failure, state``) of the frames strictly between
+#: ``start`` and ``end``; ``keys`` holds every box of the track in effect at ``start`` and at
+#: ``end`` (the part's keyframes among them), what a tracker starts from
+Proposer = Callable[[pd.DataFrame, int, str, int, int], pd.DataFrame]
+
+
+def linear_proposer(keys: pd.DataFrame, track_id: int, part: str, start: int, end: int) -> pd.DataFrame:
+    """The straight line between the two keyframes (the fallback without a tracker, and CVAT's
+    track mode)."""
+    k = keys[(keys.track_id == track_id) & (keys.part == part)].set_index("frame")
+    boxes = linear_in_between((start, _row_box(k.loc[start])), (end, _row_box(k.loc[end])))
+    return pd.DataFrame(boxes, columns=["x", "y", "w", "h"]).assign(frame=np.arange(start + 1, end))
 
 
 def keyframes_around(store: Store, clip_id: int, track_id: int, part: str, frame: int
@@ -145,26 +159,61 @@ def keyframes_around(store: Store, clip_id: int, track_id: int, part: str, frame
     return (int(before.max()) if len(before) else None, int(after.min()) if len(after) else None)
 
 
-def fill_between(store: Store, clip_id: int, track_id: int, part: str, frame: int) -> int | None:
-    """Refill the in-between boxes of ``track_id``/``part`` on both sides of the keyframe at
-    ``frame`` (up to the neighbouring keyframes); returns the tracker run written, or None
-    when there is no neighbouring keyframe. Other tracks and parts are not touched."""
+def refill_spans(store: Store, clip_id: int, track_id: int, part: str, frame: int) -> list[tuple[int, int]]:
+    """The stretches ``(start, end)`` between keyframes that a keyframe of ``track_id``/``part`` at
+    ``frame`` bounds (none when it is no keyframe or has no neighbouring keyframe)."""
     kf = store.keyframes(clip_id)
-    kf = kf[(kf.track_id == track_id) & (kf.part == part) & ~kf.deleted.astype(bool)].set_index("frame")
-    if frame not in kf.index:
-        return None
+    kf = kf[(kf.track_id == track_id) & (kf.part == part) & ~kf.deleted.astype(bool)]
+    if frame not in set(kf.frame.astype(int)):
+        return []
     before, after = keyframes_around(store, clip_id, track_id, part, frame)
-    spans = [(a, b) for a, b in ((before, frame), (frame, after)) if a is not None and b is not None and b - a > 1]
+    return [(a, b) for a, b in ((before, frame), (frame, after)) if a is not None and b is not None and b - a > 1]
+
+
+def stretch_keys(store: Store, clip_id: int, track_id: int, start: int, end: int) -> pd.DataFrame:
+    """Every box of ``track_id`` in effect at ``start`` and at ``end`` (a proposer's ``keys``)."""
+    rows = [b[b.track_id == track_id] for b in (store.frame_boxes(clip_id, start), store.frame_boxes(clip_id, end))]
+    return pd.concat(rows, ignore_index=True)
+
+
+def propose_fill(store: Store, clip_id: int, track_id: int, part: str, frame: int,
+                 propose: Proposer = linear_proposer, progress: Callable[[int, int], None] | None = None
+                 ) -> tuple[list[tuple[int, int]], pd.DataFrame | None]:
+    """The stretches a keyframe of ``track_id``/``part`` at ``frame`` bounds (:func:`refill_spans`)
+    and ``propose``'s rows for them (None: no stretch); reads the store, writes nothing.
+    ``progress(done, total)`` after each stretch."""
+    spans = refill_spans(store, clip_id, track_id, part, frame)
     if not spans:
-        return None
+        return spans, None
+    cols = ["frame", "x", "y", "w", "h", "score", "failure", "state"]
     rows = []
-    for a, b in spans:
-        boxes = in_between((a, _row_box(kf.loc[a])), (b, _row_box(kf.loc[b])))
-        for f, (x, y, w, h) in zip(range(a + 1, b), boxes):
-            rows.append(dict(frame=f, track_id=int(track_id), part=part, x=x, y=y, w=w, h=h, source="keyframes"))
+    for k, (a, b) in enumerate(spans):
+        got = propose(stretch_keys(store, clip_id, track_id, a, b), int(track_id), part, a, b)
+        got = got[(got.frame > a) & (got.frame < b)]
+        rows.append(got[[c for c in cols if c in got]])
+        if progress is not None:
+            progress(k + 1, len(spans))
+    return spans, pd.concat(rows, ignore_index=True).assign(track_id=int(track_id), part=part, source="keyframes")
+
+
+def write_fill(store: Store, clip_id: int, track_id: int, part: str, spans: list[tuple[int, int]],
+               table: pd.DataFrame | None) -> int | None:
+    """Store :func:`propose_fill`'s rows as a tracker run of that track and part only, replacing
+    its in-between boxes over ``spans`` (None: nothing to write)."""
+    if not spans or table is None:
+        return None
     start, stop = spans[0][0] + 1, spans[-1][1]
-    return store.save_tracker_run(clip_id, pd.DataFrame(rows), tracker="keyframes", start_frame=start,
+    return store.save_tracker_run(clip_id, table, tracker="keyframes", start_frame=start,
                                   stop_frame=stop, track_ids=[int(track_id)], parts=[part])
+
+
+def fill_between(store: Store, clip_id: int, track_id: int, part: str, frame: int,
+                 propose: Proposer = linear_proposer) -> int | None:
+    """Refill the in-between boxes of ``track_id``/``part`` on both sides of the keyframe at
+    ``frame`` (up to the neighbouring keyframes) with ``propose``'s boxes; returns the tracker run
+    written, or None when there is no neighbouring keyframe. Other tracks and parts are not touched."""
+    spans, table = propose_fill(store, clip_id, track_id, part, frame, propose)
+    return write_fill(store, clip_id, track_id, part, spans, table)
 
 
 def apply(store: Store, clip_id: int, changes: list[dict], author: str = "") -> list[tuple[int, int, str, int]]:

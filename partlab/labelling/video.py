@@ -359,8 +359,12 @@ def store_by_hash(path: str | PathLike, clips_dir: str | PathLike) -> tuple[Path
     dest = dest_dir / f"{digest}{src.suffix.lower()}"
     if not dest.exists():
         tmp = dest.with_suffix(dest.suffix + ".part")
-        shutil.copyfile(src, tmp)
-        tmp.replace(dest)
+        try:
+            shutil.copyfile(src, tmp)
+            tmp.replace(dest)
+        except OSError:  # a full disk: no half copy is left to look like a clip
+            tmp.unlink(missing_ok=True)
+            raise
     return dest, digest
 
 

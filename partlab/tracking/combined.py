@@ -6,13 +6,15 @@ limb people get ids from :data:`LIMB_ID_OFFSET` on, so the two never share an id
 is written once per frame (the body tracker's where both have it). The limbs' join events name
 the tracks as written.
 
-Found automatically, heads and hands are written only on people (issue 13): when the body tracker
-finds people in the clip, a limb row is kept when its box's centre lies inside a body person box
-of the same frame, a head's in the top :data:`HEAD_TOP` of it (skin-coloured walls, grass and
-parked cars move in a real background model's foreground now and then, but the body tracker starts
-no person there). A clip where the body tracker finds nobody (a person seated at a desk, whom its
-walker detection does not start) keeps the limbs' own rows; events of limb tracks no longer
-written are dropped with them.
+Found automatically, heads and hands are written only on people (issue 13). In a frame where the
+body tracker has people, the limb tracker starts, labels, writes and keeps its trackers only on
+their boxes (:mod:`partlab.tracking.limbs.people`; other frames are not gated). And when the body
+tracker finds people in the clip, a limb row is kept when its box's centre lies inside a body
+person box of the same frame, a head's in the top :data:`HEAD_TOP` of it (skin-coloured walls,
+grass and parked cars move in a real background model's foreground now and then, but the body
+tracker starts no person there). A clip where the body tracker finds nobody (a person seated at a
+desk, whom its walker detection does not start) keeps the limbs' own rows; events of limb tracks
+no longer written are dropped with them.
 """
 
 from __future__ import annotations
@@ -62,6 +64,9 @@ class Combined:
 
     def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
         body = self.body.step(frames, foreground)
+        people = [(r.box.x, r.box.y, r.box.w, r.box.h) for r in body if r.part == "person" and not r.failure]
+        if not self.from_init:  # found automatically: limbs start and live on these people
+            self.limbs.tracker.set_people(people or None)
         limbs = self.limbs.step(frames, foreground)
         self._body_rows.extend(body)
         self._limb_rows.extend(limbs)

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.errors import UserError
+from partlab.tracking import registry
 from partlab.tracking.frame import MemoryTake
 from partlab.tracking.run import RunResult, track
 from partlab.tracking.tracks import TracksCSVError, empty_tracks, normalise_tracks
@@ -139,7 +140,7 @@ def _keyframes_table(keyframes: pd.DataFrame) -> pd.DataFrame:
 
 def track_between(take, keyframes: pd.DataFrame, track_id: int, start: int | None = None, end: int | None = None, *,
                   tracker: str = "body", model: Any = None, seed: int = 0, agree_iou: float = AGREE_IOU,
-                  frames: list[np.ndarray] | None = None) -> pd.DataFrame:
+                  frames: list[np.ndarray] | None = None, parts: list[str] | None = None) -> pd.DataFrame:
     """Proposals for track ``track_id`` from its keyframe at ``start`` to its keyframe at ``end``.
 
     ``keyframes``: a tracks table (any tracks, any parts) of boxes a person drew; ``start``/``end``:
@@ -147,7 +148,8 @@ def track_between(take, keyframes: pd.DataFrame, track_id: int, start: int | Non
     (``frame, track_id, part, x, y, w, h, score, failure, state, source``) for every frame from
     ``start`` to ``end`` and every part both keyframes have: the keyframes exactly at their frames,
     the confidence blend of a forward and a backward run in between (see the module docstring).
-    ``frames``: the decoded frames ``start..end`` if the caller already has them.
+    ``frames``: the decoded frames ``start..end`` if the caller already has them; ``parts``: blend
+    only these parts (the tracker still starts from every part of the keyframes).
     """
     keys = _keyframes_table(keyframes)
     mine = keys[keys["track_id"] == track_id]
@@ -162,7 +164,7 @@ def track_between(take, keyframes: pd.DataFrame, track_id: int, start: int | Non
     end = int(end)
     a_rows = mine[mine["frame"] == start].set_index("part")
     b_rows = mine[mine["frame"] == end].set_index("part")
-    parts = [p for p in a_rows.index if p in b_rows.index]
+    parts = [p for p in a_rows.index if p in b_rows.index and (parts is None or p in parts)]
     if not parts:
         raise UserError(f"track {track_id}: the keyframes at {start} and {end} have no part in common")
     if frames is None:
@@ -180,6 +182,80 @@ def track_between(take, keyframes: pd.DataFrame, track_id: int, start: int | Non
         rows = blend_runs(f, b, a_rows.loc[part], b_rows.loc[part], start, end, agree_iou)
         out.append(rows.assign(track_id=track_id, part=part, source="tracker"))
     return normalise_tracks(pd.concat(out, ignore_index=True))
+
+
+#: a stretch is tracked inside the keyframes' boxes of its track grown on every side by this many
+#: times their largest side: the tracker's search (Zhao & Lee's lost-head window is one torso width
+#: either side) and a path that bends away from the straight line between the keyframes stay
+#: inside. On PETS09-S2L1 (people 75 px tall) 1.0 crops 768x576 to about 260x215.
+ROI_PAD = 1.0
+
+
+def stretch_region(boxes: pd.DataFrame, width: int, height: int, pad: float = ROI_PAD) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)``: the part of a ``width`` x ``height`` frame a stretch is tracked in, the
+    bounding rectangle of ``boxes`` (the keyframes' rows) grown by ``pad`` times their largest side."""
+    x, y = boxes["x"].to_numpy(float), boxes["y"].to_numpy(float)
+    w, h = boxes["w"].to_numpy(float), boxes["h"].to_numpy(float)
+    margin = pad * float(max(w.max(), h.max(), 1.0))
+    x0, y0 = int(max(np.floor(x.min() - margin), 0)), int(max(np.floor(y.min() - margin), 0))
+    x1 = int(min(np.ceil((x + w).max() + margin), width))
+    y1 = int(min(np.ceil((y + h).max() + margin), height))
+    return x0, y0, max(x1, x0 + 1), max(y1, y0 + 1)
+
+
+def track_stretch(frames: list[np.ndarray], keyframes: pd.DataFrame, track_id: int, start: int, end: int, *,
+                  parts: list[str] | None = None, pad: float = ROI_PAD, tracker: str = "body", model: Any = None,
+                  seed: int = 0, fps: float = 25.0, agree_iou: float = AGREE_IOU) -> pd.DataFrame:
+    """:func:`track_between` of one track inside its region only (:func:`stretch_region` of its
+    keyframes at ``start`` and ``end``): what the Correct page runs when a keyframe moves, so that
+    one stretch costs a crop's tracking, not the whole frame's. ``frames``: the decoded frames
+    ``start..end``. Rows are in the whole frame's coordinates."""
+    keys = _keyframes_table(keyframes)
+    mine = keys[(keys["track_id"] == track_id) & keys["frame"].isin([start, end])]
+    if not len(mine):
+        raise UserError(f"track {track_id} has no keyframe at {start} or {end}")
+    height, width = frames[0].shape[:2]
+    x0, y0, x1, y1 = stretch_region(mine, width, height, pad)
+    crops = [np.ascontiguousarray(f[y0:y1, x0:x1]) for f in frames]
+    shifted = mine.assign(x=mine["x"] - x0, y=mine["y"] - y0)
+    rows = track_between(MemoryTake(crops, fps), shifted, track_id, start, end, tracker=tracker, model=model,
+                         seed=seed, agree_iou=agree_iou, frames=crops, parts=parts)
+    return rows.assign(x=rows["x"] + x0, y=rows["y"] + y0)
+
+
+def stretch_proposer(read: Callable[[int], np.ndarray], *, tracker: str = "body", model: Any = None, seed: int = 0,
+                     fps: float = 25.0, pad: float = ROI_PAD) -> Callable[..., pd.DataFrame]:
+    """A proposer for :func:`partlab.labelling.trackops.fill_between`: ``propose(keys, track_id,
+    part, start, end)`` reads frames ``start..end`` with ``read(index)`` and returns
+    :func:`track_stretch`'s rows of ``part`` strictly between the keyframes. A part ``tracker``
+    does not report (hands for the body tracker) gets the straight line, marked "interpolated"."""
+    reported = set(registry.get(tracker).parts)
+
+    def propose(keys: pd.DataFrame, track_id: int, part: str, start: int, end: int) -> pd.DataFrame:
+        if part in reported and end - start >= 2:
+            frames = [read(i) for i in range(start, end + 1)]
+            rows = track_stretch(frames, keys, track_id, start, end, parts=[part], pad=pad, tracker=tracker,
+                                 model=model, seed=seed, fps=fps)
+        else:
+            k = _keyframes_table(keys)
+            k = k[(k["track_id"] == track_id) & (k["part"] == part)].set_index("frame")
+            rows = blend_runs(empty_tracks(), empty_tracks(), k.loc[start], k.loc[end], start, end)
+        return rows[(rows["frame"] > start) & (rows["frame"] < end)].reset_index(drop=True)
+
+    return propose
+
+
+def warm_up(tracker: str = "body") -> None:
+    """Run ``tracker`` once between two keyframes of a tiny drawn scene, so that its imports and
+    compiled kernels (numba's on-disk cache is read at a kernel's first call, which also sets up
+    numba's compiler: seconds on a busy machine) are loaded before a user waits for them."""
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 255, (64, 64, 3), dtype=np.uint8) for _ in range(3)]
+    for f in frames:
+        f[20:52, 24:40] = (40, 60, 200)
+    keys = pd.DataFrame({"frame": [0, 2], "track_id": 1, "part": "person", "x": 24.0, "y": 20.0, "w": 16.0,
+                         "h": 32.0})
+    track_between(MemoryTake(frames), keys, 1, 0, 2, tracker=tracker, frames=frames)
 
 
 class _FrameCache:

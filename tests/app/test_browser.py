@@ -8,6 +8,7 @@ Correct page (``docs/correct.png`` with ``PARTLAB_SCREENSHOT=1``, else in tmp).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import socket
@@ -36,11 +37,12 @@ def _free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.fixture
-def server(tmp_path):
+@contextlib.contextmanager
+def _serving(tmp_path, **extra_env):
     port = _free_port()
     # no demo project: tests/app/test_demo.py covers it, and rendering it would slow every first page
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), PARTLAB_DEMO="0")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), PARTLAB_DEMO="0",
+               **extra_env)
     log = open(tmp_path / "server.log", "w")
     proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=log,
                             stderr=subprocess.STDOUT)
@@ -64,6 +66,12 @@ def server(tmp_path):
         except subprocess.TimeoutExpired:
             proc.kill()
         log.close()
+
+
+@pytest.fixture
+def server(tmp_path):
+    with _serving(tmp_path) as running:
+        yield running
 
 
 def _wait_for(predicate, timeout=30.0, what="condition"):
@@ -479,3 +487,119 @@ def _run_correct_page(page, url, store, clip, tmp_path, statistics, formats):
 
     if os.environ.get("PARTLAB_SCREENSHOT") == "1":
         page.screenshot(path=str(ROOT / "docs" / "correct.png"))
+
+
+def test_sign_in_and_a_second_browser_without_credentials_sees_no_project(store, tmp_path, monkeypatch):
+    """Sign-in on (what ``partlab app --host 0.0.0.0`` serves): a browser sees a sign-in form and no
+    project until it signs in; a wrong password gets a sentence; after signing in, only the user's
+    project; a second browser (its own cookies and storage) sees the form again. An upload over the
+    limit, refused by the browser itself, says why in words."""
+    from partlab.labelling import access
+
+    mine, theirs = store.create_project("street-mine"), store.create_project("lab-theirs")
+    access.add_user(store, "ana", "ana-password")
+    access.add_user(store, "olga", "olga-password")
+    access.grant(store, "ana", mine.id, "owner")
+    access.grant(store, "olga", theirs.id, "owner")
+    big = tmp_path / "big.mp4"
+    big.write_bytes(b"\0" * (2 * 2**20 + 10))
+    monkeypatch.setenv("PARTLAB_MAX_UPLOAD_MB", "1")  # Streamlit's own limit too (streamlit_command reads it)
+    with _serving(tmp_path, PARTLAB_AUTH="password") as (url, _), \
+            playwright.sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        first, second = (browser.new_context(viewport={"width": 1280, "height": 1000}) for _ in range(2))
+        page = first.new_page()
+        page.set_default_timeout(60_000)
+        try:
+            page.goto(url + "/correct")  # a deep link asks to sign in as well
+            page.get_by_label("User name").wait_for()
+            _settled(page)
+            for name in ("street-mine", "lab-theirs"):
+                assert page.get_by_text(name).count() == 0
+            page.get_by_label("User name").fill("ana")
+            page.get_by_label("Password", exact=True).fill("olga-password")
+            page.get_by_role("button", name="Sign in").click()
+            page.get_by_text("Wrong user name or password.").wait_for()
+            page.get_by_label("Password", exact=True).fill("ana-password")
+            page.get_by_role("button", name="Sign in").click()
+            page.get_by_text("Signed in as ana").wait_for()
+            page.get_by_text("This project has no clips yet").wait_for()  # still the Correct page it asked for
+            page.get_by_role("link", name="Projects and clips").click()
+            page.get_by_text("Project: street-mine").wait_for()
+            assert page.get_by_text("lab-theirs").count() == 0
+            # an upload over the 1 MB limit: the browser refuses it, and the page says so in words
+            uploader = page.locator('[data-testid="stFileUploaderDropzoneInput"]')
+            _settled(page)
+            uploader.set_input_files(str(big))
+            said = page.get_by_text("File must be 1.0MB or smaller.")
+            said.wait_for(state="attached")
+            # Streamlit alone renders it 1 px wide for screen readers only; shown, it is a line of text
+            _wait_for(lambda: (said.bounding_box() or {}).get("width", 0) > 100, what="the refusal shown as text")
+            assert store.clips(mine.id) == []
+            # another browser, no credentials: the form, no project
+            other = second.new_page()
+            other.set_default_timeout(60_000)
+            other.goto(url + "/projects")
+            other.get_by_label("User name").wait_for()
+            _settled(other)
+            for name in ("street-mine", "lab-theirs", "Signed in as"):
+                assert other.get_by_text(name).count() == 0
+        finally:
+            try:
+                page.screenshot(path=str(tmp_path / "last.png"), full_page=True)
+            except playwright.Error:
+                pass
+            browser.close()
+
+
+def test_an_event_is_added_stretched_and_undone_on_the_timeline_and_exported(server, page, store, tmp_path):
+    """On the Correct page's timeline: E adds a clap from the shown frame, dragging its right end
+    stretches it, Ctrl+Z takes the stretch back; the CVAT export holds the event as tags."""
+    import pandas as pd
+
+    from partlab.labelling import formats
+    from partlab.labelling.video import write_video
+    from tests.app.conftest import walker_boxes, walker_frames
+
+    url, _ = server
+    clip_file = write_video(tmp_path / "walk40.mp4", walker_frames(40), fps=10.0)
+    project = store.create_project("events")
+    clip = store.add_clip(project.id, clip_file)
+    store.save_tracker_run(clip.id, walker_boxes(40), tracker="import")
+    page.goto(url + "/correct")
+    page.wait_for_function("() => window.partlabEditor && window.partlabEditor.stats.ready === 0", timeout=90_000)
+    _settled(page)
+    page.select_option(".pl-event-type", "clap")
+    _focus_editor(page)
+    page.keyboard.press("e")  # a clap over frames 0..9 (one second at 10 fps)
+
+    def stored():
+        ev = store.events(clip.id)
+        return [(int(r.start_frame), int(r.end_frame), r.type, int(r.revision)) for r in ev.itertuples()]
+
+    _wait_for(lambda: stored() == [(0, 9, "clap", 1)], what="the new event in the store")
+    # the editor shows the stored event (with its id) on the timeline's event row
+    page.wait_for_function("() => { const e = window.partlabEditor; return e.events.length === 1 && "
+                           "e.events[0].id !== null && e.tlGeom && e.tlGeom.lanes.count === 1; }")
+    _settled(page)
+    x0, x1, y = page.evaluate("""() => {
+        const e = window.partlabEditor, g = e.tlGeom, r = e.timeline.getBoundingClientRect();
+        return [r.left + g.X(10), r.left + g.X(19) + 0.5 * (g.X(1) - g.X(0)), r.top + g.evTop + g.laneH / 2]; }""")
+    page.mouse.move(x0 - 1, y)
+    page.mouse.down()
+    page.mouse.move((x0 + x1) / 2, y, steps=3)
+    page.mouse.move(x1, y, steps=3)
+    page.mouse.up()
+    _wait_for(lambda: stored() == [(0, 19, "clap", 2)], what="the stretched event in the store")
+    assert page.evaluate("() => window.partlabEditor.eventInfo.textContent") == "#1 clap 0-19"
+
+    _settled(page)
+    _focus_editor(page)
+    page.keyboard.press("Control+z")
+    _wait_for(lambda: stored() == [(0, 9, "clap", 3)], what="the stretch undone")
+    page.wait_for_function("() => window.partlabEditor.events.length === 1 && window.partlabEditor.events[0].end === 9")
+
+    out = formats.export_clip(store, clip.id, "cvat", tmp_path / "cvat", frames=False)
+    csv = pd.read_csv(out / "events.csv")
+    assert csv[["start_frame", "end_frame", "kind"]].values.tolist() == [[0, 9, "clap"]]
+    assert (out / "events.xml").read_text().count('<tag label="clap"') == 10

@@ -6,7 +6,7 @@ from partlab.cli import COMMANDS, build_parser, main
 
 def test_every_contract_command_is_there():
     assert list(COMMANDS) == ["track", "batch", "train", "eval", "export", "import", "synth", "calibrate", "app",
-                             "serve-ml"]
+                             "users", "serve-ml"]
     parser = build_parser()
     args = parser.parse_args(["track", "v.mp4", "-o", "t.csv", "--tracker", "limbs", "--seed", "3"])
     assert (args.video, args.output, args.tracker, args.seed) == ("v.mp4", "t.csv", "limbs", 3)

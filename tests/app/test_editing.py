@@ -127,3 +127,107 @@ def test_an_undone_edit_is_no_correction(store, tracked_clip):
     assert store.human_frames(clip.id) == [] and store.progress(clip.id)["corrected_frames"] == 0
     apply_events(store, clip.id, [dict(kind="redo")], hist)
     assert _box(store, clip.id, 4, "head").source == "human" and store.human_frames(clip.id) == [4]
+
+
+def _events(store, clip_id):
+    return [(int(r.event_id), int(r.start_frame), int(r.end_frame), r.type) for r in store.events(clip_id).itertuples()]
+
+
+def test_events_are_added_stretched_retyped_deleted_and_undone_as_steps(store, tracked_clip):
+    _, clip = tracked_clip
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [dict(seq=1, kind="event_add", frame=2, type="clap", start_frame=2,
+                                             end_frame=4, tracks=[1], parts=["left_hand", "right_hand"])], hist)
+    assert res.errors == [] and _events(store, clip.id) == [(1, 2, 4, "clap")]
+    apply_events(store, clip.id, [dict(seq=2, kind="event_edit", event_id=1, revision=1, end_frame=9)], hist)
+    apply_events(store, clip.id, [dict(seq=3, kind="event_edit", event_id=1, revision=2, type="handshake")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "handshake")]
+    apply_events(store, clip.id, [dict(seq=4, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")]
+    apply_events(store, clip.id, [dict(seq=5, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 4, "clap")]  # the stretch undone, a new revision
+    apply_events(store, clip.id, [dict(seq=6, kind="redo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")]
+    apply_events(store, clip.id, [dict(seq=7, kind="event_delete", event_id=1, revision=6)], hist)
+    assert _events(store, clip.id) == []
+    res = apply_events(store, clip.id, [dict(seq=8, kind="undo")], hist)
+    assert _events(store, clip.id) == [(1, 2, 9, "clap")] and res.notes == ["undid the deletion of the clap event 2-9"]
+    assert store.events(clip.id).iloc[0].parts == ["left_hand", "right_hand"]  # the fields came back whole
+    apply_events(store, clip.id, [dict(seq=9, kind="undo"), dict(seq=10, kind="undo")], hist)
+    assert _events(store, clip.id) == []  # the add undone: the event is deleted
+    assert len(store.events(clip.id, history=True)) == 10  # every step is a revision, nothing is overwritten
+
+
+def test_a_stale_or_impossible_event_edit_is_refused(store, tracked_clip):
+    _, clip = tracked_clip
+    eid = store.add_event(clip.id, 1, 3, "pick")
+    store.edit_event(clip.id, eid, expected_revision=1, end_frame=5, author="someone else")
+    hist = EditHistory()
+    res = apply_events(store, clip.id, [dict(seq=1, kind="event_edit", event_id=eid, revision=1, end_frame=8)], hist)
+    assert "was changed by someone else (revision 2, you had 1)" in res.errors[0]
+    res = apply_events(store, clip.id, [dict(seq=2, kind="event_edit", event_id=eid, revision=2, end_frame=99)], hist)
+    assert "not an interval inside clip" in res.errors[0] and not hist.undo
+    assert _events(store, clip.id) == [(eid, 1, 5, "pick")]
+
+
+def _head_clip(store, tmp_path, n=60):
+    import numpy as np
+    import pandas as pd
+
+    from partlab.labelling.video import write_video
+
+    project = store.create_project("modes")
+    clip = store.add_clip(project.id, write_video(tmp_path / "c.mp4", [np.zeros((80, 200, 3), np.uint8)] * n, fps=10))
+    rows = [dict(frame=f, track_id=t, part=p, x=5.0 + f + 60 * t, y=10.0, w=8.0, h=8.0)
+            for f in range(n) for t in (1, 2) for p in ("head", "torso")]
+    store.save_tracker_run(clip.id, pd.DataFrame(rows))
+    return clip
+
+
+def _move(frame, y, revision):
+    return dict(kind="edit", frame=frame, track_id=1, part="head", box=[100.0 + frame, y, 10, 10], failure=False,
+                occluded=0, revision=revision)
+
+
+def test_track_mode_refines_the_straight_line_with_the_tracker_inside_the_same_step(store, tmp_path):
+    import pandas as pd
+    import pytest
+
+    from partlab.app.editing import refine_step
+
+    clip = _head_clip(store, tmp_path)
+    hist = EditHistory()
+    for f in (0, 25, 50):  # keyframes every 25 frames on track 1's head
+        apply_events(store, clip.id, [_move(f, 40.0, 0)], hist, fill=True)
+    others = store.tracks(clip.id).query("not (track_id == 1 and part == 'head')").drop(columns="revision")
+    res = apply_events(store, clip.id, [_move(25, 60.0, 1)], hist, fill=True)  # the middle keyframe 20 px down
+    assert [s.refill for s in res.refills] == [[(1, "head", 25)]]
+    assert _box(store, clip.id, 10, "head").y == pytest.approx(40 + 20 * 10 / 25)  # the line, at once
+    seen = []
+
+    def tracker(keys, track_id, part, start, end):  # stands for keyframe-guided tracking
+        seen.append((start, end, sorted(set(zip(keys.frame, keys.track_id, keys.part)))))
+        frames = range(start + 1, end)
+        return pd.DataFrame(dict(frame=list(frames), x=500.0, y=[float(f) for f in frames], w=9.0, h=9.0,
+                                 state="tracked"))
+
+    out = refine_step(store, clip.id, hist, res.refills[0], tracker)
+    assert seen == [(0, 25, [(0, 1, "head"), (0, 1, "torso"), (25, 1, "head"), (25, 1, "torso")]),
+                    (25, 50, [(25, 1, "head"), (25, 1, "torso"), (50, 1, "head"), (50, 1, "torso")])]
+    assert out["boxes"] == 48 and hist.undo[-1].refined == [out["run_id"]]
+    head = store.tracks(clip.id).query("track_id == 1 and part == 'head'").set_index("frame")
+    assert (head.loc[10].x, head.loc[40].y, head.loc[25].y, head.loc[55].x) == (500.0, 40.0, 60.0, 5 + 55 + 60)
+    pd.testing.assert_frame_equal(  # every other track and part as it was
+        store.tracks(clip.id).query("not (track_id == 1 and part == 'head')").drop(columns="revision")
+        .reset_index(drop=True), others.reset_index(drop=True))
+    apply_events(store, clip.id, [dict(kind="undo")], hist)  # one step: the move, its line and the tracker's boxes
+    head = store.tracks(clip.id).query("track_id == 1 and part == 'head'").set_index("frame")
+    assert (head.loc[25].y, head.loc[10].y, head.loc[10].x) == (40.0, 40.0, pytest.approx(110.0))
+    # a refinement that ends after its step was undone, or after a newer refill of the track, writes nothing
+    redo = apply_events(store, clip.id, [dict(kind="redo")], hist).refills[0]
+    apply_events(store, clip.id, [dict(kind="undo")], hist)
+    assert refine_step(store, clip.id, hist, redo, tracker) is None
+    old = apply_events(store, clip.id, [dict(kind="redo")], hist).refills[0]
+    apply_events(store, clip.id, [_move(25, 70.0, int(_box(store, clip.id, 25, "head").revision))], hist, fill=True)
+    assert refine_step(store, clip.id, hist, old, tracker) is None
+    assert _box(store, clip.id, 10, "head").y == pytest.approx(40 + 30 * 10 / 25)

@@ -83,3 +83,16 @@ def test_clear_errors(files, tmp_path, capsys, argv, message):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"partlab {argv[0]}: ") and message in err
+
+
+def test_export_with_events_writes_tags_and_refuses_events_of_another_clip(files, tmp_path, capsys):
+    ev = tmp_path / "events.csv"
+    ev.write_text("start_frame,end_frame,kind,track_id_a,part_a,track_id_b,part_b\n3,6,handshake,0,right_hand,3,"
+                  "right_hand\n")
+    args = ["export", str(files / "truth.csv"), "--video", str(files / "clip.avi"), "--format", "cvat", "--no-frames"]
+    assert main(args + ["-o", str(tmp_path / "cvat"), "--events", str(ev)]) == 0
+    xml = (tmp_path / "cvat" / "events.xml").read_text()
+    assert xml.count('<tag label="handshake"') == 4  # frames 3, 4, 5, 6
+    ev.write_text("start_frame,end_frame,kind\n15,25,clap\n")  # the clip has 20 frames
+    assert main(args + ["-o", str(tmp_path / "late"), "--events", str(ev)]) == 2
+    assert "the clap event 15-25 ends after the clip's last frame (19)" in capsys.readouterr().err

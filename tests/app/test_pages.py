@@ -3,6 +3,7 @@ a tracking run stored, corrections shown, a training run producing a bundle, exp
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pandas as pd
@@ -22,7 +23,8 @@ def page(name: str, **session) -> AppTest:
 
 
 def texts(at: AppTest, kind: str) -> list[str]:
-    return [e.value for e in getattr(at, kind)]
+    """The texts of one kind of element as a reader sees them (names are escaped Markdown: ``\\:`` shows ``:``)."""
+    return [re.sub(r"\\(.)", r"\1", e.value) for e in getattr(at, kind)]
 
 
 def test_projects_page_creates_a_project_and_accepts_a_clip(store, clip_file):
@@ -97,7 +99,7 @@ def test_names_are_shown_as_text_not_markdown(store):
     at.text_input[0].input("**big** :red[x]")
     at.button[0].click().run()
     escaped = "\\*\\*big\\*\\* \\:red\\[x\\]"  # what Markdown shows as **big** :red[x]
-    assert texts(at, "success") == [f"Created project '{escaped}'."]
+    assert [e.value for e in at.success] == [f"Created project '{escaped}'."]
     assert [h.value for h in at.subheader] == [f"Project: {escaped}"]
 
 

@@ -62,3 +62,23 @@ def test_written_scene_is_a_take_with_rendered_and_stereo_depth(tmp_path):
     assert d.dtype == np.float32 and np.isfinite(d).all()
     near = d < np.nanpercentile(d, 30)  # the person
     assert np.nanmedian(np.abs(s - d)[near]) < 40
+
+
+def test_a_hand_outside_the_frame_has_no_row_and_one_at_its_edge_is_half_occluded():
+    from partlab.labelling.synth import depth_scene as ds
+
+    rng = np.random.default_rng(0)
+    lay = ds._layout(rng, "desk_depth", 1700.0, 160, 120)
+    cam = lay.cams["cam0"]
+    hands = np.tile(lay.torso_c, (1, 2, 1)).astype(float)
+    elbows = hands.copy()
+    z = lay.torso_c[2] - 200.0
+    # the left hand's centre on the image's right edge, the right hand far outside the frame
+    hands[0, 0] = cam.back_project(np.array([[159.5, 60.0]]), np.array([z]))[0]
+    hands[0, 1] = cam.back_project(np.array([[-200.0, 60.0]]), np.array([z]))[0]
+    buf = ds._Buffer(cam)
+    buf.ellipsoid(hands[0, 0], np.array([lay.body.hand_r] * 3), ds.HAND_L, (0, 0, 255))
+    rows = {r[2]: r for r in ds._truth_rows(0, buf.label, lay, hands, elbows)}
+    assert "right_hand" not in rows and "left_hand" in rows
+    x, y, w, h, occ = rows["left_hand"][3:8]
+    assert x + w <= 160 and 0.4 < occ < 0.6  # half the hand's disc is past the edge

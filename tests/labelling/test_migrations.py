@@ -72,9 +72,9 @@ def test_revision_1_is_exactly_the_previous_release_schema(backend):
 def test_a_new_database_is_created_at_head_matching_the_models(backend, tmp_path):
     store = Store(clips_dir=tmp_path)
     with store.engine.connect() as conn:
-        assert migrations.current(conn) == migrations.head() == "0004"
+        assert migrations.current(conn) == migrations.head() == "0005"
     assert _schema_diff(store.url, Base.metadata) == []
-    assert migrations.known_revisions() == ["0001", "0002", "0003", "0004"]
+    assert migrations.known_revisions() == ["0001", "0002", "0003", "0004", "0005"]
 
 
 def test_previous_release_database_is_migrated_and_keeps_every_edit(backend, tmp_path):
@@ -82,7 +82,7 @@ def test_previous_release_database_is_migrated_and_keeps_every_edit(backend, tmp
     _legacy_database(url)
     store = Store(clips_dir=tmp_path)
     with store.engine.connect() as conn:
-        assert migrations.current(conn) == "0004"
+        assert migrations.current(conn) == "0005"
         assert conn.execute(text("SELECT count(*) FROM edits")).scalar() == 4
     assert [p.name for p in store.projects()] == ["lab"] and store.project(1).default_bundle_id == 1
     hist = store.history(1, 2, 1, "head")
@@ -113,7 +113,7 @@ def test_previous_release_database_is_migrated_and_keeps_every_edit(backend, tmp
     assert store.undo(1, 2, 1, "head", expected_revision=4) == 5
     assert store.frame_boxes(1, 2).query("part == 'head' and track_id == 1").iloc[0].x == 52.0
     # opening again is a no-op
-    assert migrations.upgrade(store.engine) == "0004"
+    assert migrations.upgrade(store.engine) == "0005"
 
 
 def test_a_newer_schema_is_refused_and_left_alone(backend, tmp_path):
@@ -122,7 +122,7 @@ def test_a_newer_schema_is_refused_and_left_alone(backend, tmp_path):
     migrations.upgrade(eng)
     with eng.begin() as c:
         c.execute(text("UPDATE alembic_version SET version_num = '0099'"))
-    with pytest.raises(StoreError, match=r"revision '0099', made by a newer partlab; .* up to '0004'"):
+    with pytest.raises(StoreError, match=r"revision '0099', made by a newer partlab; .* up to '0005'"):
         Store(clips_dir=tmp_path)
     with eng.connect() as c:
         assert c.execute(text("SELECT version_num FROM alembic_version")).scalar() == "0099"
@@ -150,7 +150,7 @@ def test_a_failing_migration_leaves_the_database_as_it_was(tmp_path, monkeypatch
         assert migrations.current(c) is None  # not even stamped
     assert _schema_diff(url, LEGACY) == []  # no takes table, no camera column
     monkeypatch.setattr(Operations, "create_table", real)
-    assert migrations.upgrade(eng) == "0004"
+    assert migrations.upgrade(eng) == "0005"
     eng.dispose()
 
 

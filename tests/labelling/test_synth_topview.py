@@ -59,3 +59,15 @@ def test_scenes_differ_by_seed_and_dark_clothes_are_dark():
 def test_unknown_topview_scenario_is_refused(tmp_path, capsys):
     assert main(["synth", str(tmp_path / "x"), "--scenario", "topview_s9"]) == 2
     assert "unknown scenario 'topview_s9'" in capsys.readouterr().err
+
+
+def test_group_scenes_vary_the_number_of_people_camera_height_and_noise():
+    scenes = [make_topview("topview_group", seed=s, n_frames=1, width=160, height=120) for s in range(6)]
+    counts = [len(s.people) for s in scenes]
+    assert set(counts) <= {1, 2, 3} and len(set(counts)) >= 2
+    heights = [s.camera.centre[2] for s in scenes]
+    assert all(2700 <= h <= 3200 for h in heights) and max(heights) - min(heights) > 100
+    for s in scenes:
+        # every person is seen (labelled pixels of their own) and nobody else is labelled
+        assert set(np.unique(s.person[0])) == set(range(len(s.people) + 1))
+        assert min((s.person[0] == k + 1).sum() for k in range(len(s.people))) > 100

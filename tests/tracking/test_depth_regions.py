@@ -102,3 +102,54 @@ def test_elbow_found_on_the_depth_of_the_arm_and_fallback_when_hidden():
     got, ok = elbow(cam, hidden, shoulder, hand, 300.0, 260.0, 20.0, 60.0, 36)
     assert not ok and np.allclose(got, hand + [0, 0, 260.0])  # (X_h, Y_h, Z_h + l_f)
     assert Posture().upper_arm > Posture().forearm
+
+
+def test_hand_reference_with_its_other_bin_observes_the_scale():
+    """A round hand on pixels outside the hand mask: with the fill-weighted reference the window
+    of the hand's own size scores best; a pure-skin reference (fill 1) prefers the smallest."""
+    from partlab.tracking.core.hue_histogram import box_histograms, hue_confidence, integral_histogram
+    from partlab.tracking.depth.tracker import hand_reference
+
+    nb = 16
+    bins = np.full((80, 80), nb, np.int16)  # "other": not in front of the face
+    yy, xx = np.mgrid[:80, :80]
+    bins[(xx - 40) ** 2 + (yy - 40) ** 2 <= 10**2] = 2  # the hand, 20 px across, skin hue bin 2
+    skin = np.full((10, 10), 2, np.int16)  # the face's inner part
+    integral = integral_histogram(bins, nb + 1)
+    alphas = np.array([0.7, 0.85, 1.0, 1.15, 1.4])
+    boxes = np.stack([40 - 10 * alphas, 40 - 10 * alphas, 20 * alphas, 20 * alphas], axis=1)
+    for fill, best in ((0.785, 1.0), (1.0, 0.7)):
+        ref = hand_reference(skin, (0, 0, 10, 10), nb, fill)
+        assert ref.shape == (nb + 1,) and ref.sum() == pytest.approx(1.0)
+        conf = hue_confidence(box_histograms(integral, boxes), ref, 6.0)
+        assert alphas[np.argmax(conf)] == best, (fill, conf)
+    ref = hand_reference(skin, (0, 0, 10, 10), nb, 0.785)
+    conf = hue_confidence(box_histograms(integral, boxes), ref, 6.0)
+    assert conf[2] > 0.95 and conf[0] < conf[2] - 0.1 and conf[-1] < conf[2] - 0.1
+
+
+def test_arm_lengths_are_fitted_to_the_depth_of_a_shorter_arm():
+    """Arms 6 % shorter than the head's proportions: the stretched arm rules the longer factors
+    out, the bent ones fit best at the true factor, and the elbow then lands on the true one."""
+    from partlab.tracking.depth.posture import ArmFit
+
+    cam = Camera("c", [[300, 0, 160], [0, 300, 120], [0, 0, 1]], (320, 240))
+    p = Posture()
+    upper, fore, true_scale = 300.0, 260.0, 0.94
+    shoulder = np.array([0.0, 0.0, 1500.0])
+    fit = ArmFit(p)
+    for reach, turn in ((0.97, 0.0), (0.8, 0.5), (0.9, -0.4)):
+        direction = np.array([np.sin(turn), np.cos(turn), -0.3])
+        direction /= np.linalg.norm(direction)
+        hand = shoulder + reach * true_scale * (upper + fore) * direction
+        true = elbow_circle(shoulder, hand, true_scale * upper, true_scale * fore, 36)[9]
+        depth = np.full((240, 320), 3000.0, np.float32)
+        for a, b in ((shoulder, true), (true, hand)):
+            for s in np.linspace(0, 1, 200):
+                q = a + s * (b - a)
+                (u, v), = cam.project(q[None])
+                depth[int(v) - 4:int(v) + 5, int(u) - 4:int(u) + 5] = q[2] - 20.0
+        fit.update(cam, depth, shoulder, hand, upper, fore, 20.0, 60.0, 36, lambda c: np.ones(len(c), bool), 8)
+    assert fit.scale == true_scale, fit.cost
+    got, ok = elbow(cam, depth, shoulder, hand, fit.scale * upper, fit.scale * fore, 20.0, 60.0, 36)
+    assert ok and np.linalg.norm(got - true) < 40.0

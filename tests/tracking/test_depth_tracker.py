@@ -49,6 +49,8 @@ def test_full_tracker_keeps_both_hands_and_recovers_posture(scene):
         err = np.linalg.norm(q[["X", "Y", "Z"]].to_numpy(float) - q[["X_t", "Y_t", "Z_t"]].to_numpy(float), axis=1)
         assert len(q) == N and np.mean(err) < limit, (part, np.mean(err))
     assert set(tracks["part"]) >= {"left_elbow", "right_elbow", "torso"}
+    hands = tracks[tracks["part"].isin(["left_hand", "right_hand"])]
+    assert (hands["x"] >= 0).all() and (hands["x"] + hands["w"] <= 320 + 1e-6).all()  # boxes in the frame
     assert (tracks["camera"] == "cam0").all()
 
 

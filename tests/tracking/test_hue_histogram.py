@@ -2,6 +2,7 @@ from __future__ import annotations
 
 import cv2
 import numpy as np
+import pytest
 
 from partlab.tracking.core.hue_histogram import (
     back_projection,
@@ -10,6 +11,8 @@ from partlab.tracking.core.hue_histogram import (
     hue_bin_image,
     hue_confidence,
     integral_histogram,
+    local_box_histograms,
+    local_mean_shift,
     mean_shift,
     reference_histogram,
 )
@@ -57,3 +60,40 @@ def test_mean_shift_climbs_to_the_skin_patch_on_the_back_projection():
     assert abs(x - 30) <= 2 and abs(y - 10) <= 2
     # a window over no probability stays where it is
     assert mean_shift(bp, (0.0, 0.0, 8.0, 8.0), 20, 0.5) == (0.0, 0.0, 8.0, 8.0)
+
+
+def test_local_mean_shift_equals_the_whole_frame_one_and_stops_at_its_margin():
+    rng = np.random.default_rng(5)
+    f = np.full((120, 160, 3), (90, 110, 70), np.uint8)
+    for _ in range(6):  # skin patches scattered over the frame
+        x, y = rng.integers(0, 140), rng.integers(0, 100)
+        cv2.circle(f, (int(x), int(y)), int(rng.integers(4, 9)), (110, 150, 210), -1)
+    bins = hue_bin_image(cv2.cvtColor(f, cv2.COLOR_BGR2HSV), 16, 30, 40)
+    ref = reference_histogram(hue_bin_image(_frame(), 16, 30, 40), (32, 12, 10, 10), 16)  # skin only
+    bp = back_projection(bins, ref)
+    assert 0 < (bp > 0).mean() < 0.3
+    for box in rng.uniform([0, 0, 8, 8], [150, 110, 20, 20], (40, 4)):
+        whole = mean_shift(bp, tuple(box), 10, 1.0)
+        local = local_mean_shift(bins, ref, tuple(box), 10, 1.0, margin=10.0)
+        np.testing.assert_allclose(local, whole)
+    # with a small margin a window far from any skin cannot climb out of its neighbourhood
+    g = np.full((60, 200, 3), (90, 110, 70), np.uint8)
+    cv2.rectangle(g, (150, 20), (169, 39), (110, 150, 210), -1)
+    gb = hue_bin_image(cv2.cvtColor(g, cv2.COLOR_BGR2HSV), 16, 30, 40)
+    assert local_mean_shift(gb, ref, (10.0, 20.0, 10.0, 10.0), 10, 1.0, margin=2.0) == (10.0, 20.0, 10.0, 10.0)
+    x, _, _, _ = local_mean_shift(gb, ref, (135.0, 20.0, 20.0, 20.0), 10, 1.0, margin=2.0)
+    assert abs(x - 150) <= 2
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_local_box_histograms_equal_the_whole_frame_integral_ones(compiled, monkeypatch):
+    from partlab.tracking.core import kernels
+
+    monkeypatch.setattr(kernels, "HAVE_NUMBA", compiled)
+    rng = np.random.default_rng(2)
+    bins = rng.integers(-1, 16, (50, 70)).astype(np.int16)
+    boxes = np.vstack([rng.uniform([-10, -10, 0, 0], [75, 55, 30, 30], (200, 4)),
+                       [[0, 0, 70, 50], [69.5, 10, 5, 5], [10.5, 11.5, 3.5, 2.5]]])
+    expect = box_histograms(integral_histogram(bins, 16), boxes)
+    np.testing.assert_allclose(local_box_histograms(bins, boxes, 16), expect, atol=1e-12)
+    assert local_box_histograms(bins, np.zeros((0, 4)), 16).shape == (0, 16)

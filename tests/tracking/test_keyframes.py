@@ -11,7 +11,14 @@ from partlab.errors import UserError
 from partlab.labelling.evaluation import count_edits, interpolate_keyframes
 from partlab.labelling.video import write_video
 from partlab.tracking.frame import MemoryTake
-from partlab.tracking.keyframes import blend_runs, track_between, track_with_keyframes
+from partlab.tracking.keyframes import (
+    blend_runs,
+    stretch_proposer,
+    stretch_region,
+    track_between,
+    track_stretch,
+    track_with_keyframes,
+)
 from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
 from tests.tracking.walkers import background, draw_walker
 
@@ -104,3 +111,40 @@ def test_keyframes_command_writes_every_frame_between_keyframes(walk, tmp_path, 
     assert main(["track", str(video), "-o", str(out), "--keyframes", str(tmp_path / "keys.csv"),
                  "--init", str(tmp_path / "keys.csv")]) == 2
     assert "--keyframes and --init" in capsys.readouterr().err
+
+
+def test_track_stretch_tracks_inside_the_tracks_region_and_answers_in_frame_coordinates(walk):
+    frames, truth = walk
+    # the walker's strip placed at (200, 150) of a larger frame; the rest is a second, untouched scene
+    big = [np.concatenate([np.zeros((150, 360, 3), np.uint8), f, np.full((100, 360, 3), 90, np.uint8)]) for f in frames]
+    big = [np.concatenate([np.full((450, 200, 3), 60, np.uint8), f, np.zeros((450, 120, 3), np.uint8)], axis=1)
+           for f in big]
+    moved = truth.assign(x=truth.x + 200, y=truth.y + 150)
+    keys = moved[moved.frame.isin([0, 30])]
+    x0, y0, x1, y1 = stretch_region(keys, 680, 450)
+    assert (x1 - x0) * (y1 - y0) < 0.5 * 680 * 450  # a crop, not the frame
+    assert x0 <= keys.x.min() and x1 >= (keys.x + keys.w).max() and y0 <= keys.y.min()
+    out = track_stretch(big, keys, 3, 0, 30, parts=["person"])
+    assert out["frame"].tolist() == list(range(31))
+    for f in (0, 30):
+        got = out[out.frame == f][["x", "y", "w", "h"]].to_numpy(float)
+        assert np.allclose(got, keys[keys.frame == f][["x", "y", "w", "h"]].to_numpy(float))
+    ours = count_edits(moved, out, keyframes=2)
+    line = count_edits(moved, interpolate_keyframes(keys), keyframes=2)
+    assert ours.edits < line.edits
+
+
+def test_stretch_proposer_reads_only_the_stretch_and_draws_a_line_for_parts_it_cannot_track(walk):
+    frames, truth = walk
+    read = []
+    propose = stretch_proposer(lambda i: read.append(i) or frames[i])
+    hand = truth.assign(part="left_hand", w=6.0, h=6.0)
+    keys = pd.concat([truth, hand])
+    keys = keys[keys.frame.isin([5, 25])]
+    line = propose(keys, 3, "left_hand", 5, 25)
+    assert read == [] and line["frame"].tolist() == list(range(6, 25)) and set(line["state"]) == {"interpolated"}
+    a, b = hand.set_index("frame").loc[5], hand.set_index("frame").loc[25]
+    assert line.set_index("frame").loc[15, "x"] == pytest.approx((a.x + b.x) / 2)
+    person = propose(keys, 3, "person", 5, 25)
+    assert read == list(range(5, 26)) and person["frame"].tolist() == list(range(6, 25))
+    assert set(person["part"]) == {"person"} and set(person["state"]) <= {"tracked", "review", "interpolated"}

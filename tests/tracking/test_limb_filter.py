@@ -3,7 +3,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from partlab.tracking.core.hue_histogram import hue_bin_image, reference_histogram
 from partlab.tracking.core.skin import SkinModel, find_blobs
 from partlab.tracking.limbs.filter import (
     Candidates,
@@ -81,8 +81,8 @@ def test_filter_follows_a_moving_skin_disc_and_refines_onto_it():
             filt = LimbFilter((cx, 30), (14, 14), ref, p, rng)
             continue
         filt.predict(rng)
-        filt.weigh(cands, integral_histogram(bins, p.appearance.hue_bins))
-        filt.refine(back_projection(bins, filt.ref_hist))
+        filt.weigh(cands, bins)
+        filt.refine(bins)
         filt.resample(rng)
         errors.append(np.hypot(filt.estimate[0] - cx, filt.estimate[1] - 30))
     assert max(errors) < 4.0

@@ -8,7 +8,7 @@ from partlab.labelling.synth.multiview import look_at, make_multiview_scene
 from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
 from partlab.tracking.limbs3d.geometry import midpoints, pair_candidates
-from partlab.tracking.limbs3d.params import Limbs3DParams
+from partlab.tracking.limbs3d.params import Limbs3DParams, Limbs3DPriors, Limbs3DStates
 from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
 from partlab.tracking.limbs3d.tracker import Limbs3DTracker, triangulate
 
@@ -73,19 +73,19 @@ def test_true_pairs_get_a_high_prior_and_false_pairs_a_low_one():
 
 
 def test_prune_and_merge_drops_weak_and_merges_close_candidates():
-    params = Limbs3DParams(merge_distance=45.0, merge_boost=0.5, prior_threshold=0.1)
+    params = Limbs3DParams(priors=Limbs3DPriors(merge_distance=45.0, merge_boost=0.5, prior_threshold=0.1))
     pts = np.array([[0.0, 0, 1000], [20.0, 0, 1000], [300.0, 0, 1000], [600.0, 0, 1000], [0, 0, -50]])
     pr = np.array([0.6, 0.3, 0.5, 0.05, 0.9])
     out, w = prune_and_merge(pts, pr, params)
     assert len(out) == 2  # the weak one and the one under the floor are gone, two merged
     np.testing.assert_allclose(w, [0.75, 0.5])  # 0.6 + 0.5 * 0.3
     np.testing.assert_allclose(out[0], [20 / 3, 0, 1000])  # prior-weighted mean (merge_average)
-    out, w = prune_and_merge(pts, pr, Limbs3DParams(merge_average=False))
+    out, w = prune_and_merge(pts, pr, Limbs3DParams(priors=Limbs3DPriors(merge_average=False)))
     np.testing.assert_allclose(out[0], [0, 0, 1000])  # the paper: the stronger point is kept
 
 
 def test_state_machine_combines_and_splits_3d_targets_by_direction():
-    m = LimbStateMachine(Limbs3DParams(combine_distance=80.0, split_distance=120.0))
+    m = LimbStateMachine(Limbs3DParams(states=Limbs3DStates(combine_distance=80.0, split_distance=120.0)))
     for t in (0, 1):
         m.add(t, LimbState.UNLABELLED)
         m._status[t].state = LimbState.NORMAL

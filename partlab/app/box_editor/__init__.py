@@ -13,7 +13,10 @@ Python was busy is re-sent until acknowledged.
 Events (dicts): ``{"kind": "edit", "frame", "track_id", "part", "box": [x, y, w, h],
 "failure", "occluded", "revision", "added"?}``, ``{"kind": "delete", "frame",
 "track_id", "part", "revision"}``, ``{"kind": "frame", "target"}``, ``{"kind": "undo"}``,
-``{"kind": "redo"}``, ``{"kind": "occluders", "boxes": [[x, y, w, h], ...]}``.
+``{"kind": "redo"}``, ``{"kind": "occluders", "boxes": [[x, y, w, h], ...]}``, and for the
+timeline's events ``{"kind": "event_add", "type", "start_frame", "end_frame"}``,
+``{"kind": "event_edit", "event_id", "revision", "start_frame"?, "end_frame"?, "type"?}``,
+``{"kind": "event_delete", "event_id", "revision"}``.
 """
 
 from __future__ import annotations
@@ -131,7 +134,8 @@ def box_editor(*, key: str, width: int, height: int, frame_count: int, fps: floa
     ``frame_url(i)``: frame ``i`` as a JPEG data URL; ``boxes_by_frame``: :func:`pack_boxes`
     of the clip's effective boxes (of ``version``); ``jump``: ``{seq, frame}``, a new ``seq``
     makes the editor show ``frame``; ``tracks``: ``[{id, colour, state}]``; ``timeline``:
-    ``{tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged}``.
+    ``{tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged, events: [{id, revision, start, end,
+    type, colour}], kinds}``.
     """
     if mode not in ("boxes", "occluders"):
         raise ValueError(f"mode must be 'boxes' or 'occluders', got {mode!r}")

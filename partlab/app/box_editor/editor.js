@@ -6,7 +6,8 @@
 // for a Streamlit rerun. Python's data: {width, height, frame_count, fps, parts, tracks,
 // next_track_id, mode, applied_seq, version, jump: {seq, frame}, chunk: {req, lo, frames,
 // blo, bhi, boxes: {frame: [[track, part index, x, y, w, h, flags, occluded, revision]]}},
-// timeline: {tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged}}; flags: 1
+// timeline: {tracks: [{id, colour, spans, keys, fails, acc, rej}], flagged, events: [{id, revision,
+// start, end, type, colour}], kinds}}; flags: 1
 // failure, 2 human (a keyframe). `version` changes whenever stored boxes change; cached
 // boxes of another version are asked for again. Every user action becomes an event {seq,
 // kind, ...} sent as the trigger value "events" until Python reports it applied
@@ -47,6 +48,11 @@ class Editor {
     this.timeline = q(".pl-timeline");
     this.partsBox = q(".pl-parts");
     this.tracksBox = q(".pl-tracks");
+    this.eventType = q(".pl-event-type");
+    this.eventInfo = q(".pl-event-info");
+    this.events = [];          // the clip's events on the timeline: {id, revision, start, end, type, colour}
+    this.selEvent = null;      // the id of the selected event
+    this.evDrag = null;        // {ev, edge, orig: [start, end]} while an end of an event is dragged
     this.data = null;
     this.frames = new Map();   // frame -> decoded image (ImageBitmap or HTMLImageElement)
     this.boxes = new Map();    // frame -> box list of `this.version`
@@ -95,11 +101,12 @@ class Editor {
     const speeds = [...new Set([fps, 15, 25, 30])].sort((a, b) => a - b).map((v) => [String(v), `${v} fps`]);
     this.fillSelect(this.speed, speeds, this.speed.value || String(fps));
     const occl = d.mode === "occluders";
-    for (const sel of [".pl-add", ".pl-legend", ".pl-timeline"]) this.root.querySelector(sel).style.display = occl ? "none" : "";
+    for (const sel of [".pl-add", ".pl-legend", ".pl-timeline", ".pl-eventbar"]) this.root.querySelector(sel).style.display = occl ? "none" : "";
     for (const act of ["track", "failure", "occluded", "undo", "redo", "flag", "keyframe", "fill", "labels"]) {
       this.root.querySelector(`[data-act="${act}"]`).style.display = occl ? "none" : "";
     }
     this.legend();
+    this.takeEvents();
     if (first) {
       this.setStatus(occl ? "draw occluder regions; drag to move, Delete removes" :
         "click a box to select it; drag to move, corners to resize; B or Shift+drag draws a new box; wheel zooms, right-drag pans");
@@ -436,11 +443,14 @@ class Editor {
     const tracks = (tl.tracks || []).filter((t) => !this.hiddenTracks.has(t.id));
     const c = this.timeline;
     const rowH = 7, top = 10, labelW = 34;
-    const h = top + Math.max(1, tracks.length) * rowH + 2;
+    const lanes = this.eventLanes();
+    const evTop = top + Math.max(1, tracks.length) * rowH + 3, laneH = 8;
+    const h = evTop + Math.max(1, lanes.count) * laneH + 2;
     const w = Math.max(100, c.clientWidth || 600);
     const n = Math.max(1, this.data.frame_count || 1);
     const X = (f) => labelW + (f / n) * (w - labelW);
-    const sig = `${w}:${h}:${this.version}:${[...this.hiddenTracks].join(",")}:${JSON.stringify(tl.flagged || []).length}`;
+    const sig = `${w}:${h}:${this.version}:${[...this.hiddenTracks].join(",")}:${JSON.stringify(tl.flagged || []).length}:` +
+      `${JSON.stringify(this.events)}:${this.selEvent}`;
     if (this.tlSig !== sig) {
       this.tlSig = sig;
       if (c.width !== w || c.height !== h) { c.width = w; c.height = h; }
@@ -462,13 +472,153 @@ class Editor {
         ctx.fillStyle = "#000"; for (const f of t.fails || []) ctx.fillRect(X(f), y + 1, 1, rowH - 2);
         ctx.fillStyle = "#fff"; for (const f of t.keys || []) ctx.fillRect(X(f) - 1, y, 2, rowH);
       });
+      ctx.fillStyle = "#888"; ctx.fillText("events", 0, evTop + laneH - 1);
+      for (const e of this.events) {  // each event a coloured range in its lane; the selected one outlined
+        const y = evTop + lanes.of.get(e) * laneH;
+        ctx.fillStyle = e.colour || "#bab0ac";
+        ctx.fillRect(X(e.start), y + 1, Math.max(2, X(e.end + 1) - X(e.start)), laneH - 2);
+        if (e.id === this.selEvent) {
+          ctx.strokeStyle = "#000"; ctx.lineWidth = 2;
+          ctx.strokeRect(X(e.start), y + 1, Math.max(2, X(e.end + 1) - X(e.start)), laneH - 2);
+        }
+      }
     }
     const ctx = c.getContext("2d");
     ctx.clearRect(0, 0, c.width, c.height);
     ctx.drawImage(this.tlLayer, 0, 0);
     ctx.fillStyle = "#ff4b4b";
     ctx.fillRect(X(this.cur) - 1, 0, 2, h);
-    this.tlGeom = { labelW, w, n, top, rowH, tracks };
+    this.tlGeom = { labelW, w, n, top, rowH, tracks, evTop, laneH, lanes, X };
+  }
+
+  // ------------------------------------------------------------ events on the timeline
+  takeEvents() {
+    if (this.evDrag) return; // the user is stretching one: keep the local copy until the drop
+    const kinds = (this.data.timeline || {}).kinds || ["clap", "handshake", "exchange", "pick", "place"];
+    this.fillSelect(this.eventType, kinds.map((k) => [k, k]), this.eventType.value || kinds[0]);
+    this.events = ((this.data.timeline || {}).events || []).map((e) => ({ ...e }));
+    if (!this.events.some((e) => e.id === this.selEvent)) this.selEvent = null;
+    this.eventStatus();
+  }
+
+  eventLanes() {
+    // overlapping events go to separate lanes (first lane free at the event's start)
+    const ends = [], of = new Map();
+    for (const e of [...this.events].sort((a, b) => a.start - b.start)) {
+      let lane = ends.findIndex((end) => end < e.start);
+      if (lane < 0) { lane = ends.length; ends.push(e.end); } else ends[lane] = e.end;
+      of.set(e, lane);
+    }
+    return { count: ends.length, of };
+  }
+
+  selectedEvent() { return this.events.find((e) => e.id === this.selEvent) || null; }
+
+  eventStatus() {
+    const e = this.selectedEvent();
+    this.eventInfo.textContent = e ? `#${e.id} ${e.type} ${e.start}-${e.end}` : `${this.events.length} events`;
+  }
+
+  redrawEvents() { this.tlSig = null; this.drawTimeline(); this.eventStatus(); }
+
+  eventAt(ev) {
+    // the event under the pointer on the timeline's event row and which of its ends is within 5 px
+    const g = this.tlGeom;
+    if (!g) return null;
+    const r = this.timeline.getBoundingClientRect();
+    const x = ev.clientX - r.left, y = ev.clientY - r.top;
+    if (y < g.evTop) return null;
+    const lane = Math.floor((y - g.evTop) / g.laneH);
+    const frame = Math.round(((x - g.labelW) / (g.w - g.labelW)) * g.n);
+    const hits = this.events.filter((e) => g.lanes.of.get(e) === lane && x >= g.X(e.start) - 5 && x <= g.X(e.end + 1) + 5);
+    const e = hits[0];
+    if (!e) return { e: null, frame };
+    const edge = Math.abs(x - g.X(e.end + 1)) <= 5 ? "end" : Math.abs(x - g.X(e.start)) <= 5 ? "start" : null;
+    return { e, edge, frame };
+  }
+
+  frameAtX(clientX) {
+    const g = this.tlGeom, r = this.timeline.getBoundingClientRect();
+    const f = Math.floor(((clientX - r.left - g.labelW) / (g.w - g.labelW)) * g.n);
+    return Math.min(Math.max(f, 0), g.n - 1);
+  }
+
+  onTimelineDown(ev) {
+    const hit = this.eventAt(ev);
+    if (!hit) return;
+    this.tlSkipClick = true; // the event row is not a jump-to-frame click
+    ev.preventDefault();
+    if (!hit.e) { this.selEvent = null; this.redrawEvents(); return; }
+    this.selEvent = hit.e.id;
+    this.eventType.value = hit.e.type;
+    if (hit.edge) {
+      this.evDrag = { ev: hit.e, edge: hit.edge, orig: [hit.e.start, hit.e.end] };
+      this.timeline.setPointerCapture(ev.pointerId);
+    } else this.show(hit.e.start, true); // a click on an event jumps to its start
+    this.setStatus(`${hit.e.type} event ${hit.e.start}-${hit.e.end}` + (hit.edge ? ": drag to stretch" : ""));
+    this.redrawEvents();
+  }
+
+  onTimelineMove(ev) {
+    const d = this.evDrag;
+    if (!d) {
+      const hit = this.eventAt(ev);
+      this.timeline.style.cursor = hit && hit.edge ? "ew-resize" : "pointer";
+      return;
+    }
+    const f = this.frameAtX(ev.clientX);
+    if (d.edge === "end") d.ev.end = Math.max(d.ev.start, f);
+    else d.ev.start = Math.min(d.ev.end, f);
+    this.redrawEvents();
+  }
+
+  onTimelineUp(ev) {
+    const d = this.evDrag;
+    if (!d) return;
+    this.evDrag = null;
+    try { this.timeline.releasePointerCapture(ev.pointerId); } catch (e) { /* already released */ }
+    const e = d.ev;
+    if (e.start === d.orig[0] && e.end === d.orig[1]) return;
+    if (e.id === null) { [e.start, e.end] = d.orig; this.redrawEvents(); return this.setStatus("the new event is being saved; try again"); }
+    this.emit({ kind: "event_edit", event_id: e.id, revision: e.revision, start_frame: e.start, end_frame: e.end });
+    e.revision += 1;
+    this.setStatus(`${e.type} event now ${e.start}-${e.end}`);
+    this.redrawEvents();
+  }
+
+  addEvent() {
+    const type = this.eventType.value;
+    const last = Math.max(0, (this.data.frame_count || 1) - 1);
+    const end = Math.min(last, this.cur + Math.max(1, Math.round(this.data.fps || 10)) - 1);
+    this.emit({ kind: "event_add", type, start_frame: this.cur, end_frame: end });
+    this.events.push({ id: null, revision: 1, start: this.cur, end, type, colour: "#888" }); // until Python's answer
+    this.setStatus(`added a ${type} event ${this.cur}-${end}; drag its ends on the event row to stretch it`);
+    this.redrawEvents();
+  }
+
+  eventAct(name, shift) {
+    const e = this.selectedEvent();
+    if (name === "event_add") return this.addEvent();
+    if (name === "event_next") {
+      const starts = [...new Set(this.events.map((x) => x.start))].sort((a, b) => a - b);
+      return this.jumpTo(starts, shift, "event");
+    }
+    if (!e || e.id === null) return this.setStatus("select an event first (click it on the timeline's event row)");
+    this.emit({ kind: "event_delete", event_id: e.id, revision: e.revision });
+    this.events.splice(this.events.indexOf(e), 1);
+    this.selEvent = null;
+    this.setStatus(`deleted the ${e.type} event ${e.start}-${e.end}`);
+    this.redrawEvents();
+  }
+
+  retypeEvent() {
+    const e = this.selectedEvent();
+    if (!e || e.id === null || e.type === this.eventType.value) return;
+    e.type = this.eventType.value;
+    this.emit({ kind: "event_edit", event_id: e.id, revision: e.revision, type: e.type });
+    e.revision += 1;
+    this.setStatus(`event #${e.id} is now a ${e.type}`);
+    this.redrawEvents();
   }
 
   setStatus(text) { this.status.textContent = text; }
@@ -511,7 +661,8 @@ class Editor {
   act(name, shift) {
     const occl = this.data.mode === "occluders";
     const b = this.selectedBox();
-    if (name === "prev" || name === "next") this.step(name === "next" ? 1 : -1);
+    if (name.startsWith("event_")) { if (!occl) this.eventAct(name, shift); }
+    else if (name === "prev" || name === "next") this.step(name === "next" ? 1 : -1);
     else if (name === "play") this.togglePlay();
     else if (name === "track") this.nextTrack();
     else if (name === "undo" || name === "redo") { if (!occl) this.emit({ kind: name }); }
@@ -695,6 +846,7 @@ class Editor {
 
   onTimeline(ev) {
     const g = this.tlGeom;
+    if (this.tlSkipClick) { this.tlSkipClick = false; return; }
     if (!g) return;
     const r = this.timeline.getBoundingClientRect();
     const x = ev.clientX - r.left, y = ev.clientY - r.top;
@@ -724,6 +876,8 @@ class Editor {
     else if (k === "o" || k === "O") act = "occluded";
     else if (k === "g" || k === "G") act = "flag";
     else if (k === "k" || k === "K") act = "keyframe";
+    else if (k === "e" || k === "E") act = "event_add";
+    else if (k === "j" || k === "J") act = "event_next";
     else if (k === "b" || k === "B") act = "draw";
     else if (k === "l" || k === "L") act = "labels";
     else if (k === "t" || k === "T") act = "fill";
@@ -748,6 +902,11 @@ class Editor {
     this.svg.addEventListener("contextmenu", (ev) => ev.preventDefault());
     this.viewport.addEventListener("wheel", (ev) => this.onWheel(ev), { passive: false });
     this.timeline.addEventListener("click", (ev) => this.onTimeline(ev));
+    this.timeline.addEventListener("pointerdown", (ev) => this.onTimelineDown(ev));
+    this.timeline.addEventListener("pointermove", (ev) => this.onTimelineMove(ev));
+    this.timeline.addEventListener("pointerup", (ev) => this.onTimelineUp(ev));
+    this.timeline.addEventListener("pointercancel", (ev) => this.onTimelineUp(ev));
+    this.eventType.addEventListener("change", () => this.retypeEvent());
     this.root.addEventListener("keydown", (ev) => { if (ev.key === " ") this.spaceDown = false; this.onKey(ev); });
     for (const button of this.root.querySelectorAll("button[data-act]")) {
       button.addEventListener("click", (ev) => { this.act(button.dataset.act, ev.shiftKey); this.root.focus({ preventScroll: true }); });

@@ -19,13 +19,33 @@ def plain(text) -> str:
     return _MARKDOWN.sub(r"\\\1", str(text))
 
 
+def storage_message(exc: BaseException) -> str:
+    """A refused write, a full disk or a read-only data directory as one sentence (shown as text)."""
+    if isinstance(exc, OSError):
+        from partlab.cli import describe_os_error
+
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        said = describe_os_error(exc)  # a full disk says itself that earlier outputs stay
+        return plain(f"Cannot write{where}: {said}." + ("" if "earlier outputs" in said else
+                                                        " Nothing was changed; what was saved before is intact."))
+    return plain(f"Not done: {exc}")
+
+
 def require_project(s: Store):
-    """The current project, or stop the page with a hint."""
+    """The current project, or stop the page with a hint; a viewer is told that changes are refused."""
+    from partlab.labelling import access
+
     pid = state.project_id(s)
     if pid is None:
-        st.info("No project yet: create one on the Projects page.")
+        st.info("No project yet: create one on the Projects page."
+                if not isinstance(s, access.GuardedStore) else
+                "No project of yours yet: create one on the Projects page, or ask a project's owner for a role.")
         st.stop()
-    return s.project(pid)
+    project = s.project(pid)
+    if not access.may(s, pid, "annotator"):
+        st.caption(f"You are a viewer of {plain(project.name)}: you can look and export; changes are refused "
+                   "(a project owner can make you an annotator).")
+    return project
 
 
 def bound_widget(widget, persistent_key: str, widget_key: str, *args, **kwargs):

@@ -16,10 +16,12 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.box_editor import box_editor, encode_image, pack_boxes, pending_events, track_colour, view
-from partlab.app.editing import apply_events, record
+from partlab.app.editing import Step, apply_events, record, refine_step
 from partlab.app.runs import start_tracking
 from partlab.app.views.common import job_panel, pick_clip, plain, require_project
 from partlab.labelling import trackops
+from partlab.labelling.events import KINDS
+from partlab.labelling.formats.events import KIND_COLOURS
 from partlab.labelling.store import Store, StoreError
 from partlab.labelling.video import VideoClip, VideoError
 from partlab.tracking.parts import BOX_PARTS
@@ -104,13 +106,49 @@ def clip_boxes(url: str, clip_id: int, version) -> dict:
                 parts=[p for p in BOX_PARTS if p in set(df.part)] or list(BOX_PARTS), ids=[t["id"] for t in tracks])
 
 
+def timeline_events() -> list[dict]:
+    """The clip's events as the editor's timeline draws them (newest revision of each, not deleted)."""
+    return [dict(id=int(r.event_id), revision=int(r.revision), start=int(r.start_frame), end=int(r.end_frame),
+                 type=str(r.type), colour=KIND_COLOURS.get(str(r.type), "#bab0ac"))
+            for r in s.events(clip.id).itertuples()]
+
+
 def apply(events: list[dict]) -> None:
     """Write the editor's events; the messages show above the editor on this run."""
     fill = any(e.get("fill") for e in events if e.get("kind") == "edit")
     result = apply_events(s, clip.id, events, history, author=state.author(), fill=fill)
+    refine(result.refills)
     st.session_state.setdefault("correct_messages", []).extend(result.errors + result.notes)
     if result.frame is not None and any(e.get("kind") in ("undo", "redo") for e in events):
         jump(result.frame)
+
+
+@st.cache_resource(show_spinner=False)
+def warm_tracker() -> threading.Thread:
+    """Load the body tracker and its compiled kernels once per server process, in the
+    background, so that the first keyframe a user moves does not wait for them."""
+    from partlab.tracking.keyframes import warm_up
+
+    thread = threading.Thread(target=warm_up, name="partlab-warm-tracker", daemon=True)
+    thread.start()
+    return thread
+
+
+def refine(steps: list[Step]) -> None:
+    """Keyframe-guided tracking of each refilled track and part, restricted to that track's region
+    and stretch, as a background job; the straight line between the keyframes shows until it ends."""
+    from partlab.app import jobs
+    from partlab.tracking.keyframes import stretch_proposer
+
+    for step in steps:
+        tid, part, _ = step.refill[0]
+
+        def work(progress, step=step):
+            with VideoClip(clip.path) as video:
+                return refine_step(Store(s.url), clip.id, history, step, stretch_proposer(video.read, fps=clip.fps),
+                                   progress)
+
+        jobs.submit("refine", f"Tracker boxes between the keyframes of {part} #{tid}", work, clip_id=clip.id)
 
 
 def current_frame() -> int:
@@ -138,13 +176,14 @@ def editor_panel() -> None:
         cache = frame_cache(str(clip.path))
         cache.url(frame)
     except (VideoError, IndexError, ValueError) as exc:
-        st.error(f"Cannot show frame {frame}: {exc}")
+        st.error(plain(f"Cannot show frame {frame}: {exc}"))
         return
     tracks = [dict(id=t, colour=track_colour(t)) for t in data["ids"]]
     late = box_editor(key=editor_key, width=clip.width, height=clip.height, frame_count=clip.frame_count,
                       fps=clip.fps, frame_url=cache.url, boxes_by_frame={} if occluder_mode else data["by_frame"],
                       version=version, jump=st.session_state[jkey], tracks=tracks,
-                      next_track_id=s.next_track_id(clip.id), used_parts=data["parts"], timeline=data["timeline"],
+                      next_track_id=s.next_track_id(clip.id), used_parts=data["parts"],
+                      timeline=dict(data["timeline"], events=timeline_events(), kinds=list(KINDS)),
                       mode="occluders" if occluder_mode else "boxes",
                       occluders=[dict(x=b.x, y=b.y, w=b.w, h=b.h) for b in s.occluders(clip.id)])
     if late:  # events the early read did not see (not expected; kept so none is ever dropped)
@@ -154,7 +193,9 @@ def editor_panel() -> None:
         st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
 
+warm_tracker()
 editor_panel()
+job_panel("refine", limit=1, clip_id=clip.id)
 frame = current_frame()
 version = s.data_version(clip.id)
 data = clip_boxes(s.url, clip.id, version)
@@ -192,7 +233,7 @@ with tab_tracks:
                 jump(frame)
                 st.rerun()
             except StoreError as exc:
-                st.error(f"Not saved: {exc}")
+                st.error(plain(f"Not saved: {exc}"))
         st.caption(f"Operations apply at the frame shown (frame {frame}); each is one step of undo (Ctrl+Z in the "
                    "editor) and is stored as revisions of the boxes it changes.")
 
@@ -211,7 +252,7 @@ with tab_review:
                     st.session_state[f"last_review:{clip.id}"] = rid
                     st.rerun()
                 except StoreError as exc:
-                    st.error(str(exc))
+                    st.error(plain(exc))
         rid = st.session_state.get(f"last_review:{clip.id}")
         if rid is not None and st.button("Undo my last verdict", key=f"rv_undo:{clip.id}"):
             s.undo_review(clip.id, rid)
@@ -239,7 +280,7 @@ with tab_retrack:
                                                    if b.id == project.default_bundle_id), None))
             st.success(f"Started: {plain(job.label)}")
         except (RuntimeError, ValueError) as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     runs = s.runs(clip.id)
     if len(runs):
         r = runs.iloc[-1]
@@ -261,4 +302,8 @@ with tab_keys:
         "or on hover · wheel, **+**/**-**: zoom at the mouse · **0**: fit · **1**: 1:1 · right- or middle-drag: pan · "
         "**Ctrl+Z / Ctrl+Y**: undo/redo a step. The timeline under the frame shows each track's presence (colour), "
         "keyframes (white ticks), failure flags (black ticks), reviewed ranges (green/red) and flagged frames (red "
-        "strip on top); click it to jump.")
+        "strip on top); click it to jump. Its bottom row holds the **events** (activities over a range of frames, "
+        "a colour per kind): **E** or *add event* adds one of the chosen kind from the shown frame; click an event "
+        "to select it and jump to its start, drag its left or right end to stretch it, pick another kind to retype "
+        "it, *delete event* removes it; **J** / **Shift+J**: next/previous event. Event changes are undone with "
+        "Ctrl+Z like box edits and stored as revisions.")

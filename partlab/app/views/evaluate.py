@@ -31,7 +31,7 @@ if truth_file is not None:
     try:
         truth = read_tracks_csv(io.StringIO(truth_file.getvalue().decode("utf-8", "replace")), name=truth_file.name)
     except ValueError as exc:
-        st.error(f"Truth not read: {exc}")
+        st.error(plain(f"Truth not read: {exc}"))
 if truth is None:
     truth = training_truth(s, clip.id)
     st.caption(f"Truth: {truth.frame.nunique()} corrected frames of this clip.")

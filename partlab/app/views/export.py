@@ -8,7 +8,7 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.runs import safe_name
-from partlab.app.views.common import require_project
+from partlab.app.views.common import plain, require_project, storage_message
 from partlab.labelling import formats
 from partlab.labelling.config import data_dir
 
@@ -55,10 +55,10 @@ if go:
         _old_archives()
     except (ValueError, OSError) as exc:
         shutil.rmtree(work, ignore_errors=True)
-        st.error(f"Export failed: {exc}")
+        st.error(storage_message(exc) if isinstance(exc, OSError) else plain(f"Export failed: {exc}"))
 
 archive = Path(st.session_state.get("export_archive", ""))
 if archive.name and archive.is_file():
     # deferred: the file is read from disk only when the user clicks, not kept in memory per session
-    st.download_button(f"Download {archive.name}", lambda: archive.open("rb"), file_name=archive.name,
+    st.download_button(f"Download {plain(archive.name)}", lambda: archive.open("rb"), file_name=archive.name,
                        mime="application/zip")

@@ -8,8 +8,10 @@ import streamlit as st
 
 from partlab.app import state
 from partlab.app.runs import clip_state
+from partlab.app.upload_notice import show_refusals
 from partlab.app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
 from partlab.app.views.common import plain, require_project
+from partlab.labelling import access
 from partlab.labelling.store import StoreError
 from partlab.labelling.video import VideoClip, VideoError
 
@@ -26,7 +28,7 @@ def new_project_form() -> None:
                 st.session_state["projects_flash"] = f"Created project {plain(repr(project.name))}."
                 st.rerun()  # the sidebar's project picker shows the new project
             except StoreError as exc:
-                st.error(str(exc))
+                st.error(plain(exc))
 
 
 if s.projects():
@@ -45,23 +47,26 @@ st.subheader(f"Project: {plain(project.name)}")
 try:
     limit = max_upload_mb()
 except UploadRefused as exc:
-    st.error(str(exc))
+    st.error(plain(exc))
     st.stop()
-uploaded = st.file_uploader(f"Upload clips ({', '.join(UPLOAD_EXTENSIONS)}; up to {limit} MB each)",
-                            type=list(UPLOAD_EXTENSIONS), accept_multiple_files=True, key=f"upload:{project.id}")
+uploaded = None
+if access.may(s, project.id, "annotator"):  # a viewer gets no uploader (the store would refuse the clip too)
+    uploaded = st.file_uploader(f"Upload clips ({', '.join(UPLOAD_EXTENSIONS)}; up to {limit} MB each)",
+                                type=list(UPLOAD_EXTENSIONS), accept_multiple_files=True, key=f"upload:{project.id}")
+    show_refusals()  # a file over the limit, refused by the browser: its sentence shown, not just an icon
 seen = st.session_state.setdefault("uploads_done", {})
 for f in uploaded or []:
     if f.file_id in seen:
         kind, message = seen[f.file_id]
     else:
         try:
-            with st.spinner(f"Checking and storing {f.name}..."):
+            with st.spinner(f"Checking and storing {plain(f.name)}..."):
                 clip = save_upload(s, project.id, f.name, f)
             kind, message = "success", f"Added {plain(clip.name)}: {clip.frame_count} frames, {clip.fps:.1f} fps, " \
                                        f"{clip.width}x{clip.height}."
             st.session_state[state.CLIP] = clip.id
         except UploadRefused as exc:
-            kind, message = "error", f"Upload {exc}"
+            kind, message = "error", plain(f"Upload {exc}")
         seen[f.file_id] = (kind, message)
     getattr(st, kind)(message)
 

@@ -49,7 +49,7 @@ if go:
                              start=first if from_boxes else 0, init_from_boxes=from_boxes, init=init)
         st.success(f"Started: {plain(job.label)}. It keeps running while you use other pages.")
     except (RuntimeError, ValueError) as exc:
-        st.error(str(exc))
+        st.error(plain(exc))
 
 
 job_panel("track", clip_id=clip.id)
@@ -64,7 +64,7 @@ with st.expander("Import boxes from a tracks CSV (e.g. another tool's output or 
             st.session_state["track_flash"] = f"Stored {len(df)} boxes as run {run_id}; human corrections were kept."
             st.rerun()  # the form above offers to start from these boxes now
         except ValueError as exc:
-            st.error(f"Not imported: {exc}")
+            st.error(plain(f"Not imported: {exc}"))
 if "track_flash" in st.session_state:
     st.success(st.session_state.pop("track_flash"))
 

@@ -43,7 +43,7 @@ if go_train:
     except NothingLearnt as exc:
         st.error(f"Nothing to learn yet: {exc}.")
     except (RuntimeError, ValueError) as exc:
-        st.error(str(exc))
+        st.error(plain(exc))
 
 
 job_panel("train", limit=3, project_id=project.id)
@@ -97,7 +97,7 @@ if bundles:
             s.set_default_bundle(project.id, chosen)
             st.success(f"Default bundle: {plain(labels[chosen])}")
         except StoreError as exc:
-            st.error(str(exc))
+            st.error(plain(exc))
     for b in reversed(bundles):
         with st.expander(f"{plain(b.name)} · {b.created:%Y-%m-%d %H:%M} · {plain(b.path)}", expanded=b is bundles[-1]):
             show_summary(b.summary, key=str(b.id))

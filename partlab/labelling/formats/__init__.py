@@ -21,6 +21,7 @@ from partlab.labelling.archive import ArchiveError, is_archive, safe_extract
 from partlab.labelling.formats import coco, cvat, labelstudio, mot, parquet, voc, yolo
 from partlab.labelling.formats.alignment import align_frames
 from partlab.labelling.formats.base import MANIFEST_NAME, ExportManifest, FormatError, check_frame_count
+from partlab.labelling.formats.events import export_events
 from partlab.labelling.video import VideoInfo, probe
 
 __all__ = ["FORMATS", "IMPORT_FORMATS", "FormatError", "Format", "export_dataset", "import_dataset", "export_clip",
@@ -63,13 +64,14 @@ def _format(fmt: str) -> Format:
 
 
 def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: VideoInfo, video_path=None,
-                   every: int = 1, frames: bool = True) -> Path:
+                   every: int = 1, frames: bool = True, events: pd.DataFrame | None = None) -> Path:
     """Write ``tracks_df`` as a ``fmt`` dataset in the directory ``out_dir``; returns it.
 
     ``video_info`` is the clip the boxes were annotated on (fps, size, frame count);
     ``video_path``, when given, is probed and refused if its decoded frame count
     differs. Frames are written as JPEG (``frames=True``, needs ``video_path``) for
-    formats with images; ``every`` keeps frames whose index is a multiple of it.
+    formats with images; ``every`` keeps frames whose index is a multiple of it. ``events`` (the
+    events CSV's table) go next to it: :mod:`~partlab.labelling.formats.events`.
     """
     f = _format(fmt)
     out = Path(out_dir)
@@ -82,6 +84,7 @@ def export_dataset(tracks_df: pd.DataFrame, fmt: str, out_dir, video_info: Video
     kept = {c.name for c in out.iterdir()} if out.is_dir() else set()
     result = f.export(tracks_df, out, video_info, video_path=video_path, every=every,
                       frames=frames and fmt not in NO_FRAMES)
+    export_events(events, out, fmt, video_info, every)
     manifest = ExportManifest.read(out)
     if manifest is not None:  # record what this export wrote, so the next one removes only that
         written = sorted(c.name for c in out.iterdir() if c.name not in kept) + [MANIFEST_NAME]
@@ -185,14 +188,18 @@ def export_clip(store, clip_id: int, fmt: str, out_dir, every: int = 1, frames: 
                 accepted_only: bool = False) -> Path:
     """Export a clip of the annotation store (its effective boxes: tracker boxes under human
     edits) against the frame count and fps recorded when the clip was added; marks it exported.
-    ``accepted_only``: only the boxes of tracks at frames a reviewer accepted (``Store.accepted``)."""
+    ``accepted_only``: only the boxes of tracks at frames a reviewer accepted (``Store.accepted``).
+    The clip's events go with it (:func:`partlab.labelling.events.from_store`)."""
+    from partlab.labelling.events import from_store
+
     clip = store.clip(clip_id)
     info = VideoInfo(clip.path, clip.fps, clip.width, clip.height, clip.frame_count)
     tracks = store.tracks(clip_id)
     if accepted_only:
         ok = store.accepted(clip_id)
         tracks = tracks.merge(ok, on=["frame", "track_id"], how="inner")
-    out = export_dataset(tracks, fmt, out_dir, info, video_path=clip.path, every=every, frames=frames)
+    out = export_dataset(tracks, fmt, out_dir, info, video_path=clip.path, every=every, frames=frames,
+                         events=from_store(store.events(clip_id)))
     store.mark_exported(clip_id)
     return out
 

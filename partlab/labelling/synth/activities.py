@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+import cv2
 import numpy as np
 
 from partlab.labelling.synth.appearance import sample_appearances
@@ -64,8 +65,20 @@ def _frame(t: float, n: int) -> int:
     return int(round(t * (n - 1)))
 
 
-def _object_colour(rng) -> tuple[int, int, int]:
-    c = OBJECT_COLOURS[int(rng.integers(len(OBJECT_COLOURS)))]
+def _hue_sat(bgr) -> tuple[int, int]:
+    h, s, _ = cv2.cvtColor(np.uint8([[bgr]]), cv2.COLOR_BGR2HSV)[0, 0]
+    return int(h), int(s)
+
+
+def _object_colour(rng, people=()) -> tuple[int, int, int]:
+    """An object colour whose hue is at least 30 degrees from every saturated colour the people wear:
+    the paper's colour analysis cannot tell an object from a sleeve of its own hue (docs state the
+    limitation), and the scenes measure the recognition, not that coincidence."""
+    worn = [h for a in people for h, sat in (_hue_sat(a.shirt), _hue_sat(a.trousers)) if sat >= 60]
+    far = [c for c in OBJECT_COLOURS
+           if all(min(abs(_hue_sat(c)[0] - h), 180 - abs(_hue_sat(c)[0] - h)) >= 15 for h in worn)]
+    pool = far or list(OBJECT_COLOURS)
+    c = pool[int(rng.integers(len(pool)))]
     return tuple(int(np.clip(v + rng.integers(-12, 13), 0, 255)) for v in c)
 
 
@@ -117,7 +130,7 @@ def pick_place(rng, camera, n_frames, fps) -> Script:
     for lo, hi, p in ((0, pick_f, p1), (place_f, n, p2)):
         q = p + box_off
         restp[lo:hi] = (view.x0 + s * q[0], view.y0 - s * q[2] + s * k * q[1])
-    colour = _object_colour(rng)
+    colour = _object_colour(rng, (app,))
     obj = CarriedObject(holder, restp, colour, radius=1.6, rest_radius_px=1.6 * s * hr)
     zeros = np.zeros(n)
     yaw = -0.4 * np.maximum(w1, w2) + 0.2 * np.sin(2 * np.pi * np.arange(n) / (fps * 4.0) + rng.uniform(0, 6.3))
@@ -161,7 +174,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
     objects, events = [], []
     start, end = _frame(t0, n), _frame(t1, n)  # the hands together
     if with_object:
-        colour = _object_colour(rng)
+        colour = _object_colour(rng, (a, b))
         holder = np.full(n, 1)  # a's right hand, then b's right hand from the middle of the meeting
         holder[(start + end) // 2:] = 3
         objects.append(CarriedObject(holder, np.full((n, 2), np.nan), colour, radius=1.5))

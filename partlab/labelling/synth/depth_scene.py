@@ -21,7 +21,9 @@ World frame = the left camera (x right, y down, z forward, millimetres). The rig
 Truth (a tracks table): ``head``, ``left_hand``, ``right_hand`` boxes (tight extent of the pixels
 the left camera sees of them) with ``X,Y,Z`` the part's centre; ``left/right_shoulder`` and
 ``left/right_elbow`` joints (a small box around the projected joint) with their 3D centres;
-``torso`` box. ``occluded`` is the fraction of a part hidden by the person's other parts.
+``torso`` box. ``occluded`` is the fraction of a part's silhouette not seen (hidden by the
+person's other parts, or outside the frame); a part wholly outside the frame has no row (as in
+:mod:`.scene`): fast hands of a person near the camera leave the field of view now and then.
 """
 
 from __future__ import annotations
@@ -273,17 +275,27 @@ def _cameras(rng: np.random.Generator, width: int, height: int) -> dict[str, Cam
     return {"cam0": left, "cam0_right": right}
 
 
-def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 150, width: int = 320,  # noqa: C901
-                     height: int = 240, *, fast: float = 1.0) -> DepthScene:
-    """Render ``name`` (``desk_depth`` or ``standing_depth``) from ``seed``; ``fast`` scales the
-    hands' speed (1: keyframes 0.2-0.6 s apart, up to about 3 m/s)."""
-    if name not in DEPTH_SCENARIOS:
-        raise ValueError(f"unknown depth scenario {name!r}; expected one of {', '.join(DEPTH_SCENARIOS)}")
-    if n_frames < 1 or width < 64 or height < 48:
-        raise ValueError(f"bad scene size {width}x{height} x {n_frames} frames")
-    rng = np.random.default_rng([seed, 100 + DEPTH_SCENARIOS.index(name)])
-    (app,) = sample_appearances(rng, 1)
-    body = _Body(app.height_m * 1000.0, float(rng.uniform(0.93, 1.07)), float(rng.uniform(0.94, 1.06)))
+@dataclass(frozen=True, eq=False)
+class _Layout:
+    """Where everything is (world mm, the left camera's frame) for one scene: the person's body,
+    the cameras, the room's planes and the fixed joints (head, neck, shoulders)."""
+
+    name: str
+    body: _Body
+    cams: dict[str, Camera]
+    distance: float
+    wall_z: float
+    torso_c: np.ndarray
+    neck_top: np.ndarray
+    head_c: np.ndarray
+    shoulders: np.ndarray  # (2, 3) [left, right]; the person's left is image right
+    floor_y: float
+    desk_y: float
+
+
+def _layout(rng: np.random.Generator, name: str, height_mm: float, width: int, height: int) -> _Layout:
+    """Proportions (shoulders +-7 %, arms +-6 %), cameras, distance and the room, in that draw order."""
+    body = _Body(height_mm, float(rng.uniform(0.93, 1.07)), float(rng.uniform(0.94, 1.06)))
     H = body.H
     cams = _cameras(rng, width, height)
     distance = rng.uniform(1100, 1600) if name == "desk_depth" else rng.uniform(1500, 2100)
@@ -294,86 +306,179 @@ def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 15
     neck_top = torso_c + np.array([0, -body.torso_r[1] - 0.02 * H, 0])
     head_c = neck_top + np.array([0, -body.head_r[1] * 0.95, -0.01 * H])
     shoulders = np.array([torso_c + np.array([s * body.shoulder_half, -body.torso_r[1] * 0.78, 0])
-                          for s in (1.0, -1.0)])  # [left, right]; the person's left is image right
+                          for s in (1.0, -1.0)])
     floor_y = torso_c[1] + 0.42 * H if name == "standing_depth" else torso_c[1] + 0.55 * H
     desk_y = torso_c[1] + 0.13 * H  # desk top below the elbows
-    # the hands' own stream, over at least 60 s: a shorter clip of the same seed is a prefix
-    paths = _hand_paths(np.random.default_rng([seed, 200 + DEPTH_SCENARIOS.index(name)]), max(n_frames, 1500),
-                        torso_c + np.array([0, 0.02 * H, 0]), body, fast)
+    return _Layout(name, body, cams, float(distance), float(wall_z), torso_c, neck_top, head_c, shoulders,
+                   float(floor_y), float(desk_y))
+
+
+def _arms(seed: int, lay: _Layout, n_frames: int, fast: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(hands, elbows)``, each ``(n_frames, 2, 3)``: the hands' paths (their own random stream,
+    over at least 60 s, so a shorter clip of the same seed is a prefix), kept above the desk top and
+    within reach, and the elbows by two-link inverse kinematics."""
+    body, H = lay.body, lay.body.H
+    index = DEPTH_SCENARIOS.index(lay.name)
+    paths = _hand_paths(np.random.default_rng([seed, 200 + index]), max(n_frames, 1500),
+                        lay.torso_c + np.array([0, 0.02 * H, 0]), body, fast)
     hands = paths[:n_frames].copy()
-    if name == "desk_depth":
-        hands[..., 1] = np.minimum(hands[..., 1], desk_y - 1.5 * body.hand_r)  # above the desk top
-    elbows = np.stack([_elbow(shoulders[k], hands[:, k], body.upper_arm, body.forearm, (1.0, -1.0)[k])
+    if lay.name == "desk_depth":
+        hands[..., 1] = np.minimum(hands[..., 1], lay.desk_y - 1.5 * body.hand_r)  # above the desk top
+    elbows = np.stack([_elbow(lay.shoulders[k], hands[:, k], body.upper_arm, body.forearm, (1.0, -1.0)[k])
                        for k in range(2)], 1)
     # reach: keep each hand within the arm's length of its shoulder
     for k in range(2):
-        d = hands[:, k] - shoulders[k]
+        d = hands[:, k] - lay.shoulders[k]
         L = np.linalg.norm(d, axis=1, keepdims=True)
-        hands[:, k] = shoulders[k] + d * np.minimum(1.0, (body.upper_arm + body.forearm) * 0.98 / L)
+        hands[:, k] = lay.shoulders[k] + d * np.minimum(1.0, (body.upper_arm + body.forearm) * 0.98 / L)
+    return hands, elbows
 
-    # looks: light, colours, textures
-    light = np.array([rng.uniform(-0.6, 0.6), rng.uniform(0.3, 0.9), 1.0])  # from above the camera, travelling +z
+
+# desk tops: grey, white, dark, blue-grey (a skin-hued wood top is a colour distractor of its own,
+# the limb tracker's desk scene; here the hands' depth is under test)
+_DESK_TOPS = ((128, 128, 128), (225, 225, 220), (45, 45, 50), (150, 120, 100))
+
+
+@dataclass(frozen=True, eq=False)
+class _Looks:
+    """Light, colours (BGR) and textures of one scene."""
+
+    light: np.ndarray  # unit vector, from above the camera, travelling +z
+    ambient: float
+    diffuse: float
+    tint: np.ndarray
+    skin: np.ndarray
+    shirt: np.ndarray
+    hair: np.ndarray
+    trousers: np.ndarray
+    wall: np.ndarray
+    floor: np.ndarray
+    desk: np.ndarray
+    tex_skin: object
+    tex_cloth: object
+    tex_wall: object
+    tex_wall2: object
+
+
+def _looks(rng: np.random.Generator, app) -> _Looks:
+    light = np.array([rng.uniform(-0.6, 0.6), rng.uniform(0.3, 0.9), 1.0])
     light /= np.linalg.norm(light)
     ambient, diffuse = rng.uniform(0.35, 0.55), rng.uniform(0.45, 0.7)
     tint = rng.uniform(0.9, 1.1, 3)
     skin, shirt, hair, trousers = (np.asarray(c, float) for c in (app.skin, app.shirt, app.hair, app.trousers))
     wall_col = rng.uniform(90, 220, 3)
     floor_col = rng.uniform(60, 160, 3)
-    # desk tops: grey, white, dark, blue-grey (a skin-hued wood top is a colour distractor of its own,
-    # the limb tracker's desk scene; here the hands' depth is under test)
-    desk_tops = [(128, 128, 128), (225, 225, 220), (45, 45, 50), (150, 120, 100)]
-    desk_col = np.asarray(desk_tops[int(rng.integers(4))], float)
+    desk_col = np.asarray(_DESK_TOPS[int(rng.integers(4))], float)
     tex_skin, tex_cloth = _texture(rng, 25.0), _texture(rng, 14.0)
     tex_wall, tex_wall2 = _texture(rng, 180.0), _texture(rng, 35.0)
+    return _Looks(light, ambient, diffuse, tint, skin, shirt, hair, trousers, wall_col, floor_col, desk_col,
+                  tex_skin, tex_cloth, tex_wall, tex_wall2)
 
-    def head_colour(local):
+
+class _Renderer:
+    """Ray-casts one scene's frames: the static room once per camera, the person per frame."""
+
+    def __init__(self, lay: _Layout, looks: _Looks, hands: np.ndarray, elbows: np.ndarray):
+        self.lay, self.looks, self.hands, self.elbows = lay, looks, hands, elbows
+        self.rooms = {k: self._room(c) for k, c in lay.cams.items()}
+
+    def _head_colour(self, local):
         hair_cap = (local[..., 1] < -0.35) | (local[..., 2] > 0.3)
-        return np.where(hair_cap[..., None], hair, skin)
+        return np.where(hair_cap[..., None], self.looks.hair, self.looks.skin)
 
-    def room_colour(base, scale=1.0):
-        return lambda p: base * (1 + scale * (0.28 * tex_wall(p) + 0.18 * tex_wall2(p)))[:, None]
+    def _room_colour(self, base, scale=1.0):
+        lk = self.looks
+        return lambda p: base * (1 + scale * (0.28 * lk.tex_wall(p) + 0.18 * lk.tex_wall2(p)))[:, None]
 
-    def room(cam: Camera) -> _Buffer:  # static: rendered once per camera
+    def _room(self, cam: Camera) -> _Buffer:
+        lay, lk = self.lay, self.looks
+        H, torso_c = lay.body.H, lay.torso_c
         buf = _Buffer(cam)
-        buf.plane(np.array([0, 0, 1.0]), wall_z, ROOM, room_colour(wall_col))
-        buf.plane(np.array([0, 1.0, 0]), floor_y, ROOM, room_colour(floor_col, 0.7))
-        if name == "desk_depth":
-            buf.plane(np.array([0, 1.0, 0]), desk_y, DESK, room_colour(desk_col, 0.6),
+        buf.plane(np.array([0, 0, 1.0]), lay.wall_z, ROOM, self._room_colour(lk.wall))
+        buf.plane(np.array([0, 1.0, 0]), lay.floor_y, ROOM, self._room_colour(lk.floor, 0.7))
+        if lay.name == "desk_depth":
+            buf.plane(np.array([0, 1.0, 0]), lay.desk_y, DESK, self._room_colour(lk.desk, 0.6),
                       bounds=lambda p: (np.abs(p[..., 0] - torso_c[0]) < 0.45 * H)
                       & (p[..., 2] > torso_c[2] - 0.45 * H) & (p[..., 2] < torso_c[2] - 0.05 * H))
         return buf
 
-    rooms = {k: room(c) for k, c in cams.items()}
-
-    def render(cam: Camera, i: int) -> _Buffer:
+    def render(self, cam: Camera, i: int) -> _Buffer:
+        lay, lk, body = self.lay, self.looks, self.lay.body
+        H = body.H
         buf = _Buffer(cam)
-        r = rooms[cam.name]
+        r = self.rooms[cam.name]
         buf.z, buf.label, buf.colour, buf.normal = r.z.copy(), r.label.copy(), r.colour.copy(), r.normal.copy()
-        buf.ellipsoid(torso_c, body.torso_r, TORSO, shirt)
-        buf.capsule(neck_top + np.array([0, 0.03 * H, 0]), head_c, 0.028 * H, NECK, skin)
-        buf.ellipsoid(head_c, body.head_r, HEAD, head_colour)
-        if name == "standing_depth":
+        buf.ellipsoid(lay.torso_c, body.torso_r, TORSO, lk.shirt)
+        buf.capsule(lay.neck_top + np.array([0, 0.03 * H, 0]), lay.head_c, 0.028 * H, NECK, lk.skin)
+        buf.ellipsoid(lay.head_c, body.head_r, HEAD, self._head_colour)
+        if lay.name == "standing_depth":
             for s in (1.0, -1.0):
-                hip = torso_c + np.array([s * 0.05 * H, body.torso_r[1] * 0.9, 0])
-                buf.capsule(hip, hip + np.array([s * 0.01 * H, 0.47 * H, 0]), 0.045 * H, LEGS, trousers)
+                hip = lay.torso_c + np.array([s * 0.05 * H, body.torso_r[1] * 0.9, 0])
+                buf.capsule(hip, hip + np.array([s * 0.01 * H, 0.47 * H, 0]), 0.045 * H, LEGS, lk.trousers)
         for k, lab in ((0, ARM_L), (1, ARM_R)):
-            buf.capsule(shoulders[k], elbows[i, k], body.arm_r * 1.15, lab, shirt)
-            buf.capsule(elbows[i, k], hands[i, k], body.arm_r, lab, shirt)
-            buf.ellipsoid(hands[i, k], np.array([body.hand_r] * 3), (HAND_L, HAND_R)[k], skin)
+            buf.capsule(lay.shoulders[k], self.elbows[i, k], body.arm_r * 1.15, lab, lk.shirt)
+            buf.capsule(self.elbows[i, k], self.hands[i, k], body.arm_r, lab, lk.shirt)
+            buf.ellipsoid(self.hands[i, k], np.array([body.hand_r] * 3), (HAND_L, HAND_R)[k], lk.skin)
         return buf
 
-    def shade(buf: _Buffer) -> np.ndarray:
-        lam = np.abs(buf.world_normals() @ light)  # two-sided Lambert: the wall faces away from +z
+    def shade(self, buf: _Buffer) -> np.ndarray:
+        lk = self.looks
+        lam = np.abs(buf.world_normals() @ lk.light)  # two-sided Lambert: the wall faces away from +z
         lab = buf.label
         body_px = (lab != ROOM) & (lab != DESK)  # the room's texture is in its colour already
         pts = buf.points()[body_px]
         tex = np.zeros(lab.shape)
-        tex[body_px] = np.where(np.isin(lab[body_px], (HEAD, HAND_L, HAND_R, NECK)), 0.10 * tex_skin(pts),
-                                0.16 * tex_cloth(pts))
-        gain = (ambient + diffuse * lam) * (1 + tex)
-        img = buf.colour * gain[..., None] * tint
-        return np.clip(img, 0, 255)
+        tex[body_px] = np.where(np.isin(lab[body_px], (HEAD, HAND_L, HAND_R, NECK)), 0.10 * lk.tex_skin(pts),
+                                0.16 * lk.tex_cloth(pts))
+        gain = (lk.ambient + lk.diffuse * lam) * (1 + tex)
+        return np.clip(buf.colour * gain[..., None] * lk.tint, 0, 255)
 
+
+def _truth_rows(i: int, labels: np.ndarray, lay: _Layout, hands: np.ndarray, elbows: np.ndarray) -> list[tuple]:
+    """Frame ``i``'s truth: head, hand and torso boxes from the pixels the left camera sees of them
+    (the projected extent when hidden), with the fraction occluded, and the four arm joints."""
+    cam, body = lay.cams["cam0"], lay.body
+    centres = {"head": lay.head_c, "left_hand": hands[i, 0], "right_hand": hands[i, 1], "torso": lay.torso_c}
+    radii = {"head": body.head_r.max(), "left_hand": body.hand_r, "right_hand": body.hand_r,
+             "torso": body.torso_r.max()}
+    rows = []
+    for part, labs in _TRUTH_LABELS.items():
+        mask = np.isin(labels, labs)
+        c = centres[part]
+        if mask.any():
+            cols = np.flatnonzero(mask.any(axis=0))
+            rws = np.flatnonzero(mask.any(axis=1))
+            box = (cols[0], rws[0], cols[-1] - cols[0] + 1, rws[-1] - rws[0] + 1)
+        else:  # hidden: the projected extent; wholly outside the frame: no row (as in .scene)
+            (u, v), = cam.project(c[None])
+            r = radii[part] * cam.K[0, 0] / c[2]
+            if u + r <= 0 or v + r <= 0 or u - r >= cam.size[0] or v - r >= cam.size[1]:
+                continue
+            box = (u - r, v - r, 2 * r, 2 * r)
+        # occluded: the fraction of the part's own silhouette that something else covers
+        occ = _occluded_fraction(cam, c, radii[part], mask) if part != "torso" else 0.0
+        rows.append((i, 1, part, *box, occ, *c))
+    for part, p in (("left_shoulder", lay.shoulders[0]), ("right_shoulder", lay.shoulders[1]),
+                    ("left_elbow", elbows[i, 0]), ("right_elbow", elbows[i, 1])):
+        (u, v), = cam.project(p[None])
+        r = body.arm_r * cam.K[0, 0] / p[2]
+        rows.append((i, 1, part, u - r, v - r, 2 * r, 2 * r, 0.0, *p))
+    return rows
+
+
+def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 150, width: int = 320,
+                     height: int = 240, *, fast: float = 1.0) -> DepthScene:
+    """Render ``name`` (``desk_depth`` or ``standing_depth``) from ``seed``; ``fast`` scales the
+    hands' speed (1: keyframes 0.2-0.6 s apart, up to about 3 m/s)."""
+    if name not in DEPTH_SCENARIOS:
+        raise ValueError(f"unknown depth scenario {name!r}; expected one of {', '.join(DEPTH_SCENARIOS)}")
+    if n_frames < 1 or width < 64 or height < 48:
+        raise ValueError(f"bad scene size {width}x{height} x {n_frames} frames")
+    rng = np.random.default_rng([seed, 100 + DEPTH_SCENARIOS.index(name)])
+    (app,) = sample_appearances(rng, 1)
+    lay = _layout(rng, name, app.height_m * 1000.0, width, height)
+    hands, elbows = _arms(seed, lay, n_frames, fast)
+    renderer = _Renderer(lay, _looks(rng, app), hands, elbows)
     frames = np.empty((n_frames, height, width, 3), np.uint8)
     right = np.empty_like(frames)
     depth = np.empty((n_frames, height, width), np.float32)
@@ -381,43 +486,22 @@ def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 15
     noise_rng = np.random.default_rng([seed, 7])
     noise = rng.uniform(1.0, 3.0)
     rows = []
-    left_cam = cams["cam0"]
     for i in range(n_frames):
-        lb = render(left_cam, i)
-        rb = render(cams["cam0_right"], i)
-        for img, out in ((shade(lb), frames), (shade(rb), right)):
+        lb = renderer.render(lay.cams["cam0"], i)
+        rb = renderer.render(lay.cams["cam0_right"], i)
+        for img, out in ((renderer.shade(lb), frames), (renderer.shade(rb), right)):
             out[i] = np.clip(img + noise_rng.normal(0, noise, img.shape), 0, 255).astype(np.uint8)
         depth[i] = lb.z.astype(np.float32)
         labels[i] = lb.label
-        centres = {"head": head_c, "left_hand": hands[i, 0], "right_hand": hands[i, 1], "torso": torso_c}
-        radii = {"head": body.head_r.max(), "left_hand": body.hand_r, "right_hand": body.hand_r,
-                 "torso": body.torso_r.max()}
-        for part, labs in _TRUTH_LABELS.items():
-            mask = np.isin(lb.label, labs)
-            c = centres[part]
-            if mask.any():
-                cols = np.flatnonzero(mask.any(axis=0))
-                rws = np.flatnonzero(mask.any(axis=1))
-                box = (cols[0], rws[0], cols[-1] - cols[0] + 1, rws[-1] - rws[0] + 1)
-            else:  # hidden: the projected extent
-                (u, v), = left_cam.project(c[None])
-                r = radii[part] * left_cam.K[0, 0] / c[2]
-                box = (u - r, v - r, 2 * r, 2 * r)
-            # occluded: the fraction of the part's own silhouette that something else covers
-            occ = _occluded_fraction(left_cam, c, radii[part], mask) if part != "torso" else 0.0
-            rows.append((i, 1, part, *box, occ, *c))
-        for part, p in (("left_shoulder", shoulders[0]), ("right_shoulder", shoulders[1]),
-                        ("left_elbow", elbows[i, 0]), ("right_elbow", elbows[i, 1])):
-            (u, v), = left_cam.project(p[None])
-            r = body.arm_r * left_cam.K[0, 0] / p[2]
-            rows.append((i, 1, part, u - r, v - r, 2 * r, 2 * r, 0.0, *p))
+        rows.extend(_truth_rows(i, lb.label, lay, hands, elbows))
     truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded", "X", "Y", "Z"])
     truth["source"] = "truth"
     truth["camera"] = "cam0"
     truth = normalise_tracks(truth)
     init = truth[(truth["frame"] == 0) & truth["part"].isin(["head", "left_hand", "right_hand"])].reset_index(drop=True)
+    cams = lay.cams
     meta = {"name": name, "seed": seed, "fps": FPS, "width": width, "height": height, "n_frames": n_frames,
-            "distance_mm": round(float(distance), 1), "height_mm": round(H, 1),
+            "distance_mm": round(lay.distance, 1), "height_mm": round(lay.body.H, 1),
             "baseline_mm": round(float(np.linalg.norm(cams["cam0_right"].centre)), 2),
             "skin": list(app.skin), "shirt": list(app.shirt), "fast": fast,
             "hand_speed_mm_s_max": round(float(np.linalg.norm(np.diff(hands, axis=0), axis=-1).max() * FPS), 1)}
@@ -425,12 +509,14 @@ def make_depth_scene(name: str = "desk_depth", seed: int = 0, n_frames: int = 15
 
 
 def _occluded_fraction(cam: Camera, c: np.ndarray, r: float, visible: np.ndarray) -> float:
+    """The fraction of the part's projected disc not seen: hidden by something nearer, or outside
+    the frame (a hand at the image's edge is partly out of view)."""
     (u, v), = cam.project(c[None])
     rad = r * cam.K[0, 0] / c[2]
     h, w = visible.shape
     yy, xx = np.ogrid[:h, :w]
     disc = (xx - u) ** 2 + (yy - v) ** 2 <= rad ** 2
-    n = int(disc.sum())
+    n = max(float(np.pi * rad ** 2), float(disc.sum()))
     return round(1.0 - min(1.0, int((disc & visible).sum()) / n), 4) if n else 1.0
 
 

@@ -162,6 +162,8 @@ class Script3D:
     facing: float  # direction (radians) the cameras' arc is centred on, seen from the scene
     table: np.ndarray | None = None  # (8, 3) corners in mm: 4 top (z = height) then 4 bottom
     objects: list = field(default_factory=list)  # (holder track per frame (T,), hand index, radius mm, BGR)
+    #: activity truth in story frames (of 150): (kind, start, end, track a, part a, track b, part b)
+    events: list = field(default_factory=list)
 
 
 def _story_time(n: int) -> np.ndarray:
@@ -217,7 +219,8 @@ def _standing(rng, n) -> Script3D:
                      np.stack([-sep, np.full(n, 0.32), np.full(n, 0.72 * H)], 1)], 1)
     hands = hands * (1 - c)[:, None, None] + clap * c[:, None, None]
     yaw = _wander(rng, n, 0.3, 0.1, 0.3)
-    return Script3D([Actor3D(app, pos, heading, yaw, hands)], facing=float(heading[0]))
+    return Script3D([Actor3D(app, pos, heading, yaw, hands)], facing=float(heading[0]),
+                    events=[("clap", 60, 80, 1, "left_hand", 1, "right_hand")])
 
 
 TABLE_H = 740.0
@@ -257,7 +260,7 @@ def _seated(rng, n) -> Script3D:
         for fl, ll in ((0.2, -0.65), (0.2, 0.65), (0.9, 0.65), (0.9, -0.65)):
             corners.append([*(1000 * (fl * F + ll * L)), z])
     return Script3D([Actor3D(app, pos, heading, yaw, hands, seated=True)], facing=float(heading0),
-                    table=np.array(corners))
+                    table=np.array(corners), events=[("clap", 40, 60, 1, "left_hand", 1, "right_hand")])
 
 
 def _handshake(rng, n) -> Script3D:
@@ -301,8 +304,10 @@ def _handshake(rng, n) -> Script3D:
     obj = (holder, np.where(holder == 1, 0, 1), float(rng.uniform(38, 48)),
            tuple(int(v) for v in rng.choice([(40, 160, 60), (170, 90, 40), (50, 50, 60), (40, 200, 220)])))
     actors = [Actor3D(app, pos, hd, _wander(rng, n, 0.25, 0.1, 0.3), hands) for app, pos, hd, hands in actors_h]
+    events = [("handshake", 32, 55, 1, "right_hand", 2, "right_hand"),
+              ("exchange", 90, 104, 1, "left_hand", 2, "right_hand")]
     return Script3D(actors, facing=float(axis - np.pi / 2 if rng.random() < 0.5 else axis + np.pi / 2),
-                    objects=[obj])
+                    objects=[obj], events=events)
 
 
 BUILDERS_3D = {"standing": _standing, "seated": _seated, "handshake": _handshake}
@@ -404,6 +409,9 @@ class MultiScene:
     fps: float
     appearances: tuple = ()
     backgrounds: dict = field(default_factory=dict)  # camera -> the empty scene it sees (the table included)
+    #: activity truth (:data:`partlab.labelling.synth.scene.EVENT_TRUTH_COLUMNS`): the clap, the handshake and
+    #: the exchange, frames where the hands are together
+    events: pd.DataFrame | None = None
 
 
 def _check(name: str, n_cameras: int, seed: int, n_frames: int, width: int, height: int) -> None:
@@ -527,7 +535,21 @@ def make_multiview_scene(name: str, n_cameras: int = 3, seed: int = 0, n_frames:
     truth = normalise_tracks(truth)
     first = truth.groupby("track_id")["frame"].transform("min")
     init = truth[truth["frame"] == first].reset_index(drop=True)
-    return MultiScene(frames, cams, truth, truth3d, init, FPS, tuple(a.appearance for a in script.actors), plates)
+    return MultiScene(frames, cams, truth, truth3d, init, FPS, tuple(a.appearance for a in script.actors), plates,
+                      _events(script, n_frames))
+
+
+def _events(script: Script3D, n: int) -> pd.DataFrame:
+    """The script's activities within the take's ``n`` frames (the story is 150 frames long)."""
+    from partlab.labelling.synth.scene import EVENT_TRUTH_COLUMNS
+
+    rows = []
+    for kind, a, b, ta, pa, tb, pb in script.events:
+        if b < n:
+            colour = script.objects[0][3] if kind == "exchange" and script.objects else None
+            rows.append(dict(kind=kind, start_frame=a, end_frame=b, track_id_a=ta, part_a=pa, track_id_b=tb,
+                             part_b=pb, colour="" if colour is None else "#{:02x}{:02x}{:02x}".format(*colour[::-1])))
+    return pd.DataFrame(rows, columns=list(EVENT_TRUTH_COLUMNS))
 
 
 def hide_camera(scene_dir: str | PathLike, camera: str, start: int, stop: int) -> None:
@@ -639,7 +661,8 @@ def render_take(name: str, outdir: str | PathLike, n_cameras: int = 3, seed: int
     """Render a multi-camera take: ``<cam>.mp4`` per camera, ``calibration.json``, ``truth.csv`` (per
     view, ``camera`` column), ``truth3d.csv``, ``init.csv``, ``scene.json``, ``<cam>_background.png``
     (the empty scene, as the
-    paper's background model is trained on, sec. 6.1) and ``chessboard/``."""
+    paper's background model is trained on, sec. 6.1), ``events.csv`` (the activity truth) and
+    ``chessboard/``."""
     from partlab.labelling.calibration import write_calibration
     from partlab.labelling.video import write_video
     from partlab.tracking.tracks import write_tracks_csv
@@ -654,6 +677,7 @@ def render_take(name: str, outdir: str | PathLike, n_cameras: int = 3, seed: int
     write_tracks_csv(scene.truth, out / "truth.csv")
     write_tracks_csv(scene.init, out / "init.csv")
     scene.truth3d.to_csv(out / "truth3d.csv", index=False, lineterminator="\n")
+    scene.events.to_csv(out / "events.csv", index=False, lineterminator="\n")
     meta = {"name": name, "seed": seed, "fps": scene.fps, "cameras": [c.name for c in scene.cameras],
             "width": width, "height": height, "n_frames": n_frames, "units": "mm",
             "people": [{"track_id": k + 1, "skin": list(p.skin), "shirt": list(p.shirt),

@@ -12,7 +12,9 @@ Scenarios (:data:`TOPVIEW_SCENARIOS`):
 
 * ``topview_s1``: one person in dark clothes moving both arms (the paper's S1);
 * ``topview_s2``: one person in bright, flashy clothes (S2);
-* ``topview_s3``: two people facing each other whose reaching arms cross and overlap (S3).
+* ``topview_s3``: two people facing each other whose reaching arms cross and overlap (S3);
+* ``topview_group``: one to three people side by side at a counter, each with their own sizes,
+  clothes (dark or bright) and motions, seen from 2.7-3.2 m with 0.5-2 times the sensor noise.
 
 :func:`render_topview` writes a take folder that :func:`partlab.labelling.take.open_take` reads::
 
@@ -56,7 +58,11 @@ from partlab.tracking.topview.model import (
 )
 from partlab.tracking.tracks import TrackRecord, records_to_frame
 
-TOPVIEW_SCENARIOS: tuple[str, ...] = ("topview_s1", "topview_s2", "topview_s3")
+TOPVIEW_SCENARIOS: tuple[str, ...] = ("topview_s1", "topview_s2", "topview_s3", "topview_group")
+#: camera height (mm) and sensor noise factor ranges: the paper's 2.9 m for S1-S3; a group is seen
+#: from 2.7-3.2 m (ceilings differ) with a sensor 0.5-2 times as noisy as the reference one
+CAMERA_HEIGHT_MM = {"topview_group": (2700.0, 3200.0)}
+NOISE_FACTOR = {"topview_group": (0.5, 2.0)}
 FPS = 25.0
 #: world size (mm) of the box drawn around each joint's image
 JOINT_BOX_MM = {"head": 190.0, "right_shoulder": 120.0, "left_shoulder": 120.0, "right_elbow": 110.0,
@@ -175,7 +181,26 @@ def _people(name: str, rng, n: int) -> list[Person]:
         sa = _motion(rng, n, a, -ux * gap / 2, -uy * gap / 2, yaw_a, reach=(True, False))
         sb = _motion(rng, n, b, ux * gap / 2, uy * gap / 2, yaw_a + np.pi, reach=(False, True))
         return [Person(a, _looks(rng, rng.random() < 0.5), sa), Person(b, _looks(rng, rng.random() < 0.5), sb)]
+    if name == "topview_group":
+        return _group(rng, n)
     raise ValueError(f"unknown top-view scenario {name!r}; expected one of {', '.join(TOPVIEW_SCENARIOS)}")
+
+
+def _group(rng, n: int) -> list[Person]:
+    """One to three people side by side (shoulder to shoulder 0.75-0.9 m apart), facing about the
+    same way, each moving both arms."""
+    count = int(rng.integers(1, 4))
+    gap = rng.uniform(750, 900)
+    axis = rng.uniform(-0.5, 0.5)
+    ux, uy = np.cos(axis), np.sin(axis)
+    people = []
+    for k in range(count):
+        off = (k - (count - 1) / 2) * gap
+        body = _body(rng)
+        yaw = axis + rng.uniform(-0.3, 0.3) + (np.pi if rng.random() < 0.5 else 0.0)
+        x, y = off * ux + rng.uniform(-60, 60), off * uy + rng.uniform(-60, 60)
+        people.append(Person(body, _looks(rng, rng.random() < 0.5), _motion(rng, n, body, x, y, yaw)))
+    return people
 
 
 # -- ray casting ------------------------------------------------------------------------------
@@ -288,7 +313,7 @@ def joint_box(camera: Camera, point: np.ndarray, size_mm: float) -> Box:
 def make_topview(name: str, seed: int = 0, n_frames: int = 150, width: int = 320, height: int = 240) -> TopViewScene:
     """Render scenario ``name`` (one of :data:`TOPVIEW_SCENARIOS`)."""
     rng = np.random.default_rng([seed, 17])
-    cam_h = rng.uniform(2850, 2950)
+    cam_h = rng.uniform(*CAMERA_HEIGHT_MM.get(name, (2850.0, 2950.0)))
     camera = topview_camera(width, height, cam_h)
     people = _people(name, rng, n_frames)
     dirs = _pixel_rays(camera)
@@ -300,7 +325,7 @@ def make_topview(name: str, seed: int = 0, n_frames: int = 150, width: int = 320
     bx, by = rng.uniform(-1200, 1200), rng.uniform(-900, 900)
     basket = (bx, by, rng.uniform(200, 350), rng.uniform(150, 250), rng.uniform(350, 600))  # x, y, half w, half d, top
     basket_col = np.array(rng.integers(20, 230, 3), np.float32)
-    noise_scale = rng.uniform(0.6, 1.4)
+    noise_scale = rng.uniform(*NOISE_FACTOR.get(name, (0.6, 1.4)))
     step = 2.85e-6 * noise_scale  # disparity step (1/mm): about 6 mm at 1.5 m, 24 mm at 2.9 m
     color = np.zeros((n_frames, height, width, 3), np.uint8)
     depth = np.zeros((n_frames, height, width), np.float32)

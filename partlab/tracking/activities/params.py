@@ -70,13 +70,17 @@ class Decision:
     same_colour: float = number(10.0, POSITIVE)
     # the decision points of a two-hand activity are where the hands are this many hand sides apart
     # (the paper: "separated by a minimum pre-defined distance"), searched up to ``apart_search``
-    # frames before the join and after the separation
+    # frames before the join and after the separation; a pick or place decides where the hand is this
+    # many hand sides from where it stood still (before it came, after it left)
     apart_size: float = number(3.0, POSITIVE)
     apart_search: int = number(40, POSITIVE_COUNT)
     # two hands touch when their centres are at most this many hand sides apart: what the state
     # machine's combined state means (its ``combine_size`` is 1.3), read from the tracks themselves so
     # that a touch the state machine saw as one hand lost still counts
     contact_size: float = number(1.5, POSITIVE)
+    # ... and, with 3D positions (a multi-camera tracker), when their centres are at most this many mm
+    # apart: 1.5 hand sides of an adult hand (about 45 mm radius)
+    contact_mm: float = number(135.0, POSITIVE)
     # joins of the same two hands this close in time are one activity (three claps, a shake with
     # a few contacts): frames between one separation and the next join
     merge_gap: int = number(30, POSITIVE_COUNT)

@@ -140,18 +140,26 @@ def still_moments(centres: dict[int, tuple[float, float, float]], params: Activi
     return [(a, b) for a, b in runs if b - a + 1 >= params.decision.still_frames]
 
 
+def _near(hands: pd.DataFrame, params: ActivityParams) -> tuple[np.ndarray, np.ndarray]:
+    """Per hand row: its centre and how near another hand's centre must be to touch it. With 3D
+    positions (``X, Y, Z`` mm, a multi-camera tracker) the centres are 3D and the reach is
+    ``contact_mm``: two hands one behind the other in a view do not touch. Else the first view's
+    box centres, ``contact_size`` hand sides."""
+    if {"X", "Y", "Z"} <= set(hands.columns) and hands[["X", "Y", "Z"]].notna().all(axis=None):
+        return hands[["X", "Y", "Z"]].to_numpy(float), np.full(len(hands), params.decision.contact_mm / 2)
+    centre = np.stack([(hands["x"] + hands["w"] / 2).to_numpy(), (hands["y"] + hands["h"] / 2).to_numpy()], 1)
+    return centre, params.decision.contact_size * 0.5 * np.maximum(hands["w"], hands["h"]).to_numpy()
+
+
 def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
-    """Frames where two hands touch (centres within ``contact_size`` hand sides, in the first view),
-    as join rows: one per run of touching frames of a pair."""
+    """Frames where two hands touch (:func:`_near`), as join rows: one per run of touching frames of a pair."""
     cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
     hands = tracks[tracks["part"].isin(HAND_PARTS)]
     if "camera" in hands.columns and (hands["camera"] != "").any():
         hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
     if hands.empty:
         return pd.DataFrame(columns=cols)
-    cx = (hands["x"] + hands["w"] / 2).to_numpy()
-    cy = (hands["y"] + hands["h"] / 2).to_numpy()
-    side = np.maximum(hands["w"], hands["h"]).to_numpy()
+    centre, reach = _near(hands, params)
     frame, tid, part = hands["frame"].to_numpy(), hands["track_id"].to_numpy(), hands["part"].to_numpy()
     touching: dict[tuple, list[int]] = defaultdict(list)
     order = np.argsort(frame, kind="stable")
@@ -160,7 +168,7 @@ def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
         for i in range(len(idx)):
             for j in range(i + 1, len(idx)):
                 p, q = idx[i], idx[j]
-                if np.hypot(cx[p] - cx[q], cy[p] - cy[q]) <= params.decision.contact_size * 0.5 * (side[p] + side[q]):
+                if np.linalg.norm(centre[p] - centre[q]) <= reach[p] + reach[q]:
                     key = tuple(sorted(((int(tid[p]), str(part[p])), (int(tid[q]), str(part[q])))))
                     touching[key].append(int(frame[p]))
     rows = []
@@ -204,8 +212,8 @@ def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, 
                   params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
     """The two decision windows of a join: ending at the last frame before ``start`` and starting at
     the first frame after ``end`` where the hands are ``apart_size`` hand sides apart (the gap
-    windows of :func:`_windows` where they never are). The activity lasts from the first to the
-    second decision point."""
+    windows of :func:`_windows` where they never are). The activity itself is reported over the
+    touch (the join's frames), where annotators put it."""
     d = params.decision
 
     def apart(f: int) -> bool:
@@ -224,6 +232,31 @@ def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, 
     return (b0, b1), (a0, a1)
 
 
+def moved_windows(centres: Mapping[int, tuple], s0: int, s1: int,
+                  params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
+    """The decision windows of a still moment ``s0..s1`` (a pick or a place): ending where the hand,
+    coming in, was last ``apart_size`` hand sides from where it stopped, and starting where it is
+    that far from where it left (searched up to ``apart_search`` frames; the gap windows of
+    :func:`_windows` where it never is). Right after a place the hand is still beside the object it
+    put down, which would read as still holding it; a hand's length away it no longer is."""
+    d = params.decision
+    (b0, b1), (a0, a1) = _windows(s0, s1, params)
+
+    def away(f: int, ref: int) -> bool:
+        if f not in centres or ref not in centres:
+            return False
+        (x, y, _), (rx, ry, side) = centres[f], centres[ref]
+        return np.hypot(x - rx, y - ry) >= d.apart_size * side
+
+    before = next((f for f in range(s0 - 1, s0 - d.apart_search, -1) if away(f, s0)), None)
+    after = next((f for f in range(s1 + 1, s1 + d.apart_search) if away(f, s1)), None)
+    if before is not None:
+        b0, b1 = before - d.window, before
+    if after is not None:
+        a0, a1 = after, after + d.window
+    return (b0, b1), (a0, a1)
+
+
 def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityParams,
                clothes: Mapping[int, np.ndarray]) -> tuple[list[dict], dict[Key, list]]:
     rows, busy = [], defaultdict(list)
@@ -235,19 +268,39 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
             (b0, b1), (a0, a1) = apart_windows(centres.get(a, {}), centres.get(b, {}), start, end, params)
-            base.update(start_frame=min(start, b1 + 1), end_frame=max(end, a0 - 1))
             worn = np.union1d(clothes.get(a[0], np.zeros(0, int)), clothes.get(b[0], np.zeros(0, int)))
             seen = [_without(_held(colours.get(k, {}), lo, hi, params), worn)
                     for k in (a, b) for lo, hi in ((b0, b1), (a0, a1))]
             if all(s is not None for s in seen):
                 ab, aa, bb, ba = seen
                 v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
+                if v.kind == "exchange" and a[0] == b[0]:
+                    continue  # an object moved from one of a person's hands to the other: no activity of Table 1
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
                             object_colour="" if v.colour is None else hue_to_hex(v.colour))
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
                 base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
         rows.append(base)
     return rows, busy
+
+
+def _distinct(rows: list[dict]) -> list[dict]:
+    """One activity where several pairs of hands report the same one: of rows of one kind that share
+    a hand and overlap by more than half (temporal IoU), the most confident (a person's right hand
+    meets the other's right and left hand in the same exchange)."""
+    kept: list[dict] = []
+    for r in sorted(rows, key=lambda r: -r["confidence"]):
+        hands = {(r["track_id_a"], r["part_a"]), (r["track_id_b"], r["part_b"])} - {(0, "")}
+        span = (r["start_frame"], r["end_frame"])
+        if not any(k["kind"] == r["kind"] and hands & {(k["track_id_a"], k["part_a"]), (k["track_id_b"], k["part_b"])}
+                   and _iou(span, (k["start_frame"], k["end_frame"])) > 0.5 for k in kept):
+            kept.append(r)
+    return kept
+
+
+def _iou(a: tuple[int, int], b: tuple[int, int]) -> float:
+    inter = min(a[1], b[1]) - max(a[0], b[0]) + 1
+    return max(inter, 0) / (max(a[1], b[1]) - min(a[0], b[0]) + 1)
 
 
 def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, list[HandColour]]],
@@ -262,7 +315,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
         for s0, s1 in still_moments(cs, params):
             if any(s0 <= e + d.gap + d.window and s1 >= b - d.gap - d.window for b, e in busy.get(key, ())):
                 continue  # part of a two-hand activity
-            (b0, b1), (a0, a1) = _windows(s0, s1, params)
+            (b0, b1), (a0, a1) = moved_windows(cs, s0, s1, params)
             worn = clothes.get(key[0], np.zeros(0, int))
             before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
                              for lo, hi in ((b0, b1), (a0, a1)))
@@ -273,6 +326,6 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
                                  confidence=round(v.margin, 3)))
-    out = pd.DataFrame(rows, columns=list(ACTIVITY_COLUMNS))
+    out = pd.DataFrame(_distinct(rows), columns=list(ACTIVITY_COLUMNS))
     out = out[(out["confidence"] >= params.decision.min_confidence) | (out["kind"] == "hand_head")]
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)

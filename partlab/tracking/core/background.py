@@ -14,7 +14,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from partlab.tracking.params import BodyParams
+from partlab.tracking.body.params import BodyParams  # not partlab.tracking.params: no limb parameters to import
 
 
 def _ellipse(size: int) -> np.ndarray | None:

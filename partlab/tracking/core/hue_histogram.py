@@ -16,6 +16,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from partlab.tracking.core import kernels
+
 
 def hue_bin_image(hsv: np.ndarray, bins: int, min_saturation: int, min_value: int) -> np.ndarray:
     """``(H, W) int16`` hue bin of every pixel of an HSV frame; -1 where the pixel is too grey or dark."""
@@ -51,6 +53,37 @@ def box_histograms(integral: np.ndarray, boxes: np.ndarray) -> np.ndarray:
     total = counts.sum(axis=1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(total > 0, counts / np.maximum(total, 1e-12), 0.0)
+
+
+def local_box_histograms(bin_image: np.ndarray, boxes: np.ndarray, bins: int) -> np.ndarray:
+    """:func:`box_histograms` of ``boxes (N, 4)`` over ``bin_image (H, W)`` (-1 = no bin), from an
+    integral histogram of only the region the boxes cover.
+
+    One filter's particles cover a few times its box; the whole frame's integral histogram
+    (``bins`` planes of the frame) cost more than the rest of the limb tracker on PETS09
+    (768 x 576). The counts, and so the histograms, are the same as from the whole frame's
+    (compiled: counted box by box, :func:`partlab.tracking.core.kernels.box_bin_counts`).
+    """
+    hgt, wid = bin_image.shape
+    b = np.asarray(boxes, dtype=float).reshape(-1, 4)
+    if len(b) == 0:
+        return np.zeros((0, bins))
+    x1 = np.clip(np.round(b[:, 0]), 0, wid).astype(int)
+    y1 = np.clip(np.round(b[:, 1]), 0, hgt).astype(int)
+    x2 = np.clip(np.round(b[:, 0] + b[:, 2]), 0, wid).astype(int)
+    y2 = np.clip(np.round(b[:, 1] + b[:, 3]), 0, hgt).astype(int)
+    if kernels.HAVE_NUMBA:
+        counts = kernels.box_bin_counts(np.ascontiguousarray(bin_image, np.int16),
+                                        np.column_stack([x1, y1, x2, y2]).astype(np.int64), int(bins))
+        total = counts.sum(axis=1, keepdims=True)
+        return np.where(total > 0, counts / np.maximum(total, 1e-12), 0.0)
+    ox, oy = int(x1.min()), int(y1.min())
+    crop = bin_image[oy:max(int(y2.max()), oy), ox:max(int(x2.max()), ox)]
+    integral = np.zeros((bins, crop.shape[0] + 1, crop.shape[1] + 1), np.int32)
+    if crop.size:
+        onehot = (crop[None, :, :] == np.arange(bins, dtype=crop.dtype)[:, None, None]).astype(np.int32)
+        integral[:, 1:, 1:] = onehot.cumsum(axis=1).cumsum(axis=2)
+    return box_histograms(integral, np.column_stack([x1 - ox, y1 - oy, x2 - x1, y2 - y1]))
 
 
 def bhattacharyya_distance(hists: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -103,3 +136,24 @@ def mean_shift(backproj: np.ndarray, box, iterations: int, eps: float) -> tuple[
     crit = (cv2.TERM_CRITERIA_EPS | cv2.TERM_CRITERIA_COUNT, int(iterations), float(eps))
     _, (nx, ny, _, _) = cv2.meanShift(backproj, window, crit)
     return (float(x + nx - x_i), float(y + ny - y_i), float(w), float(h))
+
+
+def local_mean_shift(bin_image: np.ndarray, ref: np.ndarray, box, iterations: int, eps: float,
+                     margin: float = 2.0) -> tuple[float, float, float, float]:
+    """:func:`mean_shift` of ``box`` on the back-projection of ``ref``, computed only over the box
+    grown by ``margin`` of its larger side on every side (seed 003 sec. 3).
+
+    The window moves at most half its size a step and stops at the nearest peak, so it never
+    needs the rest of the frame; back-projecting the whole frame for every target cost ten
+    times the rest of the refinement on PETS09 (768 x 576). The result equals the whole-frame
+    one unless the window would climb more than ``margin`` sides away.
+    """
+    hgt, wid = bin_image.shape
+    x, y, w, h = (float(v) for v in box)
+    m = margin * max(w, h, 1.0)
+    x1, y1 = max(int(np.floor(x - m)), 0), max(int(np.floor(y - m)), 0)
+    x2, y2 = min(int(np.ceil(x + w + m)), wid), min(int(np.ceil(y + h + m)), hgt)
+    if x2 <= x1 or y2 <= y1:
+        return (x, y, w, h)
+    nx, ny, _, _ = mean_shift(back_projection(bin_image[y1:y2, x1:x2], ref), (x - x1, y - y1, w, h), iterations, eps)
+    return (nx + x1, ny + y1, w, h)

@@ -27,6 +27,12 @@ class Appearance:
     # the hands' reference is the face's colour (sec. 4): the inner part of the face box, which
     # leaves out the hair at its top and the background at its sides
     face_inner: tuple[float, float] = pair((0.6, 0.6))
+    # the share of a hand's box that the hand covers: the reference is the face's skin hue times
+    # this plus the "other" bin (no hue, or not in front of the face) times the rest, so that the
+    # window whose skin share matches it scores best and the scale alpha is observed (a pure-skin
+    # reference prefers any window inside the hand, the smallest alpha). pi/4 (a disc in its
+    # square; a fist is about that, an open hand with spread fingers less)
+    hand_fill: float = number(0.785, FRACTION)
 
 
 @dataclass(frozen=True)
@@ -111,10 +117,13 @@ class Reacquisition:
     scale_factor: float = number(1.1)
     min_neighbors: int = number(4, POSITIVE_COUNT)
     min_face: int = number(16, POSITIVE_COUNT)
-    # "if average confidence of samples exceeds the threshold ... initialisation is successful"
-    hand_confidence: float = number(0.1)
+    # "if average confidence of samples exceeds the threshold ... initialisation is successful".
+    # Both hand thresholds sit above what a window with no hand pixel at all scores against the
+    # hands' reference, exp(-lam (1 - sqrt(1 - hand_fill))) = 0.04 at the defaults; a window a
+    # fifth of whose pixels are the hand's skin scores about 0.3, the hand's own window 1
+    hand_confidence: float = number(0.2)
     # a hand whose best sample stays under this for hand_frames frames is re-initialised
-    hand_lost: float = number(0.02)
+    hand_lost: float = number(0.1)
     hand_frames: int = number(5, POSITIVE_COUNT)
     # a hand's reference size from the face box when no hand box is given (hand : face width)
     hand_size: float = number(0.7)
@@ -141,6 +150,11 @@ class Posture:
     # widths) under which a candidate "matches its corresponding point in the depth map"
     elbow_candidates: int = number(72, POSITIVE_COUNT)
     elbow_tolerance: float = number(0.6)
+    # the arm model: points sampled along each of the upper arm and forearm of a candidate
+    arm_samples: int = number(8, POSITIVE_COUNT)
+    # the factors tried on the arms' proportions (each person's arms fitted to the depth over the
+    # clip, posture.ArmFit): adults' arm-to-head ratios spread by several per cent
+    arm_scales: tuple[float, ...] = pair((0.88, 0.94, 1.0, 1.06, 1.12), n=5)
     # sec. 5's "rough range of elbow ... according to human kinetics": an elbow is not more than this
     # above its shoulder, nor more than this nearer the body's midline than its shoulder (head widths);
     # without it, candidates in front of the chest match the chest's depth as well as the arm's

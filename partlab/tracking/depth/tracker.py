@@ -38,7 +38,7 @@ from partlab.tracking.core.hue_histogram import (
 )
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthParams
-from partlab.tracking.depth.posture import head_width, recover
+from partlab.tracking.depth.posture import ArmFit, head_width, recover
 from partlab.tracking.depth.regions import HandRegion, depth_foreground, face_depth, hand_regions
 from partlab.tracking.depth.sampling import draw_importance, icondensation_correction
 from partlab.tracking.frame import FrameSet
@@ -59,6 +59,27 @@ def haar_faces(params) -> FaceDetector:
         return [tuple(int(v) for v in f) for f in found]
 
     return detect
+
+
+def _in_frame(box, size) -> tuple[float, float, float, float] | None:
+    """A window ``x, y, w, h`` clipped to the image (the filter's state may reach past its edge
+    when a hand leaves the field of view); None when nothing of it is inside."""
+    x, y, w, h = box
+    x1, y1 = max(x, 0.0), max(y, 0.0)
+    x2, y2 = min(x + w, float(size[0])), min(y + h, float(size[1]))
+    return (x1, y1, x2 - x1, y2 - y1) if x2 > x1 and y2 > y1 else None
+
+
+def hand_reference(bins: np.ndarray, skin_box, hue_bins: int, fill: float) -> np.ndarray | None:
+    """``(hue_bins + 1,)`` the hands' reference (sec. 4: the face's colour): the hue histogram of
+    ``skin_box`` (grey pixels in the last, *other* bin) times ``fill``, plus ``1 - fill`` in the
+    other bin, the share of a hand's window that is not hand (``Appearance.hand_fill``)."""
+    face = reference_histogram(np.where(bins >= 0, bins, hue_bins), skin_box, hue_bins + 1)
+    if face is None:
+        return None
+    other = np.zeros(hue_bins + 1)
+    other[hue_bins] = 1.0
+    return fill * face + (1.0 - fill) * other
 
 
 def default_camera(width: int, height: int) -> Camera:
@@ -107,6 +128,7 @@ class DepthTracker:
                 rows = init[(init["track_id"] == self.track_id) & (init["frame"] == self.start_frame)]
                 self._init_boxes = {r.part: (float(r.x), float(r.y), float(r.w), float(r.h)) for r in rows.itertuples()}
         self.hands = {h: _Hand(h, np.zeros(2)) for h in HANDS}
+        self.arms = ArmFit(params.posture)  # the person's arm lengths, fitted over the clip (sec. 5)
         self.stats = _Stats()
         self.events = None
 
@@ -152,11 +174,28 @@ class DepthTracker:
 
     # -- sec. 4: the hands -----------------------------------------------------------------------
     def _hand_reference(self, bins) -> np.ndarray | None:
-        """The hands' reference: the hue of the face box's inner part (sec. 4)."""
+        """The hands' reference: the hue of the face box's inner part (sec. 4), over the hue bins
+        plus the *other* bin (:meth:`_hand_bins`; grey pixels of the face count there)."""
         x, y, w, h = self.face.box()
         iw, ih = self.params.appearance.face_inner
         inner = (x + w * (1 - iw) / 2, y + h * (1 - ih), w * iw, h * ih)  # lower middle: skin, no hair
-        return reference_histogram(bins, inner, self.params.appearance.hue_bins)
+        return hand_reference(bins, inner, self.params.appearance.hue_bins, self.params.appearance.hand_fill)
+
+    def _hand_bins(self, bins, depth, fd) -> np.ndarray:
+        """The hands' bin image: hue bins, and one *other* bin (index ``hue_bins``) for pixels with
+        no hue and, with depth, for pixels not in front of the face's plane (sec. 4 constraint 1).
+
+        Leaving such pixels out of the histogram (as eq. 1-2 do for grey pixels) makes every window
+        that holds the hand score alike, however large: the scale alpha then drifts freely and the
+        box outgrows the hand (seed 002's box rule fails with the centre on the hand). Counted in a
+        bin the reference (the face's skin) hardly has, they lower the confidence of a window by the
+        share of it that is not hand, as background of another hue does in colour alone."""
+        nb = self.params.appearance.hue_bins
+        keep = bins >= 0
+        if fd is not None and self.params.depth.depth_foreground:
+            with np.errstate(invalid="ignore"):
+                keep &= depth < fd.mean - self.params.depth.hand_gap * fd.width_mm
+        return np.where(keep, bins, nb).astype(bins.dtype)
 
     def _assign(self, regions: list[HandRegion]) -> None:
         """Give each hand the candidate region nearest its prediction (both hands jointly; the
@@ -238,6 +277,7 @@ class DepthTracker:
         p, d = self.params, self.params.dynamics
         f = h.filter
         noise = d.hand_noise * h.size[0]
+        held = (f.pos.copy(), f.estimate.copy())
         predicted = f.predicted(d.velocity_decay)[:, :2].copy()
         f.propagate(d.velocity_decay, noise, d.alpha_noise)
         correction = None
@@ -259,11 +299,57 @@ class DepthTracker:
             f.refine(backproj, p.refinement.iterations, p.refinement.eps)
         f.resample()
         if f.conf.max() < p.reacquisition.hand_lost:
+            # nothing like a hand anywhere the samples went (hidden, or out of the frame): hold the
+            # last state, without velocity, where the hand was last seen instead of coasting on
+            # across the image (a coasting filter reached the other hand and stayed on it)
+            f.pos, f.estimate = held
+            f.vel[:] = 0.0
             h.low += 1
             if h.low >= p.reacquisition.hand_frames:
                 h.initialised = False
         else:
             h.low = 0
+
+    def _hands(self, bins, depth, fd, fbox) -> None:
+        """Sec. 4 for both hands: start (or restart) the uninitialised ones, track the others."""
+        p = self.params
+        ref = self._hand_reference(bins)
+        if ref is None:
+            return
+        nb = p.appearance.hue_bins
+        hand_bins = self._hand_bins(bins, depth, fd)
+        hand_integral = integral_histogram(hand_bins, nb + 1)
+        backproj = None
+        if p.refinement.mean_shift:
+            weight = (hand_bins < nb).astype(np.float32)
+            x, y, w, h = (int(round(v)) for v in fbox)  # the face is not a hand
+            weight[max(y, 0):max(y + h, 0), max(x, 0):max(x + w, 0)] = 0.0
+            backproj = back_projection(bins, ref[:nb], weight)
+        done = None
+        for hand in self._hand_order():
+            integ = hand_integral if done is None else self._exclude(hand_bins, done, nb)
+            if not hand.initialised:
+                self._start_hand(hand, bins, integ, ref)
+            elif hand.filter is not None:
+                hand.filter.ref = ref
+                self._track_hand(hand, integ, backproj)
+            if hand.initialised and hand.low == 0:
+                done = hand.filter.box()
+
+    def _hand_order(self) -> list[_Hand]:
+        """The hands, the one tracked with the best confidence first (sec. 4's one region per hand,
+        as an exclusion: what one hand's window holds is not the other hand's)."""
+        def key(h: _Hand) -> float:
+            return -float(h.filter.conf.max()) if (h.initialised and h.filter is not None) else 1.0
+        return sorted(self.hands.values(), key=key)
+
+    @staticmethod
+    def _exclude(hand_bins: np.ndarray, box, nb: int) -> np.ndarray:
+        """The hands' integral histogram with ``box`` (the other hand's window) counted as *other*."""
+        x, y, w, h = (int(round(v)) for v in box)
+        masked = hand_bins.copy()
+        masked[max(y, 0):max(y + h, 0), max(x, 0):max(x + w, 0)] = nb
+        return integral_histogram(masked, nb + 1)
 
     # -- the loop ----------------------------------------------------------------------------------
     def _first_face(self, color, depth, bins, integral, camera) -> bool:
@@ -330,30 +416,24 @@ class DepthTracker:
                    if fd is not None and p.depth.importance_sampling else [])
         self._assign(regions)
         # 3. the hands, observed in front of the face's plane (sec. 4 constraint 1) when depth is used
-        ref = self._hand_reference(bins)
-        hand_integral = integral
-        if fd is not None and p.depth.depth_foreground:
-            with np.errstate(invalid="ignore"):
-                near = depth < fd.mean - p.depth.hand_gap * fd.width_mm
-            hand_integral = integral_histogram(np.where(near, bins, -1).astype(bins.dtype), ap.hue_bins)
-        if ref is not None:
-            weight = np.ones(bins.shape, np.float32) if fg is None else (
-                (depth < fd.mean - p.depth.hand_gap * fd.width_mm).astype(np.float32))
-            x, y, w, h = (int(round(v)) for v in fbox)  # the face is not a hand
-            weight[max(y, 0):max(y + h, 0), max(x, 0):max(x + w, 0)] = 0.0
-            backproj = back_projection(bins, ref, weight) if p.refinement.mean_shift else None
-            for hand in self.hands.values():
-                if not hand.initialised:
-                    self._start_hand(hand, bins, hand_integral, ref)
-                elif hand.filter is not None:
-                    hand.filter.ref = ref
-                    self._track_hand(hand, hand_integral, backproj)
+        self._hands(bins, depth, fd, fbox)
         # 4. posture and rows
         hand_boxes = [self.hands[n].filter.box() if self.hands[n].initialised else None for n in HANDS]
         if self.head_mm is None:
             self.head_mm = head_width(camera, depth, fbox, p.posture)
-        pose = recover(camera, depth, fbox, hand_boxes, p.posture, self.head_mm)
+        pose = recover(camera, depth, fbox, [self._seen(n, b, camera) for n, b in zip(HANDS, hand_boxes)],
+                       p.posture, self.head_mm, self.arms)
         return self._rows(index, view.stream, camera, fbox, hand_boxes, pose)
+
+    def _seen(self, name: str, box, camera) -> tuple | None:
+        """The hand's box for the posture when the hand is seen now: tracked with confidence (not
+        held, :meth:`_track_hand`) and at least half of its window inside the frame; else None
+        (no 3D point, no elbow: a stale or cut-off hand would place the arm wrongly)."""
+        h = self.hands[name]
+        if box is None or h.low > 0:
+            return None
+        shown = _in_frame(box, tuple(camera.size))
+        return box if shown is not None and shown[2] * shown[3] >= 0.5 * box[2] * box[3] else None
 
     def _rows(self, index, stream, camera, fbox, hand_boxes, pose) -> list[TrackRecord]:
         tid = self.track_id
@@ -362,11 +442,13 @@ class DepthTracker:
             X, Y, Z = (float(v) for v in point) if point is not None else (float("nan"),) * 3
             return TrackRecord(index, tid, part, Box(*box), score=score, state=state, camera=stream, X=X, Y=Y, Z=Z)
 
-        rows = [rec("head", fbox, pose.head if pose else None, float(self.face.conf.max()))]
+        size = tuple(camera.size)
+        rows = [rec("head", _in_frame(fbox, size) or fbox, pose.head if pose else None, float(self.face.conf.max()))]
         for name, box in zip(HANDS, hand_boxes):
-            if box is None:
+            shown = _in_frame(box, size) if box is not None else None
+            if shown is None:  # a hand held outside the frame is not a box anyone can check
                 continue
-            rows.append(rec(name, box, getattr(pose, name) if pose else None,
+            rows.append(rec(name, shown, getattr(pose, name) if pose else None,
                             float(self.hands[name].filter.conf.max())))
         if pose is None:
             return rows

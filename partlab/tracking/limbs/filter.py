@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from partlab.tracking.core.hue_histogram import box_histograms, hue_confidence, mean_shift
+from partlab.tracking.core.hue_histogram import hue_confidence, local_box_histograms, local_mean_shift
 from partlab.tracking.core.resampling import systematic_resample
 from partlab.tracking.core.skin import Blobs
 from partlab.tracking.params import LimbParams
@@ -50,28 +50,42 @@ class Candidates:
 
 def silhouette_term(centres: np.ndarray, foreground: np.ndarray | None, sigma_s: float) -> np.ndarray:
     """``exp(-Ds^2 / (2 sigma_s^2))`` with ``Ds`` the distance of each centre to the foreground
-    silhouette (seed 000 eq. 27, one camera); all ones without a foreground mask."""
+    silhouette (seed 000 eq. 27, one camera); all ones without a foreground mask.
+
+    ``Ds`` is measured within ``4 sigma_s`` of each centre (farther, the term is under 3e-4 and
+    is taken as 0): a centre on the silhouette costs one lookup, not a distance transform of the
+    frame."""
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)
     if foreground is None or centres.size == 0:
         return np.ones(len(centres))
     fg = np.asarray(foreground) > 0
-    if not fg.any():
-        return np.zeros(len(centres))
-    dist = cv2.distanceTransform((~fg).astype(np.uint8), cv2.DIST_L2, 3)
     hgt, wid = fg.shape
     xs = np.clip(np.round(centres[:, 0]).astype(int), 0, wid - 1)
     ys = np.clip(np.round(centres[:, 1]).astype(int), 0, hgt - 1)
-    d = dist[ys, xs]
-    return np.exp(-(d * d) / (2.0 * sigma_s**2))
+    reach = max(int(np.ceil(4 * sigma_s)), 1)
+    out = np.zeros(len(centres))
+    for k, (x, y) in enumerate(zip(xs, ys)):
+        if fg[y, x]:
+            out[k] = 1.0
+            continue
+        x1, y1 = max(x - reach, 0), max(y - reach, 0)
+        win = fg[y1:min(y + reach + 1, hgt), x1:min(x + reach + 1, wid)]
+        if win.any():
+            d = cv2.distanceTransform((~win).astype(np.uint8), cv2.DIST_L2, 3)[y - y1, x - x1]
+            out[k] = np.exp(-(d * d) / (2.0 * sigma_s**2)) if d <= reach else 0.0
+    return out
 
 
 def skin_term(blobs: Blobs, skin_probability: np.ndarray | None) -> np.ndarray:
     """Mean skin probability over each blob's pixels: how good the observation is (role of p_o)."""
     if skin_probability is None or len(blobs) == 0:
         return np.ones(len(blobs))
-    sums = np.bincount(blobs.labels.ravel(), weights=np.asarray(skin_probability, float).ravel(),
-                       minlength=int(blobs.ids.max()) + 1)
-    return np.clip(sums[blobs.ids] / np.maximum(blobs.areas, 1.0), 0.0, 1.0)
+    prob = np.asarray(skin_probability)
+    out = np.empty(len(blobs))
+    for k, ((x, y, w, h), i) in enumerate(zip(blobs.boxes.astype(int), blobs.ids)):
+        own = blobs.labels[y:y + h, x:x + w] == i
+        out[k] = float(prob[y:y + h, x:x + w][own].sum())
+    return np.clip(out / np.maximum(blobs.areas, 1.0), 0.0, 1.0)
 
 
 def candidate_terms(blobs: Blobs, foreground: np.ndarray | None, skin_probability: np.ndarray | None,
@@ -243,8 +257,9 @@ class LimbFilter:
         return np.column_stack([self.particles[:, 0] - w / 2, self.particles[:, 1] - h / 2,
                                 np.full(len(self.particles), w), np.full(len(self.particles), h)])
 
-    def weigh(self, candidates: Candidates, integral: np.ndarray) -> np.ndarray:
-        """Weights = blob likelihood (eq. 17) x hue confidence (seed 003 eq. 1) + a floor.
+    def weigh(self, candidates: Candidates, bin_image: np.ndarray) -> np.ndarray:
+        """Weights = blob likelihood (eq. 17) x hue confidence (seed 003 eq. 1) + a floor; the hue
+        histograms of the particles' boxes over ``bin_image`` (hue bins of skin pixels, -1 elsewhere).
 
         The floor is added, not multiplied by the hue term: a filter whose blob vanished
         then diffuses around its last place instead of being drawn to another limb's skin.
@@ -254,7 +269,8 @@ class LimbFilter:
         """
         p = self.params
         blob = np.minimum(blob_likelihood(self.particles[:, :2], candidates, p.priors.sigma_xy), 1.0)
-        hue = hue_confidence(box_histograms(integral, self.particle_boxes()), self.ref_hist, p.appearance.lam)
+        hist = local_box_histograms(bin_image, self.particle_boxes(), p.appearance.hue_bins)
+        hue = hue_confidence(hist, self.ref_hist, p.appearance.lam)
         score = blob * hue
         self.confidence = float(score.max()) if score.size else 0.0
         w = score + p.priors.blob_floor
@@ -263,13 +279,15 @@ class LimbFilter:
         self.estimate = (self.weights[:, None] * self.particles[:, :2]).sum(axis=0)
         return self.weights
 
-    def refine(self, backproj: np.ndarray | None) -> None:
-        """Mean shift from the PF mean on the back-projection, then shift the samples
-        by the same amount (seed 003 sec. 3: "redistribute the samples")."""
+    def refine(self, bin_image: np.ndarray | None) -> None:
+        """Mean shift from the PF mean on the back-projection of the reference over the hue bins
+        ``bin_image`` (skin pixels; -1 elsewhere), then shift the samples by the same amount (seed 003
+        sec. 3: "redistribute the samples")."""
         p = self.params
-        if backproj is None or p.appearance.mean_shift_iterations <= 0:
+        if bin_image is None or p.appearance.mean_shift_iterations <= 0:
             return
-        x, y, w, h = mean_shift(backproj, self.box(), p.appearance.mean_shift_iterations, p.appearance.mean_shift_eps)
+        x, y, w, h = local_mean_shift(bin_image, self.ref_hist, self.box(), p.appearance.mean_shift_iterations,
+                                      p.appearance.mean_shift_eps)
         self.shift_to((x + w / 2, y + h / 2))
 
     def shift_to(self, centre) -> None:

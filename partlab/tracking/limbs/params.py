@@ -12,7 +12,8 @@ parameters here. ``LimbParams`` is stored by model bundles under the key ``"limb
 - ``blobs``: which skin blobs become candidates, and the arm ends hands see;
 - ``states``: the five-state machine (sec. 5.2);
 - ``labels``: which target is a head, a left or a right hand (sec. 7.1);
-- ``adjustment``: re-acquiring a lost head with the face detector (Xu, Deng & Jia sec. 3).
+- ``adjustment``: re-acquiring a lost head with the face detector (Xu, Deng & Jia sec. 3);
+- ``people``: where people are, for trackers started without ``--init`` (issue 13).
 
 docs/parameters.md lists every field with its default and why.
 """
@@ -197,6 +198,30 @@ class LimbAdjustment:
 
 
 @dataclass(frozen=True)
+class LimbPeople:
+    """Where people are, for trackers started without ``--init`` (``partlab.tracking.limbs.people``):
+    limbs start, are labelled, are written and live only on person regions."""
+
+    # a foreground component at least this fraction of the frame tall is a person region: PETS09's
+    # farthest walkers are ~0.09 of the frame, a seated person at a desk ~0.5; road cones,
+    # flickering wall patches and grass tufts are under 0.04
+    min_height: float = number(0.06, FRACTION)
+    # closing kernel (fraction of the frame height) joining a walker's legs, body and head into one
+    # component: ~9 px on 576 lines, about a walker's leg gap
+    close: float = number(0.015, FRACTION)
+    # ... on the foreground shrunk by this factor (a region's box needs no finer grain)
+    shrink: int = number(4, POSITIVE_COUNT)
+    # a head is labelled and written only in the top quarter of a person region: a standing
+    # person's head centre lies at about a fourteenth of their height from the top (PETS09 truth:
+    # 0.06-0.1), a seated one's lower; the top third also let through red sleeves at mid-chest
+    # (PETS frames 0-199, --seed 1: limb heads on a truth person's top third 0.74 at 1/3, 0.80 at 0.2)
+    head_top: float = number(0.25, FRACTION)
+    # frames off every person region after which an automatically started tracker ends; ~2 s at
+    # PETS09's 7 fps: a walker's silhouette breaks up behind a pillar for about that long
+    end_frames: int = number(15, POSITIVE_COUNT)
+
+
+@dataclass(frozen=True)
 class LimbParams(Parameters):
     """Parameters of the head-and-hands tracker, by what they tune."""
 
@@ -210,6 +235,7 @@ class LimbParams(Parameters):
     states: LimbStates = group_field(LimbStates)
     labels: LimbLabels = group_field(LimbLabels)
     adjustment: LimbAdjustment = group_field(LimbAdjustment)
+    people: LimbPeople = group_field(LimbPeople)
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {
@@ -262,4 +288,9 @@ class LimbParams(Parameters):
         "head_guess_frames": "labels.head_guess_frames",
         "reacquire_frames": "adjustment.reacquire_frames",
         "reacquire_confidence": "adjustment.reacquire_confidence",
+        "people_min_height": "people.min_height",
+        "people_close": "people.close",
+        "people_shrink": "people.shrink",
+        "people_head_top": "people.head_top",
+        "people_end_frames": "people.end_frames",
     }

@@ -163,6 +163,13 @@ class LimbStateMachine:
                              f"{self._status[tracker].state.value}")
         del self._status[tracker]
 
+    def end(self, tracker: int) -> None:
+        """Forget a tracker that is not combined (its track ended); its past events stay."""
+        if self._status[tracker].state == LimbState.COMBINED:
+            raise ValueError(f"tracker {tracker} is combined: end its pair first")
+        del self._status[tracker]
+        self._sizes.pop(tracker, None)
+
     def trackers(self) -> list[int]:
         return list(self._status)
 

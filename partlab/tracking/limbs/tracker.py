@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.tracking.core.box import Box
-from partlab.tracking.core.hue_histogram import back_projection, hue_bin_image, integral_histogram, reference_histogram
+from partlab.tracking.core.hue_histogram import hue_bin_image, reference_histogram
 from partlab.tracking.core.skin import Blobs, SkinModel, find_blobs, train_skin_model
 from partlab.tracking.limbs.filter import (
     Candidates,
@@ -43,6 +43,7 @@ from partlab.tracking.limbs.filter import (
     nearest_per_parent,
     tip_candidates,
 )
+from partlab.tracking.limbs.people import foreground_people, in_regions, merge_boxes, on_regions
 from partlab.tracking.limbs.state_machine import (
     JoinEvent,
     LimbState,
@@ -59,6 +60,11 @@ EVENT_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_id_
                                   "track_id_b", "part_b", "ended_by")
 
 FACE_CASCADE_FILE = "haarcascade_frontalface_default.xml"
+#: side of the frontal-face cascade's window (pixels): it finds no smaller face
+FACE_WINDOW = 24
+#: smallest head box (pixels) whose face the cascade can find: a face's skin fills about 0.75 of
+#: the cascade's box, so a smaller head's face is under its window (PETS09's heads, 8-16 px)
+FACE_MIN_SIDE = 0.75 * FACE_WINDOW
 
 
 def load_face_detector() -> cv2.CascadeClassifier | None:
@@ -114,6 +120,7 @@ class _Target:
     shown: np.ndarray | None = None  # combined: the position written for this member
     anchor: np.ndarray | None = None  # the person's head estimate when ``last`` was taken
     prev: np.ndarray | None = None  # normal: the estimate one frame before (the hand's velocity)
+    off: int = 0  # found automatically: frames in a row off every person region
 
     @property
     def labelled(self) -> bool:
@@ -133,12 +140,13 @@ def _check_frame(frame: np.ndarray, foreground: np.ndarray | None) -> np.ndarray
 @dataclass(frozen=True)
 class _View:
     """One frame's observations: skin ``blobs``, their candidates ``cands``, the hue bin of every
-    skin pixel ``skin_bins (H, W) int16`` (-1 elsewhere) and its integral histogram."""
+    skin pixel ``skin_bins (H, W) int16`` (-1 elsewhere); found automatically, the person regions
+    ``people (P, 4)`` (:mod:`partlab.tracking.limbs.people`), else None."""
 
     blobs: Blobs
     cands: Candidates
     skin_bins: np.ndarray
-    integral: np.ndarray
+    people: np.ndarray | None = None
 
 
 class _CandidateSets:
@@ -194,6 +202,11 @@ class LimbTracker:
         self._next_person = 0
         self._last_frame = -1
         self._init: dict[int, list[tuple[int, str, np.ndarray]]] = {}
+        self._given_people: np.ndarray | None = None  # person boxes of the next frame (set_people)
+        #: found automatically, where person regions come from: "foreground" (its components) or
+        #: "given" (set_people before each frame; a frame without boxes is not gated)
+        self.people_from = "foreground"
+        self._ended: dict[int, _Target] = {}  # trackers ended off people (their events still name them)
         rows = None if init is None else normalise_tracks(init)
         if rows is not None:
             self._next_person = int(rows["track_id"].max()) + 1 if len(rows) else 0
@@ -208,6 +221,14 @@ class LimbTracker:
                     (int(r.track_id), str(r.part), np.array([r.x, r.y, r.w, r.h], float)))
 
     # -- public ----------------------------------------------------------------------------
+    def set_people(self, boxes) -> None:
+        """Person boxes ``(P, 4) x, y, w, h`` of the next frame from another tracker (``--tracker
+        all``: the body tracker's), used instead of the foreground's person regions; None: that
+        tracker has no one in the frame, which is then not gated (a person seated at a desk,
+        whom the body tracker does not start, keeps their limbs)."""
+        self.people_from = "given"
+        self._given_people = None if boxes is None else np.asarray(boxes, float).reshape(-1, 4)
+
     @property
     def events(self) -> pd.DataFrame:
         """Join/separation events so far (:data:`EVENT_COLUMNS`); a join still open ends at the last frame."""
@@ -218,7 +239,8 @@ class LimbTracker:
             if self.machine.state(t) == LimbState.COMBINED and p is not None and t < p:
                 evs.append(JoinEvent(self.machine.joined_at(t), self._last_frame, t, p, "open"))
         for e in evs:
-            a, b = self.targets[e.tracker_a], self.targets[e.tracker_b]
+            a = self.targets.get(e.tracker_a) or self._ended[e.tracker_a]
+            b = self.targets.get(e.tracker_b) or self._ended[e.tracker_b]
             rows.append({"start_frame": e.start_frame, "end_frame": e.end_frame,
                          "kind": event_kind(a.part, a.track_id, b.part, b.track_id),
                          "track_id_a": a.track_id, "part_a": a.part, "track_id_b": b.track_id,
@@ -245,18 +267,24 @@ class LimbTracker:
         observations = {t: self._filter_step(t, seen, view) for t in active}
         self._follow_leaders(observations)
         if self.auto_start:
-            self._propose(view.cands, observations)
-        self._label(index, frame, observations)
+            self._propose(view.cands, observations, view.people)
+        self._label(index, frame, observations, view.people)
         self._reacquire_heads(frame, view.skin_bins, observations)
         # 3. high layer
         for tr in self.machine.update(index, observations):
             self._apply(tr, index, view.skin_bins)
         self._fill_references(view.skin_bins)
-        return self._records(index)
+        if view.people is not None:
+            self._end_off_people(view.people)
+        return self._records(index, view.people)
 
     # -- 1. observations -------------------------------------------------------------------
     def _observe(self, index: int, frame: np.ndarray, foreground: np.ndarray | None, starting) -> _View:
-        """Skin pixels within the support, their blobs, candidates and the skin hue."""
+        """Skin pixels within the support, their blobs, candidates and the skin hue.
+
+        Found automatically, skin and hue are computed only on the person regions and around the
+        tracked targets (nothing is started or kept elsewhere), so the cost follows the people,
+        not the frame."""
         p = self.params
         if starting and p.skin.adapt:
             # the given boxes show these people's skin against this scene: a Bayes skin model
@@ -266,27 +294,45 @@ class LimbTracker:
                                          bins=self.skin.bins, ybins=p.skin.ybins, prior=self.skin,
                                          keep_mass=p.skin.keep_mass, keep_recall=p.skin.keep_recall,
                                          threshold=p.skin.threshold, keep_min_side=p.skin.keep_min_side)
-        skin_prob = self.skin.probability(frame)
-        skin_mask = skin_prob >= p.skin.threshold
+        people = self._people(foreground, frame.shape[:2])
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
+        rois = None if people is None else merge_boxes(np.vstack([people, self._support_boxes(index)]),
+                                                       frame.shape[:2])
+        skin_prob = on_regions(self.skin.probability, frame, rois, 0.0, np.float32, pad=self.skin.blur)
+        skin_mask = skin_prob >= p.skin.threshold
         if fg is not None:
             skin_mask &= fg
         if p.skin.open > 1:  # remove speckle left by noise
             kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (p.skin.open, p.skin.open))
             skin_mask = cv2.morphologyEx(skin_mask.astype(np.uint8), cv2.MORPH_OPEN, kernel) > 0
-        people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
-        blobs = find_blobs(skin_mask.astype(np.uint8), people, p.blobs.alpha, self._min_area(starting))
+        n_people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
+        blobs = find_blobs(skin_mask.astype(np.uint8), n_people, p.blobs.alpha, self._min_area(starting))
         cands = candidate_terms(blobs, fg, skin_prob, p)
-        hsv = cv2.cvtColor(frame, cv2.COLOR_BGR2HSV)
         a = p.appearance
-        bins = hue_bin_image(hsv, a.hue_bins, a.hue_min_saturation, a.hue_min_value)
+
+        def hue_bins(img: np.ndarray) -> np.ndarray:
+            return hue_bin_image(cv2.cvtColor(img, cv2.COLOR_BGR2HSV), a.hue_bins, a.hue_min_saturation,
+                                 a.hue_min_value)
+
+        bins = on_regions(hue_bins, frame, rois, -1, np.int16)
         skin_bins = np.where(skin_mask, bins, -1).astype(np.int16)  # skin_mask is within the support
         # Hue is measured over skin pixels only: red objects (a cup) and wood share skin's hue
         # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
         # The colour likelihood and the mean shift therefore run on the "skin-colour
         # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
-        integral = integral_histogram(skin_bins, a.hue_bins)
-        return _View(blobs, cands, skin_bins, integral)
+        return _View(blobs, cands, skin_bins, people)
+
+    def _people(self, foreground: np.ndarray | None, shape: tuple[int, int]) -> np.ndarray | None:
+        """Found automatically, this frame's person regions: the boxes given by :meth:`set_people`,
+        else the foreground's (all of the frame without a foreground mask); with ``--init``, None."""
+        given, self._given_people = self._given_people, None
+        if not self.auto_start:
+            return None
+        if self.people_from == "given":
+            return given
+        if foreground is None:
+            return np.array([[0.0, 0.0, float(shape[1]), float(shape[0])]])
+        return foreground_people(foreground, self.params)
 
     # -- 2. low layer: one filter ----------------------------------------------------------
     def _filter_step(self, t: int, seen: _CandidateSets, view: _View) -> Observation:
@@ -299,7 +345,7 @@ class LimbTracker:
         on_end = False  # the hand is seen as the end of an arm-long blob
         if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
             obs_c, on_end = self._nearest_ends(tgt, state, obs_c, own_c, before, prev, len(view.blobs))
-        tgt.filter.weigh(obs_c, view.integral)
+        tgt.filter.weigh(obs_c, view.skin_bins)
         modes = self._pair_modes(t, obs_c) if state == LimbState.COMBINED else ()
         if state != LimbState.LOST:
             self._refine(tgt, obs_c, on_end, view.skin_bins)
@@ -363,7 +409,7 @@ class LimbTracker:
             if d.min() <= max(tgt.size):
                 tgt.filter.shift_to(obs_c.centres[int(np.argmin(d))])
         else:
-            tgt.filter.refine(back_projection(skin_bins, tgt.filter.ref_hist))
+            tgt.filter.refine(skin_bins)
 
     def _remember(self, t: int, state: LimbState, before: np.ndarray, skin_bins: np.ndarray) -> None:
         """Velocity, last confident place (the lost-state search centre) and the model update."""
@@ -460,14 +506,8 @@ class LimbTracker:
         need real foreground to start. The neighbourhood is the target's box scaled by
         ``support_scale`` around its last estimate.
         """
-        boxes = [b for _, _, b in self._init.get(index, [])]
-        for t, tgt in self.targets.items():
-            if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
-                continue
-            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else self._search_centre(t)
-            w, h = tgt.size[0] * self.params.blobs.support_scale, tgt.size[1] * self.params.blobs.support_scale
-            boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
-        if not boxes:
+        boxes = self._support_boxes(index)
+        if not len(boxes):
             return fg
         out = fg.copy()
         hgt, wid = fg.shape
@@ -477,6 +517,18 @@ class LimbTracker:
             if x2 > x1 and y2 > y1:
                 out[y1:y2, x1:x2] = True
         return out
+
+    def _support_boxes(self, index: int) -> np.ndarray:
+        """``(B, 4)`` boxes kept observable: this frame's init boxes and every tracked target's box
+        scaled by ``support_scale`` around its estimate (a lost one's around where it is looked for)."""
+        boxes = [np.asarray(b, float) for _, _, b in self._init.get(index, [])]
+        for t, tgt in self.targets.items():
+            if tgt.filter is None or self.machine.state(t) == LimbState.UNINITIALIZED:
+                continue
+            c = tgt.filter.estimate if self.machine.state(t) != LimbState.LOST else self._search_centre(t)
+            w, h = tgt.size[0] * self.params.blobs.support_scale, tgt.size[1] * self.params.blobs.support_scale
+            boxes.append(np.array([c[0] - w / 2, c[1] - h / 2, w, h]))
+        return np.array(boxes, float).reshape(-1, 4)
 
     # -- starting trackers -----------------------------------------------------------------
     def _new_tracker(self, target: _Target, state: LimbState) -> int:
@@ -568,9 +620,12 @@ class LimbTracker:
                 keep &= d > max(tgt.size) / 2 + self.params.priors.sigma_xy
         return self._subset(cands, keep)
 
-    def _propose(self, cands: Candidates, observations: dict[int, Observation]) -> None:
-        """Uninitialized trackers follow candidates no existing tracker explains (sec. 5.2)."""
+    def _propose(self, cands: Candidates, observations: dict[int, Observation], people: np.ndarray | None) -> None:
+        """Uninitialized trackers follow candidates no existing tracker explains (sec. 5.2), on a
+        person region."""
         free = self._unclaimed(cands, exclude=-1)
+        if people is not None and len(free):
+            free = self._subset(free, in_regions(free.centres, people))
         pending = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNINITIALIZED]
         used: set[int] = set()
         for t in pending:
@@ -597,28 +652,47 @@ class LimbTracker:
                 self.targets.pop(t)
 
     # -- labelling (unlabelled -> normal) -----------------------------------------------------
-    def _faces(self, frame: np.ndarray) -> np.ndarray:
-        if self.face is None:
+    def _faces(self, frame: np.ndarray, near: list[tuple[np.ndarray, float]]) -> np.ndarray:
+        """Face boxes ``(F, 4) x, y, w, h`` found within ``near``: ``(centre, half side)`` squares.
+
+        Only faces near a tracker are ever used (a face on a tracker labels it a head, one near a
+        lost head re-acquires it), so the cascade scans those squares, not the frame: on PETS09
+        (768 x 576, a dozen trackers) the whole-frame scan took 60% of the tracker's time."""
+        if self.face is None or not near:
             return np.zeros((0, 4))
         grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
-        found = self.face.detectMultiScale(grey, scaleFactor=1.1, minNeighbors=4, minSize=(12, 12))
-        return np.asarray(found, float).reshape(-1, 4)
+        hgt, wid = grey.shape
+        found = []
+        for (cx, cy), half in near:
+            x1, y1 = max(int(cx - half), 0), max(int(cy - half), 0)
+            x2, y2 = min(int(np.ceil(cx + half)), wid), min(int(np.ceil(cy + half)), hgt)
+            if min(x2 - x1, y2 - y1) < FACE_WINDOW:  # the cascade's smallest window
+                continue
+            f = self.face.detectMultiScale(grey[y1:y2, x1:x2], scaleFactor=1.1, minNeighbors=4, minSize=(12, 12))
+            if len(f):
+                found.append(np.asarray(f, float).reshape(-1, 4) + np.array([x1, y1, 0, 0]))
+        return np.concatenate(found) if found else np.zeros((0, 4))
 
-    def _label(self, index: int, frame: np.ndarray, observations: dict[int, Observation]) -> None:
+    def _label(self, index: int, frame: np.ndarray, observations: dict[int, Observation],
+               people: np.ndarray | None = None) -> None:
         """Cues for unlabelled trackers that never had a type: a face -> new person's head;
-        beside a head -> that person's hand on that side; alone and topmost for a while -> head."""
+        beside a head -> that person's hand on that side; alone and topmost for a while -> head.
+        Found automatically, a head only in the top of a person region, a hand only inside one."""
         p = self.params
         todo = [t for t in self.machine.trackers() if self.machine.state(t) == LimbState.UNLABELLED
                 and not self.targets[t].labelled and self.targets[t].filter is not None]
         if not todo:
             return
-        faces = self._faces(frame)
+        # a face holding a tracker's centre lies within a few of its sides
+        faces = self._faces(frame, [(self.targets[t].filter.estimate, max(3.0 * max(self.targets[t].size), 32.0))
+                                    for t in todo if max(self.targets[t].size) >= FACE_MIN_SIDE])
         for t in sorted(todo, key=lambda t: self.targets[t].filter.estimate[1]):  # topmost first
             tgt = self.targets[t]
             tgt.unlabelled_frames += 1
             cx, cy = tgt.filter.estimate
-            on_face = any(fx <= cx <= fx + fw and fy <= cy <= fy + fh for fx, fy, fw, fh in faces)
-            head = self._nearest_head(tgt.filter.estimate)
+            may_head, may_hand = self._may_be(tgt.filter.estimate, people)
+            on_face = may_head and any(fx <= cx <= fx + fw and fy <= cy <= fy + fh for fx, fy, fw, fh in faces)
+            head = self._nearest_head(tgt.filter.estimate) if may_hand else None
             # a face that is not the nearby head's own is another person's head
             if on_face and (head is None or np.hypot(*(head[1].filter.estimate - tgt.filter.estimate))
                             > max(head[1].size)):
@@ -635,12 +709,41 @@ class LimbTracker:
                     self._assign(t, htgt.track_id, side)
                 elif other not in taken:
                     self._assign(t, htgt.track_id, other)
-            elif tgt.unlabelled_frames >= p.labels.head_guess_frames:
+            elif tgt.unlabelled_frames >= p.labels.head_guess_frames and may_head:
                 self._assign(t, self._next_person, "head")
                 self._next_person += 1
             if tgt.labelled and t in observations:
                 o = observations[t]
                 observations[t] = Observation(o.position, o.likelihood, o.prior, True, o.modes, o.size)
+
+    def _may_be(self, point, people: np.ndarray | None) -> tuple[bool, bool]:
+        """Whether a tracker at ``point`` may be labelled a head (in the top of a person region) and
+        a hand (inside one); both when people are not looked for (``--init``)."""
+        if people is None:
+            return True, True
+        pt = np.asarray(point, float)[None, :]
+        return bool(in_regions(pt, people, self.params.people.head_top)[0]), bool(in_regions(pt, people)[0])
+
+    def _on_people(self, t: int, people: np.ndarray | None) -> bool:
+        """Whether tracker ``t``'s estimate is on a person region (a head in its top part)."""
+        tgt = self.targets[t]
+        if people is None or tgt.filter is None:
+            return True
+        head, hand = self._may_be(tgt.filter.estimate, people)
+        return head if tgt.part == "head" else hand
+
+    def _end_off_people(self, people: np.ndarray) -> None:
+        """End trackers found automatically that stayed ``people.end_frames`` frames off every person
+        region (a limb on a wall or a parked car, or a person who has left); a combined pair waits
+        until it splits or is lost."""
+        for t in list(self.targets):
+            tgt, state = self.targets[t], self.machine.state(t)
+            if tgt.filter is None or state in (LimbState.UNINITIALIZED, LimbState.COMBINED):
+                continue
+            tgt.off = 0 if state != LimbState.LOST and self._on_people(t, people) else tgt.off + 1
+            if tgt.off >= self.params.people.end_frames:
+                self.machine.end(t)
+                self._ended[t] = self.targets.pop(t)
 
     def _assign(self, t: int, track_id: int, part: str) -> None:
         tgt = self.targets[t]
@@ -664,21 +767,21 @@ class LimbTracker:
         p = self.params
         if self.face is None:
             return
-        faces = None
         for t, tgt in self.targets.items():
             if tgt.part != "head" or tgt.filter is None or t not in observations:
                 continue
             if self.machine.state(t) == LimbState.COMBINED:
                 continue
             tgt.low_frames = tgt.low_frames + 1 if tgt.filter.confidence < p.adjustment.reacquire_confidence else 0
-            if tgt.low_frames < p.adjustment.reacquire_frames:
+            # looked for every reacquire_frames frames while low, on heads whose face the cascade can see
+            if (tgt.low_frames < p.adjustment.reacquire_frames or tgt.low_frames % p.adjustment.reacquire_frames
+                    or max(tgt.size) < FACE_MIN_SIDE):
                 continue
-            if faces is None:
-                faces = self._faces(frame)
+            last = tgt.last if tgt.last is not None else tgt.filter.estimate
+            faces = self._faces(frame, [(last, (p.labels.person_radius + 1) * tgt.size[1])])
             if len(faces) == 0:
                 continue
             centres = faces[:, :2] + faces[:, 2:] / 2
-            last = tgt.last if tgt.last is not None else tgt.filter.estimate
             d = np.hypot(*(centres - last[None, :]).T)
             j = int(np.argmin(d))
             if d[j] > p.labels.person_radius * tgt.size[1]:
@@ -715,11 +818,15 @@ class LimbTracker:
             if tgt.last is None:
                 tgt.last = tgt.filter.estimate.copy()
 
-    def _records(self, index: int) -> list[TrackRecord]:
+    def _records(self, index: int, people: np.ndarray | None = None) -> list[TrackRecord]:
+        """This frame's rows; found automatically, only of trackers on a person region, not lost."""
         out = []
         for t, tgt in self.targets.items():
             state = self.machine.state(t)
             if state == LimbState.UNINITIALIZED or not tgt.labelled:
+                continue
+            if people is not None and (state == LimbState.LOST or (
+                    state != LimbState.COMBINED and not self._on_people(t, people))):
                 continue
             if state == LimbState.COMBINED:
                 lead = tgt.filter or self.targets[self.machine.partner(t)].filter

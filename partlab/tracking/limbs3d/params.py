@@ -1,102 +1,165 @@
-"""Parameters of the multi-camera head-and-hands tracker (3D tracking of the hands and head of
-interacting people from several cameras, sec. 4-6). Lengths are millimetres in the take's world
-frame unless they say pixels.
+"""Every tunable number of the multi-camera head-and-hands tracker (*3D tracking of the hands and
+head of interacting people from several cameras*, sec. 4-6), grouped by what it tunes. Lengths are
+millimetres in the take's world frame unless they say pixels. ``Limbs3DParams`` is stored by model
+bundles under the key ``"limbs3d"``. Groups:
 
-The three prior variances ``sigma_v``, ``sigma_d``, ``sigma_s`` (eq. 25-27) are what training
-fits from corrected takes (sec. 6.4, :mod:`partlab.models.limbs3d`); the state machine's thresholds
-are not given in the paper and are parameters here (the names are those of
-:class:`partlab.tracking.params.LimbParams`, whose state machine this tracker reuses).
+- ``observations``: silhouettes and the skin blobs of each view (sec. 6.1-6.2);
+- ``priors``: the candidate prior p(Z) = p_o p_t p_b (eq. 19, 25-27; the ``sigma_*`` are
+  **fitted** from corrected takes, sec. 6.4, :mod:`partlab.models.limbs3d`), pruning and merging;
+- ``dynamics``: one particle filter per 3D target (sec. 4.2, eq. 17);
+- ``states``: the five-state machine of sec. 5.2 (the paper gives no thresholds; the names are
+  those of :class:`partlab.tracking.limbs.params.LimbStates`, whose machine this tracker reuses);
+- ``output``: back-projected boxes and how new targets are labelled.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
+
+from partlab.tracking.core.params import (
+    COUNT,
+    FRACTION,
+    POSITIVE,
+    POSITIVE_COUNT,
+    Parameters,
+    flag,
+    group_field,
+    number,
+)
 
 
-@dataclass
-class Limbs3DParams:
-    # -- observations (sec. 6.2) --------------------------------------------------------
+@dataclass(frozen=True)
+class Limbs3DObservations:
+    """Silhouettes and skin blobs per view (sec. 6.1-6.2)."""
+
     # keep the ceil(3 * alpha * people) largest skin blobs per view (alpha > 1: spares)
-    blob_alpha: float = 1.5
+    blob_alpha: float = number(1.5, POSITIVE)
     # blobs smaller than this many pixels are noise (a hand 3 m away at 640x480 is ~200 px)
-    blob_min_area: float = 12.0
-    skin_threshold: float = 0.5
+    blob_min_area: float = number(12.0)
+    skin_threshold: float = number(0.5, FRACTION)
+    # opening kernel (pixels, elliptic) on the skin mask before blobs, 1 = none: the anti-aliased
+    # rim of a yellow or orange shirt against a grey wall mixes to skin chroma, a 1-2 px line that
+    # joins head and hands into one blob through the torso's outline; a 5 px opening removes it
+    # while a hand 3 m away (~15 px across at 640x480) stays
+    skin_open: int = number(5, POSITIVE_COUNT)
+    # with --init: refit the skin model (core.skin.train_skin_model, a Bayes ratio over coarse luma
+    # bins shrunk to the rule) on the init targets' back-projected boxes in every view. A shaded
+    # olive or orange sleeve shares the rule's chroma with skin but not its brightness; its
+    # speckle otherwise joins the hand's blob and drags its centre ~100 mm up the arm
+    skin_adapt: bool = flag(True)
+    skin_ybins: int = number(8, POSITIVE_COUNT)
     # silhouettes (sec. 6.1, background subtraction): with an empty-scene plate per view (a take's
     # ``<stream>_background.png``), a pixel is a person's where a channel differs from the plate by
-    # more than this (after a 5 x 5 blur; sensor noise is ~3 levels); without one, the run loop's
-    # adaptive foreground mask is used
-    plate_threshold: float = 28.0
+    # more than this (after a 2 x 2 area average; sensor noise is ~3 levels); without one, the run
+    # loop's adaptive foreground mask is used
+    plate_threshold: float = number(28.0, POSITIVE)
     # without an empty-scene plate: around each tracked target's projection, skin counts even where
     # the adaptive background model has absorbed a person who sits still (radius in target sizes,
-    # see head_size_mm); with a plate the silhouette is trusted (the seated scene's wooden table is
-    # skin-coloured and lies right under the hands)
-    support_scale: float = 2.5
-    # -- candidate priors p(Z) = p_o p_t p_b (eq. 19, 25-27); fitted by training ------------
-    # eq. 25: spread of the difference of the two blobs' relative heights within their silhouettes
-    sigma_v: float = 0.08
-    # eq. 26: spread of the distance between the two lines of sight (mm); true pairs lie within a
-    # few cm (blob centroids are not projections of one 3D point: the head's hair, sec. 6.3)
-    sigma_d: float = 30.0
-    # eq. 27: spread of the distance (pixels) of the candidate's projection to each view's silhouette
-    sigma_s: float = 6.0
+    # see output.head_size_mm); with a plate the silhouette is trusted
+    support_scale: float = number(2.5)
+
+
+@dataclass(frozen=True)
+class Limbs3DPriors:
+    """The candidate prior p(Z) = p_o p_t p_b (eq. 19, 25-27), pruning and merging (sec. 6.4)."""
+
+    # eq. 25 (fitted): spread (mm) of the difference of the two blobs' depths below the top of
+    # their silhouettes (priors.py: the paper's relative rows, turned into mm at the candidate's
+    # depth because a table hides the legs from some views). True pairs differ by 30-45 mm
+    # (median) and 120-150 (90th percentile) on the seated takes, and by ~200 where two people's
+    # silhouettes merge in one view and not the other (the handshake); false head-hand pairs by
+    # ~400. 150 mm: 100 gave the 3-camera handshake (seeds 0-2) 105/49/114 mm, 150 gave 90/70/101
+    sigma_v: float = number(150.0, POSITIVE)
+    # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
+    # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
+    # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;
+    # 20 mm keeps the true ones (>= 0.75 at 15 mm) and halves those false ones
+    sigma_d: float = number(20.0, POSITIVE)
+    # eq. 27 (fitted): spread of the distance (pixels) of the candidate's projection to each view's
+    # silhouette
+    sigma_s: float = number(6.0, POSITIVE)
     # candidates below this prior are pruned (the paper's Fig. 4 threshold, 0.1)
-    prior_threshold: float = 0.1
+    prior_threshold: float = number(0.1, FRACTION)
     # candidates must lie in the room: above the floor and below this height (mm)
-    max_height: float = 2400.0
+    max_height: float = number(2400.0, POSITIVE)
     # close candidates merge: the weaker is eliminated and boosts the stronger by this fraction of
     # its prior (sec. 6.4). 45 mm: the three pairs of a hand seen by three cameras lie within ~3 cm,
     # while two touching hands stay ~50 mm apart (centre to centre)
-    merge_distance: float = 45.0
-    merge_boost: float = 0.5
+    merge_distance: float = number(45.0)
+    merge_boost: float = number(0.5)
     # the kept candidate moves to the prior-weighted mean of those it absorbs (the paper keeps the
     # stronger point; the mean of the pairs of 3-4 cameras is a better estimate of the centre)
-    merge_average: bool = True
-    # -- particle filter (sec. 4.2, eq. 17) -----------------------------------------------
-    particles: int = 200
+    merge_average: bool = flag(True)
+
+
+@dataclass(frozen=True)
+class Limbs3DDynamics:
+    """One SIR filter per target, ``particles`` of ``[X, Y, Z, vX, vY, vZ]`` (sec. 4.2, eq. 17)."""
+
+    particles: int = number(200, POSITIVE_COUNT)
     # p(x | Z_c): Gaussian of this spread (mm) around each candidate, about a hand's radius
-    sigma_x: float = 45.0
+    sigma_x: float = number(45.0, POSITIVE)
     # weight every particle keeps, so a filter whose candidates vanish diffuses around its place
-    weight_floor: float = 1e-3
-    # dynamics x_t = x_{t-1} + decay v_{t-1} + noise (mm per frame; a gesturing hand moves up to
-    # ~60 mm a frame at 25 fps)
-    noise_xyz: float = 25.0
-    noise_v: float = 10.0
-    velocity_decay: float = 0.85
+    weight_floor: float = number(1e-3, POSITIVE)
+    # x_t = x_{t-1} + decay v_{t-1} + noise (mm per frame; a gesturing hand moves up to ~60 mm a
+    # frame at 25 fps)
+    noise_xyz: float = number(25.0)
+    noise_v: float = number(10.0)
+    velocity_decay: float = number(0.85, FRACTION)
     # sec. 4.2 allows "further steps" on top of SIR: this fraction of the particles is drawn around
     # the candidates within candidate_gate mm of the prediction (by prior), so a hand that moves
-    # faster than the dynamics expect (~60 mm a frame when gesturing) is not left behind; their
-    # weights are eq. 17's like any other particle's
-    candidate_mix: float = 0.3
-    candidate_gate: float = 250.0
+    # faster than the dynamics expect is not left behind; their weights are eq. 17's like any other
+    candidate_mix: float = number(0.3, FRACTION)
+    candidate_gate: float = number(250.0, POSITIVE)
     # a candidate nearer another target's prediction (by this factor) is left to that target
-    exclusive_ratio: float = 1.0
-    # -- state machine (sec. 5.2; names as LimbParams, used by LimbStateMachine) -----------
-    combine_distance: float = 80.0  # mm between estimates: two hands about touching
-    split_distance: float = 120.0  # mm between the combined posterior's modes
-    combine_size: float = 0.0  # (no size-relative thresholds in 3D: millimetres are absolute)
-    split_size: float = 0.0
-    lost_likelihood: float = 0.1
-    recover_likelihood: float = 0.25
-    lost_frames: int = 5
-    start_frames: int = 3
-    start_prior: float = 0.5
-    history_frames: int = 10
+    exclusive_ratio: float = number(1.0, POSITIVE)
+    # a combined filter spreads its particles this much wider so it sees both modes
+    combined_noise_scale: float = number(1.3, POSITIVE)
     # a lost target's particles spread this wide (mm) around where it is looked for
-    lost_search: float = 120.0
-    combined_noise_scale: float = 1.3
-    # modes of a combined pair are sought among candidates within this many split distances
-    mode_search: float = 2.5
-    # -- output -----------------------------------------------------------------------------
-    # back-projected boxes: a part's size in mm (the synthetic heads' boxes are ~230 mm, hands ~95)
-    head_size_mm: float = 230.0
-    hand_size_mm: float = 100.0
-    # automatic start (no --init): a head is the highest of a person's candidates, hands within
-    # this horizontal radius of it; persons are assumed to face the cameras' centroid
-    person_radius: float = 900.0
+    lost_search: float = number(120.0)
 
-    @property
-    def states(self) -> Limbs3DParams:
-        """Where :class:`~partlab.tracking.limbs.state_machine.LimbStateMachine` reads its thresholds
-        (``params.states.lost_frames``, the grouped style of ``LimbParams``); here they are fields of
-        this object (the state-machine block above)."""
-        return self
+
+@dataclass(frozen=True)
+class Limbs3DStates:
+    """Thresholds of the five-state machine (sec. 5.2, on 3D targets; the paper gives none)."""
+
+    combine_distance: float = number(80.0)  # mm between estimates: two hands about touching
+    split_distance: float = number(120.0)  # mm between the combined posterior's modes
+    # (no size-relative thresholds in 3D: millimetres are absolute)
+    combine_size: float = number(0.0)
+    split_size: float = number(0.0)
+    lost_likelihood: float = number(0.1, FRACTION)
+    # hysteresis: a lost target comes back only above this confidence
+    recover_likelihood: float = number(0.25, FRACTION)
+    lost_frames: int = number(5, POSITIVE_COUNT)
+    start_frames: int = number(3, POSITIVE_COUNT)
+    start_prior: float = number(0.5, FRACTION)
+    # frames of estimates kept to read the direction between two targets before they join
+    history_frames: int = number(10, COUNT)
+    # modes of a combined pair are sought among candidates within this many split distances
+    mode_search: float = number(2.5, POSITIVE)
+
+
+@dataclass(frozen=True)
+class Limbs3DOutput:
+    """Back-projected boxes and the labels of new targets."""
+
+    # a part's size in mm (the synthetic heads' boxes are ~230 mm, hands ~95)
+    head_size_mm: float = number(230.0, POSITIVE)
+    hand_size_mm: float = number(100.0, POSITIVE)
+    # automatic start (no --init): hands within this horizontal radius of a head are its person's
+    person_radius: float = number(900.0, POSITIVE)
+
+
+@dataclass(frozen=True)
+class Limbs3DParams(Parameters):
+    """Parameters of the multi-camera head-and-hands tracker, by what they tune."""
+
+    KEY: ClassVar[str] = "limbs3d"
+
+    observations: Limbs3DObservations = group_field(Limbs3DObservations)
+    priors: Limbs3DPriors = group_field(Limbs3DPriors)
+    dynamics: Limbs3DDynamics = group_field(Limbs3DDynamics)
+    states: Limbs3DStates = group_field(Limbs3DStates)
+    output: Limbs3DOutput = group_field(Limbs3DOutput)

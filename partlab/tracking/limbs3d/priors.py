@@ -1,9 +1,14 @@
 """How good is a candidate point: its prior ``p(Z) = p_o(Z) p_t(Z) p_b(Z)`` (eq. 19, 25-27), then
 pruning and merging (sec. 6.4).
 
-- ``p_o`` (eq. 25) compares the two blobs in their own images: the relative row of each blob
-  within its person's silhouette, ``Dv`` (0 at the silhouette's top, 1 at its bottom), should agree,
-  because with every camera upright a higher point has a smaller row in every view;
+- ``p_o`` (eq. 25) compares the two blobs in their own images: how far below the top of its
+  person's silhouette each blob lies, ``Dv``, should agree, because with every camera upright a
+  higher point has a smaller row in every view. The paper divides the rows by the silhouette's
+  height; that range is not the same person in every view when a table hides the legs from some
+  cameras and not others (seated, the true hand pairs got p_o 0.00-0.18 with sigma_v = 0.08), so
+  here the offset from the silhouette's top (the top of the head, which every camera above the
+  people sees) is turned into millimetres at the candidate's depth in that camera
+  (``rows * depth / f``) and ``sigma_v`` is in mm;
 - ``p_t`` (eq. 26) is the reconstruction error ``d`` of eq. 24;
 - ``p_b`` (eq. 27) projects the candidate into every view and measures its distance ``Ds`` (pixels)
   to that view's silhouette: a false pair of two limbs on one line of sight in one camera lands
@@ -29,12 +34,12 @@ from partlab.tracking.limbs3d.params import Limbs3DParams
 
 @dataclass(frozen=True, eq=False)
 class ViewObservation:
-    """One view at one frame: skin-blob ``centres (K, 2)``, their relative rows ``dv (K,)`` in
-    their silhouettes, and ``distance (H, W) float32``: pixels to the nearest silhouette pixel
+    """One view at one frame: skin-blob ``centres (K, 2)``, ``below (K,)`` image rows from the top of
+    each blob's silhouette to the blob, and ``distance (H, W) float32``: pixels to the nearest silhouette pixel
     (0 inside); ``has_silhouette`` False when the view sees nobody at all."""
 
     centres: np.ndarray
-    dv: np.ndarray
+    below: np.ndarray
     distance: np.ndarray
     has_silhouette: bool
     scale: float = 1.0  # image pixels per silhouette pixel (silhouettes may be found at lower resolution)
@@ -47,20 +52,16 @@ def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0
     centres = np.asarray(centres, float).reshape(-1, 2)
     h, w = sil.shape
     if not sil.any():
-        return ViewObservation(centres, np.full(len(centres), 0.5), np.zeros((h, w), np.float32), False, scale)
+        return ViewObservation(centres, np.zeros(len(centres)), np.zeros((h, w), np.float32), False, scale)
     n, labels, stats, _ = cv2.connectedComponentsWithStats(sil, 8)
     distance = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
     top_all = float(stats[1:, cv2.CC_STAT_TOP].min())
-    bottom_all = float((stats[1:, cv2.CC_STAT_TOP] + stats[1:, cv2.CC_STAT_HEIGHT]).max())
-    dv = np.empty(len(centres))
+    below = np.empty(len(centres))
     for k, (x, y) in enumerate(centres):
         lab = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
-        if lab > 0:
-            top, bottom = stats[lab, cv2.CC_STAT_TOP], stats[lab, cv2.CC_STAT_TOP] + stats[lab, cv2.CC_STAT_HEIGHT]
-        else:
-            top, bottom = top_all, bottom_all
-        dv[k] = (y - top) / max(float(bottom - top), 1.0)
-    return ViewObservation(centres, dv, distance * np.float32(scale), True, scale)
+        top = float(stats[lab, cv2.CC_STAT_TOP]) if lab > 0 else top_all
+        below[k] = (y - top) * scale
+    return ViewObservation(centres, below, distance * np.float32(scale), True, scale)
 
 
 def silhouette_distance(camera: Camera, view: ViewObservation, points: np.ndarray) -> np.ndarray:
@@ -89,6 +90,17 @@ class Prior:
         return self.p_o * self.p_t * self.p_b
 
 
+def _below_mm(cands: PairCandidates, cameras: list[Camera], views: list[ViewObservation], side: int) -> np.ndarray:
+    """``Dv`` of each candidate's blob in its ``side`` (0, 1) view: rows below the silhouette's top
+    at the candidate's depth in that camera, in mm (``rows * depth / f_y``)."""
+    out = np.empty(len(cands))
+    for m in np.unique(cands.views[:, side]):
+        sel = cands.views[:, side] == m
+        depth = cameras[m].to_camera(cands.points[sel])[:, 2]
+        out[sel] = views[m].below[cands.blobs[sel, side]] * depth / cameras[m].K[1, 1]
+    return out
+
+
 def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[ViewObservation],
                     params: Limbs3DParams) -> tuple[Prior, dict]:
     """Eq. 25-27 for every candidate; also returns the raw errors (``dv``, ``d``, ``ds``), which
@@ -96,14 +108,12 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
     if len(cands) == 0:
         z = np.zeros(0)
         return Prior(z, z, z), {"dv": z, "d": z, "ds": np.zeros((0, len(views)))}
-    dv_a = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 0], cands.blobs[:, 0])])
-    dv_b = np.array([views[m].dv[b] for m, b in zip(cands.views[:, 1], cands.blobs[:, 1])])
-    ddv = dv_a - dv_b
-    p_o = np.exp(-ddv**2 / (2 * params.sigma_v**2))
-    p_t = np.exp(-cands.error**2 / (2 * params.sigma_d**2))
+    ddv = _below_mm(cands, cameras, views, 0) - _below_mm(cands, cameras, views, 1)
+    p_o = np.exp(-ddv**2 / (2 * params.priors.sigma_v**2))
+    p_t = np.exp(-cands.error**2 / (2 * params.priors.sigma_d**2))
     ds = np.stack([silhouette_distance(c, v, cands.points) if v.has_silhouette else np.zeros(len(cands))
                    for c, v in zip(cameras, views)], axis=1)
-    p_b = np.exp(-(ds**2).sum(axis=1) / (2 * params.sigma_s**2))
+    p_b = np.exp(-(ds**2).sum(axis=1) / (2 * params.priors.sigma_s**2))
     return Prior(p_o, p_t, p_b), {"dv": ddv, "d": cands.error, "ds": ds}
 
 
@@ -112,8 +122,8 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
     ``merge_boost`` times its prior to the one that absorbs it (capped at 1).
     Returns ``points (K, 3)`` and ``prior (K,)``, strongest first."""
-    keep = (prior >= params.prior_threshold) & np.isfinite(points).all(axis=1)
-    keep &= (points[:, 2] > 0) & (points[:, 2] < params.max_height)
+    keep = (prior >= params.priors.prior_threshold) & np.isfinite(points).all(axis=1)
+    keep &= (points[:, 2] > 0) & (points[:, 2] < params.priors.max_height)
     pts, pr = points[keep], prior[keep]
     order = np.argsort(-pr, kind="stable")
     pts, pr = pts[order], pr[order]
@@ -124,12 +134,12 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     for i in range(len(pr)):
         if not alive[i]:
             continue
-        near = alive & (dist[i] < params.merge_distance)
+        near = alive & (dist[i] < params.priors.merge_distance)
         near[i] = False
         absorbed = np.flatnonzero(near)
         alive[absorbed] = False
-        value = min(1.0, pr[i] + params.merge_boost * float(pr[absorbed].sum()))
-        if params.merge_average and len(absorbed):
+        value = min(1.0, pr[i] + params.priors.merge_boost * float(pr[absorbed].sum()))
+        if params.priors.merge_average and len(absorbed):
             idx = np.concatenate([[i], absorbed])
             p = (pts[idx] * pr[idx, None]).sum(0) / pr[idx].sum()
         else:

@@ -33,7 +33,7 @@ import pandas as pd
 
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
-from partlab.tracking.core.skin import SkinModel, find_blobs
+from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
 from partlab.tracking.limbs3d.filter import TargetFilter
@@ -83,6 +83,7 @@ class Limbs3DTracker:
         self.cameras = [cameras[s] for s in self.streams]
         self.plates = {s: self._half(b) for s, b in (backgrounds or {}).items() if b is not None}
         self.skin = SkinModel.default()
+        self._skin_fitted = False
         self.machine = LimbStateMachine(params)
         self.targets: dict[int, _Target] = {}
         self.pending: dict[int, _Target] = {}
@@ -133,7 +134,8 @@ class Limbs3DTracker:
         if plate is not None and plate.shape == (h, w, 3):
             diff = cv2.absdiff(self._half(color), plate)
             b, g, r = cv2.split(diff)
-            sil = cv2.threshold(cv2.max(cv2.max(b, g), r), self.params.plate_threshold, 1, cv2.THRESH_BINARY)[1]
+            level = self.params.observations.plate_threshold
+            sil = cv2.threshold(cv2.max(cv2.max(b, g), r), level, 1, cv2.THRESH_BINARY)[1]
             return cv2.morphologyEx(sil, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
         if foreground is None:
             return np.zeros((h, w), np.uint8)
@@ -148,16 +150,39 @@ class Limbs3DTracker:
                 continue
             uv, r = self._project(camera, t)
             if np.all(np.isfinite(uv)):
-                cv2.circle(mask, (int(uv[0]), int(uv[1])), int(max(self.params.support_scale * r, 3)), 1, -1)
+                radius = int(max(self.params.observations.support_scale * r, 3))
+                cv2.circle(mask, (int(uv[0]), int(uv[1])), radius, 1, -1)
         return mask
 
     def _project(self, camera: Camera, t: _Target) -> tuple[np.ndarray, float]:
         cam = camera.to_camera(t.position[None])[0]
-        size = self.params.head_size_mm if t.part == "head" else self.params.hand_size_mm
+        size = self.params.output.head_size_mm if t.part == "head" else self.params.output.hand_size_mm
         return camera.project(t.position[None])[0], 0.5 * camera.K[0, 0] * size / max(cam[2], 1.0)
+
+    def _adapt_skin(self, frames: FrameSet) -> None:
+        """Refit the skin model on the starting targets' boxes in every view (once)."""
+        images, boxes = [], []
+        for stream, cam in zip(self.streams, self.cameras):
+            view = frames.views.get(stream)
+            if view is None or view.color is None:
+                continue
+            b = []
+            for t in self.targets.values():
+                if t.position is not None and t.start_frame <= frames.index:
+                    uv, r = self._project(cam, t)
+                    if np.all(np.isfinite(uv)):
+                        b.append((uv[0] - r, uv[1] - r, 2 * r, 2 * r))
+            images.append(view.color)
+            boxes.append(np.array(b, float).reshape(-1, 4))
+        if sum(len(b) for b in boxes):
+            self.skin = train_skin_model(images, boxes, bins=self.skin.bins, ybins=self.params.observations.skin_ybins,
+                                         prior=self.skin)
+        self._skin_fitted = True
 
     def observe(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]):
         p = self.params
+        if p.observations.skin_adapt and not self._skin_fitted and self.targets:
+            self._adapt_skin(frames)
         people = max(1, len({t.track_id for t in self.targets.values()}))
         centres, views = [], []
         for stream, cam in zip(self.streams, self.cameras):
@@ -177,9 +202,12 @@ class Limbs3DTracker:
             if w > 0 and h > 0:  # skin is looked for only where people are (the costly part)
                 pad = self.skin.blur
                 x0, y0, x1, y1 = max(x - pad, 0), max(y - pad, 0), min(x + w + pad, W), min(y + h + pad, H)
-                crop = self.skin.mask(view.color[y0:y1, x0:x1], allowed[y0:y1, x0:x1], p.skin_threshold)
+                crop = self.skin.mask(view.color[y0:y1, x0:x1], allowed[y0:y1, x0:x1], p.observations.skin_threshold)
+                k = p.observations.skin_open
+                if k > 1:
+                    crop = cv2.morphologyEx(crop, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
                 skin[y0:y1, x0:x1] = crop
-            blobs = find_blobs(skin, people, p.blob_alpha, p.blob_min_area)
+            blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
             centres.append(blobs.centres)
             views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0))
         return centres, views
@@ -202,7 +230,7 @@ class Limbs3DTracker:
         # targets whose init frame is now come alive
         for key, t in self.targets.items():
             if t.filter is None and t.start_frame <= index and m.state(key) == LimbState.NORMAL:
-                t.filter = TargetFilter(t.position, p, self.rng)
+                t.filter = TargetFilter(t.position, p.dynamics, self.rng)
         active = [k for k, t in self.targets.items() if t.filter is not None and m.is_leader(k)
                   and m.state(k) != LimbState.UNINITIALIZED]
         # predict
@@ -210,9 +238,9 @@ class Limbs3DTracker:
             t = self.targets[k]
             state = m.state(k)
             if state == LimbState.LOST:
-                t.filter.reset(t.position, p.lost_search)
+                t.filter.reset(t.position, p.dynamics.lost_search)
             else:
-                t.filter.predict(p.combined_noise_scale if state == LimbState.COMBINED else 1.0)
+                t.filter.predict(p.dynamics.combined_noise_scale if state == LimbState.COMBINED else 1.0)
         # exclusive use of candidates: each goes to the nearest predicted target (a combined pair
         # counts as one), unless it is about as near to several
         preds = np.array([self.targets[k].filter.estimate for k in active]).reshape(-1, 3)
@@ -223,11 +251,14 @@ class Limbs3DTracker:
             t = self.targets[k]
             if len(points) and len(active) > 1:
                 others = np.delete(dist, a, axis=1).min(axis=1)
-                mine = dist[:, a] <= p.exclusive_ratio * others
+                mine = dist[:, a] <= p.dynamics.exclusive_ratio * others
             else:
                 mine = np.ones(len(points), bool)
             est = t.filter.update(points[mine], weights[mine])
-            t.position = est
+            if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
+                t.position = est  # a lost target stays where it was lost until something is found there
+            else:
+                est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
                 obs["modes"] = self._modes(est, points[mine], weights[mine])
@@ -242,7 +273,7 @@ class Limbs3DTracker:
             if tr.new == LimbState.UNLABELLED and tr.reason == "split":
                 t.position = np.asarray(tr.position, float)
                 if t.filter is None:
-                    t.filter = TargetFilter(t.position, p, self.rng)
+                    t.filter = TargetFilter(t.position, p.dynamics, self.rng)
                 else:
                     t.filter.reset(t.position)
                 t.labelled = True  # the direction cue (sec. 7.1) keeps its label
@@ -256,13 +287,13 @@ class Limbs3DTracker:
         p = self.params
         if len(points) == 0:
             return ()
-        near = np.linalg.norm(points - est, axis=1) < p.mode_search * p.split_distance
+        near = np.linalg.norm(points - est, axis=1) < p.states.mode_search * p.states.split_distance
         pts, w = points[near], weights[near]
         if len(pts) < 2:
             return tuple(map(tuple, pts))
         order = np.argsort(-w, kind="stable")
         first = pts[order[0]]
-        rest = [i for i in order[1:] if np.linalg.norm(pts[i] - first) >= p.combine_distance]
+        rest = [i for i in order[1:] if np.linalg.norm(pts[i] - first) >= p.states.combine_distance]
         return (tuple(first),) if not rest else (tuple(first), tuple(pts[rest[0]]))
 
     # -- 5. output ------------------------------------------------------------------------------

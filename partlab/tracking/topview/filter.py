@@ -50,6 +50,7 @@ class PersonFilter:
         self._clip()
         self.weights = np.full((n, N_PARTS), 1.0 / n)
         self.estimate = starts[0].copy()
+        self.previous = self.estimate.copy()  # the estimate before the last, for the prediction
         self.survival = np.ones(N_PARTS)
         self.reference: np.ndarray | None = None  # (5, bins) colour histograms of the estimate
 
@@ -115,8 +116,15 @@ class PersonFilter:
         w = self.weights[:, WEIGHT_PARTS.index("torso")]
         yaw = self.particles[:, _YAW]
         est[_YAW] = np.arctan2(w @ np.sin(yaw), w @ np.cos(yaw))  # a circular mean
-        self.estimate = est
+        self.previous, self.estimate = self.estimate, est
         return est
+
+    def predicted(self, velocity: float) -> np.ndarray:
+        """``(17,)`` the next state predicted from the last two estimates (eq. 5's ``x^_k``):
+        ``velocity`` 0 is the last estimate, 1 constant velocity (within the joint limits)."""
+        step = self.estimate - self.previous
+        step[_YAW] = (step[_YAW] + np.pi) % (2 * np.pi) - np.pi
+        return np.clip(self.estimate + velocity * step, JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1])
 
     def step(self, points: np.ndarray, bins: np.ndarray | None = None, n_bins: int = 0,
              depth: np.ndarray | None = None, camera=None) -> np.ndarray:

@@ -97,6 +97,11 @@ class ExclusionParams:
     farther than this from every model belong to nobody (a newcomer, an object)."""
 
     max_assign_mm: float = number(250.0)
+    #: the prediction ``x^_k`` of eq. 5 comes from the last estimate "and the dynamic of the
+    #: system": ``x_{k-1} + velocity * (x_{k-1} - x_{k-2})``. 0 is the random walk's own
+    #: prediction (the last estimate); 1, constant velocity, keeps a forearm that moves 30-50 mm a
+    #: frame on its own pixels where two people's forearms cross
+    velocity: float = number(1.0)
 
 
 @dataclass(frozen=True)
@@ -119,6 +124,24 @@ class StartParams:
     min_person_span_mm: float = number(350.0)
     min_points: int = number(80, POSITIVE_COUNT)
     lost_after: int = number(10, POSITIVE_COUNT)
+    # -- fitting the model to given joints and the frame's points (:mod:`.start`) --
+    #: depth points used by the fit (spread evenly over the person's; 300 keep the fit ~0.2 s)
+    fit_points: int = number(300, POSITIVE_COUNT)
+    #: the points' share of the fit against the joints': 1 = all points together count as much
+    #: as the joints (the joints are given, the points say what they leave open)
+    points_weight: float = number(1.0, POSITIVE)
+    #: how exactly the given joints are known (mm) and how far a standing person's pelvis is from
+    #: its standing height (hips sink about 30 mm per radian of bend, knees bend a little)
+    joint_sd_mm: float = number(10.0, POSITIVE)
+    stand_sd_mm: float = number(40.0, POSITIVE)
+    bend_sink_mm: float = number(30.0)
+    #: the stature may differ from the head-to-shoulders estimate by this factor (people's
+    #: proportions vary by about 10 %)
+    stature_range: tuple[float, float] = pair((0.85, 1.2))
+    #: soft-L1 loss scale (mm): points farther off than this (another person, noise) count less
+    fit_scale_mm: float = number(20.0, POSITIVE)
+    #: least-squares evaluations per start (the fit converges in 10-30)
+    fit_evaluations: int = number(60, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ the hands' centres) and a box around the joint's image.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import cv2
 import numpy as np
@@ -27,8 +27,9 @@ from partlab.tracking.core.box import Box
 from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.topview.filter import PersonFilter
 from partlab.tracking.topview.likelihood import colour_bins, nearest
-from partlab.tracking.topview.model import JOINTS, Body, fit_state, joints, neutral_state, primitives
+from partlab.tracking.topview.model import JOINTS, Body, joints, neutral_state, primitives
 from partlab.tracking.topview.params import TopViewParams
+from partlab.tracking.topview.start import fit_person
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
 
@@ -66,28 +67,6 @@ class Geometry:
         return self.centre + depth.ravel()[index, None].astype(np.float64) * self.rays[index]
 
 
-def body_from_joints(joints_mm: Mapping[str, np.ndarray]) -> Body:
-    """A person's sizes from their joints: stature from the head, arms and shoulders measured."""
-    base = Body()
-    stature = 1750.0
-    if "head" in joints_mm:
-        stature = float(joints_mm["head"][2]) / (1 - base.head_radius / base.stature)
-    body = base.scaled(stature)
-    j = {k: np.asarray(v, np.float64) for k, v in joints_mm.items()}
-    if "right_shoulder" in j and "left_shoulder" in j:
-        body = replace(body, shoulder_offset=float(np.linalg.norm(j["right_shoulder"] - j["left_shoulder"]) / 2))
-    ups, fores = [], []
-    for side in ("right", "left"):
-        s, e, h = j.get(f"{side}_shoulder"), j.get(f"{side}_elbow"), j.get(f"{side}_hand")
-        if s is not None and e is not None:
-            ups.append(np.linalg.norm(e - s))
-        if e is not None and h is not None:
-            fores.append(np.linalg.norm(h - e))
-    if ups and fores:
-        body = body.with_arms(float(np.mean(ups)), float(np.mean(fores)))
-    return body
-
-
 class TopViewTracker:
     """Several people's upper bodies from a depth stream seen from above."""
 
@@ -123,11 +102,22 @@ class TopViewTracker:
         self.targets.append(Target(track_id, PersonFilter(self.params, child, body, state, spread)))
         self._next_id = max(self._next_id, track_id + 1)
 
-    def _start_pending(self, index: int) -> None:
-        for tid, (first, js) in sorted(self._pending.items()):
-            if first == index:
-                body = body_from_joints(js)
-                self._start(tid, body, fit_state(js, body), spread=0.5)
+    def _start_pending(self, index: int, roi: RoiPoints) -> None:
+        """Start the init's people of this frame: each fitted to its joints, then to the ROI points
+        nearest its joints' model (eq. 5 among everyone, :func:`.start.fit_person`)."""
+        starting = [(tid, js) for tid, (first, js) in sorted(self._pending.items()) if first == index]
+        if not starting:
+            return
+        first = [fit_person(js, None, self.params.start) for _, js in starting]
+        models = [primitives(state[None], body)[0] for body, state in first]
+        models += [primitives(t.filter.estimate[None], t.filter.body)[0] for t in self.targets]
+        owner = np.full(len(roi.points), -1)
+        if len(roi.points):
+            dist = np.stack([nearest(roi.points, m)[0] for m in models])
+            owner = np.where(dist.min(0) <= self.params.exclusion.max_assign_mm, np.argmin(dist, 0), -1)
+        for k, (tid, js) in enumerate(starting):
+            body, state = fit_person(js, roi.points[owner == k], self.params.start)
+            self._start(tid, body, state, spread=0.5)
 
     def _start_from_roi(self, roi: RoiPoints, owner: np.ndarray, shape: tuple[int, int]) -> None:
         """Sec. 2.1's ROI, automatically: blobs of ROI pixels nobody owns start people."""
@@ -216,7 +206,8 @@ class TopViewTracker:
         within ``max_assign_mm``)."""
         if not self.targets or not len(roi.points):
             return np.full(len(roi.points), -1, np.int64)
-        dist = np.stack([nearest(roi.points, primitives(t.filter.estimate[None], t.filter.body)[0])[0]
+        v = self.params.exclusion.velocity
+        dist = np.stack([nearest(roi.points, primitives(t.filter.predicted(v)[None], t.filter.body)[0])[0]
                          for t in self.targets])
         owner = np.argmin(dist, 0)
         owner[dist.min(0) > self.params.exclusion.max_assign_mm] = -1
@@ -227,7 +218,7 @@ class TopViewTracker:
         view = self._view(frames)
         roi = self.roi(view)
         if self._pending is not None:
-            self._start_pending(frames.index)
+            self._start_pending(frames.index, roi)
         owner = self.assign(roi)
         if self.automatic:
             before = len(self.targets)
