@@ -85,8 +85,7 @@ class DetectionCue:
         used = set()
         for i, j in pairs:
             det = Box(*dets[j, :4])
-            # a track's start frame keeps the boxes it was given (an annotator's, or a blob's)
-            if det.iou(boxes[i]) < self.p.steer_below and people[i].started != index:
+            if det.iou(boxes[i]) < self.p.steer_below:
                 self._steer(people[i], boxes[i], det, self.p.steer)
             self.last_match[people[i].track_id] = index
             if people[i].lost_since is not None:
