@@ -670,8 +670,6 @@ def _move_a_keyframe(page, store, clip):
     _wait_for(undone, what="the keyframe move undone with its in-between boxes")
     pd.testing.assert_frame_equal(rows(rest), others)
     # back to the frame the track operations below apply at, once Python has been told of it
-    page.evaluate("""() => { const e = window.partlabEditor, send = e.setState;
-        e.setState = (k, v) => { if (k === "view") e.sentFrame = v.frame; return send(k, v); }; }""")
-    _editor(page, f"e.show({back}, true)")
+    _editor(page, f"(e.sentFrame = -1, e.show({back}, true))")
     page.wait_for_function(f"() => window.partlabEditor.sentFrame === {back}")
     page.locator('[data-testid="stStatusWidget"]').wait_for(state="detached", timeout=60_000)

