@@ -70,7 +70,7 @@ def postgres_server():
     data = os.path.join(root, "db")
     subprocess.run(prefix + [initdb, "-D", data, "-A", "trust", "-U", "partlab"], check=True, capture_output=True)
     subprocess.run(prefix + [pg_ctl, "-D", data, "-l", os.path.join(root, "log"), "-w", "-o",
-                             f"-p {port} -k {root} -c listen_addresses=127.0.0.1", "start"],
+                             f"-p {port} -k {root} -c listen_addresses=127.0.0.1 -c max_connections=1000", "start"],
                    check=True, capture_output=True)
     try:
         yield f"postgresql+psycopg://partlab@127.0.0.1:{port}"
