@@ -167,6 +167,8 @@ def test_a_full_disk_is_a_sentence_and_keeps_what_was_saved(store, tracked_clip,
     assert list((data_dir() / "uploads").iterdir()) == [] and [c.id for c in store.clips(project.id)] == [clip.id]
 
 
+@pytest.mark.skipif(os.environ.get("PARTLAB_TEST_BACKEND", "sqlite") != "sqlite",
+                    reason="the SQLite store lives in the data directory; a PostgreSQL one does not")
 def test_a_read_only_data_directory_is_a_sentence(tmp_path, monkeypatch):
     data = tmp_path / "read-only"
     data.mkdir()
