@@ -10,11 +10,8 @@ from __future__ import annotations
 
 import contextlib
 import os
-import socket
 import subprocess
 import sys
-import time
-import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -84,6 +81,8 @@ def streamlit_command(host: str, port: int, extra_hosts: str = "") -> list[str]:
 
 def free_port(host: str = "127.0.0.1") -> int:
     """A TCP port nothing listens on now (the OS picks it)."""
+    import socket
+
     with socket.socket() as s:
         s.bind((host, 0))
         return s.getsockname()[1]
@@ -96,6 +95,9 @@ def serving(env: dict, log, cwd: str | os.PathLike | None = None, port: int | No
     open file ``log``), wait until its health check answers, yield ``(url, process)``, and stop it
     on exit. For the browser tests and the page benchmark: raises RuntimeError when the app exits
     or does not answer within ``wait_s``."""
+    import time
+    import urllib.request
+
     port = port or free_port()
     proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=cwd, env=env, stdout=log,
                             stderr=subprocess.STDOUT)

@@ -277,11 +277,6 @@ class JobRow(Base):
     finished: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
 
 
-#: what a user may do in one project (revision 5), weakest first: a ``viewer`` reads, an ``annotator``
-#: also edits, tracks, trains and uploads, an ``owner`` also grants roles (:mod:`partlab.labelling.access`)
-ROLES: tuple[str, ...] = ("viewer", "annotator", "owner")
-
-
 class UserRow(Base):
     """A user who signs in to the app (revision 5); ``password`` is an Argon2id hash, never the password."""
 
