@@ -422,6 +422,17 @@ def _storage_error(url: str, reason: str) -> StoreError:
     return StoreError(f"{shown}: {reason}; this change was not saved (what was saved before is intact)")
 
 
+def dispose_engines() -> None:
+    """Close every pooled connection of this process's engines and forget them (the next
+    :class:`Store` opens a new one). For tests and workers that open many databases in turn: a
+    PostgreSQL server refuses clients once its connection limit is reached."""
+    with _ENGINES_LOCK:
+        engines = list(_ENGINES.values())
+        _ENGINES.clear()
+    for eng in engines:
+        eng.dispose()
+
+
 def _engine(url: str):
     """One engine per URL per process (Streamlit reruns must not open new pools)."""
     with _ENGINES_LOCK:
