@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import itertools
 import os
-import sys
 import shutil
 import socket
 import subprocess
+import sys
 import tempfile
 
 import pytest
