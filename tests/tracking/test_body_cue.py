@@ -34,6 +34,21 @@ def test_hungarian_association_prefers_the_total_overlap_and_gates_by_iou():
     assert near == [(0, 0)]
 
 
+def test_colour_affinity_gates_and_weighs_the_assignment():
+    # two walkers side by side: both detections overlap both tracks; by IoU alone track 0 takes
+    # detection 0, but detection 0 looks like track 1 (affinity 0.9) and detection 1 like track 0
+    tracks = np.array([[0, 0, 10, 20], [4, 0, 10, 20]], float)
+    dets = np.array([[1, 0, 10, 20], [3, 0, 10, 20]], float)
+    assert sorted(associate(tracks, dets, 0.3)) == [(0, 0), (1, 1)]
+    aff = np.array([[0.2, 0.9], [0.9, 0.2]])
+    assert sorted(associate(tracks, dets, 0.3, aff, 0.0, 1.0)) == [(0, 1), (1, 0)]
+    # gated: pairs below the minimum similarity are never made, even if nothing else is left
+    assert associate(tracks, dets[:1], 0.3, aff[:, :1], 0.5, 0.0) == [(1, 0)]
+    assert associate(tracks[:1], dets[:1], 0.3, aff[:1, :1], 0.5, 0.0) == []
+    # NaN affinity (not computed) never pairs when gating
+    assert associate(tracks[:1], dets[:1], 0.3, np.array([[np.nan]]), 0.1, 0.0) == []
+
+
 def test_the_detection_cue_starts_a_track_on_a_person_entering_and_ends_it_on_leaving(monkeypatch):
     monkeypatch.setitem(S.BUILDERS, "single", _crossing)
     params = BodyParams().updated({"detector.blob_starts": False})  # only detections start tracks

@@ -65,6 +65,8 @@ class DetectionCue:
         self.detector = PeopleDetector(self.p.scan())
         self.candidates: list[Candidate] = []
         self.last_match: dict[int, int] = {}
+        self.last_seen: dict[int, tuple[int, float, float]] = {}  # track id -> (frame, centre) of its last detection
+        self.velocity: dict[int, np.ndarray] = {}  # track id -> per-frame motion between its detections
         self.scans = 0
         self.detections = np.zeros((0, 5))
 
@@ -81,11 +83,16 @@ class DetectionCue:
         regions = _blob_regions(mask, self.p.min_region_height) + boxes
         dets = self.detector.detect(frame, regions)
         self.detections = dets
-        pairs = associate(np.array([b.as_tuple() for b in boxes]).reshape(-1, 4), dets, self.p.match_iou)
+        track_boxes = np.array([b.as_tuple() for b in boxes]).reshape(-1, 4)
+        pairs = associate(track_boxes, dets, self.p.match_iou, self._affinity(people, boxes, dets, ycc),
+                          self.p.match_similarity, self.p.similarity_weight)
         used = set()
         for i, j in pairs:
             det = Box(*dets[j, :4])
-            if det.iou(boxes[i]) < self.p.steer_below:
+            self._seen(people[i].track_id, index, det)
+            if self.p.steer_coasting > 0 and (people[i].occluded_by is not None or people[i].lost_since is not None):
+                self._steer_coasting(people[i], boxes[i], det)
+            elif det.iou(boxes[i]) < self.p.steer_below:
                 self._steer(people[i], boxes[i], det, self.p.steer)
             self.last_match[people[i].track_id] = index
             if people[i].lost_since is not None:
@@ -99,6 +106,51 @@ class DetectionCue:
             self._confirm(index, dets, free, ycc, mask)
         self._end(index)
 
+    def _affinity(self, people: list, boxes: list[Box], dets: np.ndarray, ycc) -> np.ndarray | None:
+        """``(tracks, detections)`` Bhattacharyya coefficient of each track's torso model (or only
+        part's) at the place the detection puts the torso; NaN where the boxes overlap below
+        ``match_iou`` (never paired anyway). None when appearance does not gate association."""
+        if self.p.match_similarity <= 0 and self.p.similarity_weight <= 0:
+            return None
+        out = np.full((len(people), len(dets)), np.nan)
+        if not len(people) or not len(dets):
+            return out
+        iou = iou_xywh(np.array([b.as_tuple() for b in boxes]).reshape(-1, 4), dets[:, :4])
+        arr = None
+        for i, person in enumerate(people):
+            near = np.flatnonzero(iou[i] >= self.p.match_iou)
+            if not len(near):
+                continue
+            arr = as_array(ycc) if arr is None else arr
+            f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
+            states = np.array([[*t.centre, t.w, t.h, 0.0, 0.0] for t in
+                               (_target(f.box, boxes[i], Box(*dets[j, :4])) for j in near)], dtype=np.float32)
+            out[i, near] = f.similarities(arr, states)
+        return out
+
+    def _seen(self, track_id: int, index: int, det: Box) -> None:
+        """Remember where a detection saw the track and how fast it moved since the one before
+        (within ``velocity_frames``; averaged with the previous estimate)."""
+        cx, cy = det.centre
+        prev = self.last_seen.get(track_id)
+        if prev is not None and 0 < index - prev[0] <= self.p.velocity_frames:
+            v = np.array([cx - prev[1], cy - prev[2]]) / (index - prev[0])
+            old = self.velocity.get(track_id)
+            self.velocity[track_id] = v if old is None else 0.5 * (v + old)
+        else:
+            self.velocity.pop(track_id, None)
+        self.last_seen[track_id] = (index, cx, cy)
+
+    def _steer_coasting(self, person, reported: Box, det: Box) -> None:
+        """A track coasting on its dynamics (behind someone, or lost) that a detection sees (its
+        colour gating passed) goes ``steer_coasting`` of the way there and coasts on with the
+        motion its detections show: people in groups stop and turn, which the velocity it had
+        before the occlusion cannot foresee."""
+        self._steer(person, reported, det, self.p.steer_coasting)
+        v = self.velocity.get(person.track_id)
+        for f in person.filters.values():
+            f.set_velocity(v if v is not None else np.zeros(2))
+
     def _steer(self, person, reported: Box, det: Box, gain: float) -> None:
         if gain <= 0:
             return
@@ -108,9 +160,16 @@ class DetectionCue:
         torso = person.filters.get("torso")
         follows = not self.p.steer_head and torso is not None and "head" in person.filters
         before = torso.state[0:2].copy() if torso is not None else None
-        for name, f in person.filters.items():
-            if name != "head" or not follows:
-                f.steer(_target(f.box, reported, det), gain)
+        steered = [n for n in person.filters if n != "head" or not follows]
+        if len(steered) < len(person.filters):
+            # across, the detection maps the parts it steers (a head wider than the body, the
+            # decomposition's strip, would otherwise narrow the torso at every scan: the person
+            # box never narrows while the head is not steered); down, the whole person
+            across = minimum_bounding_rectangle(self.tracker.report_box(n, person.filters[n].box) for n in steered)
+            reported = Box(across.x, reported.y, across.w, reported.h)
+        for name in steered:
+            f = person.filters[name]
+            f.steer(_target(f.box, reported, det), gain)
         if follows:  # the head moves with the torso's correction, keeping its size and place on it
             person.filters["head"].shift(torso.state[0:2] - before)
 

@@ -186,6 +186,15 @@ class BodyBackground:
     ratio: float = number(0.7, FRACTION)
     morph_open: int = number(3, COUNT)
     morph_close: int = number(9, COUNT)
+    # A moving camera (pan, tilt; partlab.tracking.core.camera_motion: median Lucas-Kanade shift of
+    # a grid of points) makes the background model report the whole scene: while the camera's
+    # frame-to-frame shift reached ``camera_motion`` pixels in the last ``camera_hold`` frames, the
+    # mask is not used (no blob starts, no foreground support, tracks follow colour and the
+    # detector). Static
+    # clips measure at most 0.14 px (PETS09, OTB Crossing), a panning one 2.1 (OTB Human3).
+    # 0 turns it off (a static camera assumed, as Zhao & Lee do).
+    camera_motion: float = number(0.5, Rule())
+    camera_hold: int = number(60, COUNT)
 
 
 @dataclass(frozen=True)
@@ -275,6 +284,19 @@ class BodyDetector:
     # A detection belongs to a track when their boxes overlap at IoU >= match_iou (Hungarian
     # assignment over all pairs).
     match_iou: float = number(0.3, FRACTION)
+    # ... and when the detection's torso region (where it puts the track's torso) matches the
+    # torso's colour model at least ``match_similarity`` (Bhattacharyya coefficient; 0: IoU
+    # alone): a walker's box overlaps the neighbour beside it as much as its own person, and a
+    # detection of the neighbour steers the track onto them. The assignment maximises IoU +
+    # ``similarity_weight`` x similarity.
+    match_similarity: float = number(0.0, FRACTION)
+    similarity_weight: float = number(0.0, Rule())
+    # A track coasting on its dynamics (behind another person, or lost) that a detection matches
+    # is moved this share of the way to it and coasts on with the per-frame motion of its last
+    # detections (at most ``velocity_frames`` apart): people walking in groups stop and turn
+    # behind each other. 0: coasting tracks are steered like the others and keep their velocity.
+    steer_coasting: float = number(0.0, FRACTION)
+    velocity_frames: int = number(9, POSITIVE_COUNT)
     # A matched detection moves and re-sizes the track's parts this share of the way to where it
     # puts them (the part boxes keep their places inside the person box): colour likelihoods hardly
     # constrain a box's size, a detector's window does.
@@ -397,7 +419,8 @@ class BodyParams(Parameters):
     output: BodyOutput = group_field(BodyOutput)
 
     #: fields added after partlab 0.2 (no flat name)
-    ADDED: ClassVar[tuple[str, ...]] = tuple(f"detector.{f.name}" for f in fields(BodyDetector))
+    ADDED: ClassVar[tuple[str, ...]] = tuple(f"detector.{f.name}" for f in fields(BodyDetector)) + (
+        "background.camera_motion", "background.camera_hold")
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {

@@ -145,17 +145,31 @@ def _nms(boxes: np.ndarray, scores: np.ndarray, threshold: float) -> np.ndarray:
     return np.asarray(kept, dtype=int)
 
 
-def associate(tracks: np.ndarray, detections: np.ndarray, iou_min: float) -> list[tuple[int, int]]:
+def associate(tracks: np.ndarray, detections: np.ndarray, iou_min: float, affinity: np.ndarray | None = None,
+              affinity_min: float = 0.0, affinity_weight: float = 0.0) -> list[tuple[int, int]]:
     """``(track index, detection index)`` pairs of the assignment maximising the total IoU
     (Hungarian method), only pairs with IoU at least ``iou_min``. ``tracks``, ``detections``:
-    ``(N, >=4)`` x, y, w, h."""
+    ``(N, >=4)`` x, y, w, h.
+
+    ``affinity`` ``(tracks, detections)``, e.g. how well each detection matches each track's
+    colour model (a walker's box overlaps the neighbour it walks beside as much as its own
+    person): pairs below ``affinity_min`` are never made, and the assignment maximises
+    ``IoU + affinity_weight * affinity`` (appearance and motion gating, as in DeepSORT, Wojke et
+    al. 2017, with colour in place of a learnt embedding)."""
     if len(tracks) == 0 or len(detections) == 0:
         return []
     from scipy.optimize import linear_sum_assignment  # lazy: scipy.optimize costs a start-up 2x numpy's
 
     iou = iou_xywh(np.asarray(tracks, float)[:, :4], np.asarray(detections, float)[:, :4])
-    rows, cols = linear_sum_assignment(-iou)
-    return [(int(t), int(d)) for t, d in zip(rows, cols) if iou[t, d] >= iou_min]
+    if affinity is None:  # IoU alone: assign over every pair, then keep those overlapping enough
+        rows, cols = linear_sum_assignment(-iou)
+        return [(int(t), int(d)) for t, d in zip(rows, cols) if iou[t, d] >= iou_min]
+    # gated first (IoU and affinity), then assigned among the pairs left
+    a = np.nan_to_num(np.asarray(affinity, float), nan=-np.inf)
+    ok = (iou >= iou_min) & (a >= affinity_min)
+    score = np.where(ok, iou + affinity_weight * np.where(ok, a, 0.0), -1e6)
+    rows, cols = linear_sum_assignment(-score)
+    return [(int(t), int(d)) for t, d in zip(rows, cols) if ok[t, d]]
 
 
 def associate_near(previous: np.ndarray, detections: np.ndarray, max_distance: float) -> list[tuple[int, int]]:
