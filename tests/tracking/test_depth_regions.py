@@ -95,6 +95,16 @@ def test_a_desk_top_is_a_support_surface_and_a_hand_on_it_stays_a_hand():
     assert support_surfaces(d2, d2 < fd2.mean - 40, K, fd2, 20 * 22, p, np.random.default_rng(0)) is None
 
 
+def test_a_long_streak_in_front_of_the_face_is_not_a_hand():
+    d = _room()
+    d[100:104, 20:140] = 1200.0  # 120 x 4 px: the size of a hand's component, six face widths long
+    _blob(d, 40, 60, 7, 1150.0)
+    face_box = (70, 8, 20, 22)
+    fd = face_depth(d, face_box, fx=160.0)
+    regions = hand_regions(d, fd, face_box, 160.0, DepthCue())
+    assert [(round(r.xc), round(r.yc)) for r in regions] == [(40, 60)]
+
+
 def test_importance_weight_is_f_over_g():
     u, sigma = np.array([50.0, 40.0]), np.array([4.0, 6.0])
     xy = np.array([[50.0, 40.0], [58.0, 40.0], [20.0, 10.0]])
