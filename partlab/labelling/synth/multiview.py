@@ -278,7 +278,9 @@ def _handshake(rng, n, story) -> Script3D:
     apps = _people(rng, 2)
     t = _story_time(n)
     axis = rng.uniform(-np.pi, np.pi)  # the line between the two people
-    gap = rng.uniform(1050, 1250)  # mm between their feet
+    # mm between their feet: close enough for the hands to meet halfway (an arm reaches about 0.35 H
+    # from the shoulder; at 1.05-1.25 m they stopped 0.3 m short of each other)
+    gap = rng.uniform(700, 850)
     u = np.array([np.cos(axis), np.sin(axis)])
     side = np.array([-u[1], u[0]])
     posA = np.repeat((-u * gap / 2)[None], n, 0)
@@ -298,7 +300,7 @@ def _handshake(rng, n, story) -> Script3D:
     s0, s1 = _span(story, 25, 40, (18, 28))
     shake = bump(t, s0 / 149, s1 / 149, ramp=0.06)
     mid = np.zeros((n, 3))
-    mid[:, 2] = 0.56 * hmean + 0.045 * np.sin(2 * np.pi * 3.0 * np.arange(n) / FPS) * (shake > 0.99)
+    mid[:, 2] = 0.62 * hmean + 0.045 * np.sin(2 * np.pi * 3.0 * np.arange(n) / FPS) * (shake > 0.99)
     mid[:, :2] = -0.02 * side
     # passing: A's left hand gives an object to B's right hand (about frames 80-125), B keeps it
     g0, g1 = _span(story, s1 + 25, s1 + 45, (12, 18))

@@ -42,6 +42,7 @@ ACTIVITY_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_
 KINDS = ("clap", "handshake", "exchange", "pick", "place", "hand_head")
 
 Key = tuple[int, str]  # (track_id, part)
+LOST = "lost"  # the state of a target the tracker no longer sees (limbs' state machine)
 
 
 class ActivityTracker:
@@ -61,8 +62,8 @@ class ActivityTracker:
     def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
         rows = self.inner.step(frames, foreground)
         for r in rows:
-            if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0:
-                continue
+            if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0 or r.state == LOST:
+                continue  # a lost target's box is where it was last seen, not where it is
             stream = r.camera or next(iter(frames.views))
             view = frames.views.get(stream)
             if view is None or view.color is None:
@@ -83,7 +84,8 @@ class ActivityTracker:
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
         out = self.inner.table(records)
         joins = getattr(self.inner, "events", None)
-        found = contacts(out, self.activity_params)
+        seen = out[out["state"] != LOST] if "state" in out.columns else out
+        found = contacts(seen, self.activity_params)
         joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
         clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
                    for t, n in self._clothes_n.items()}
@@ -212,7 +214,11 @@ def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
     cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
     hands = tracks[tracks["part"].isin(HAND_PARTS)]
     if "camera" in hands.columns and (hands["camera"] != "").any():
-        hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
+        if {"X", "Y", "Z"} <= set(hands.columns) and hands[["X", "Y", "Z"]].notna().all(axis=None):
+            # a 3D tracker: a hand is where it is, whichever view saw it (one view may not see it)
+            hands = hands.drop_duplicates(["frame", "track_id", "part"])
+        else:
+            hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
     if hands.empty:
         return pd.DataFrame(columns=cols)
     rows = [(start, end, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact")
