@@ -113,6 +113,20 @@ def test_still_moments_and_contacts_from_tracks():
     assert [(j["start_frame"], j["end_frame"]) for j in merged_joins(twice, P)] == [(20, 45)]
 
 
+def test_3d_touches_come_from_whichever_view_saw_each_hand():
+    # two people's right hands 60 mm apart over frames 10-19 (else 600 mm); view cam0 sees hand 1
+    # only, cam1 sees hand 2 only: in 3D they touch although no view shows both
+    rows = []
+    for f in range(30):
+        gap = 60.0 if 10 <= f <= 19 else 600.0
+        rows.append(dict(frame=f, track_id=1, part="right_hand", x=100, y=100, w=10, h=10, camera="cam0",
+                         X=0.0, Y=0.0, Z=1000.0))
+        rows.append(dict(frame=f, track_id=2, part="right_hand", x=300, y=100, w=10, h=10, camera="cam1",
+                         X=gap, Y=0.0, Z=1000.0))
+    found = contacts(pd.DataFrame(rows), P)
+    assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
+
+
 def test_temporal_matching():
     assert temporal_iou((10, 19), (15, 24)) == pytest.approx(5 / 15)
     truth = pd.DataFrame(dict(kind=["pick", "place"], start_frame=[10, 50], end_frame=[20, 60]))
