@@ -40,24 +40,10 @@ from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
 LIMB_PARTS = ("head", "left_hand", "right_hand")
-
-
-def triangulate(cameras: list[Camera], pixels: list[np.ndarray]) -> np.ndarray:
-    """A world point (mm) from its pixels in two or more views: ``cv2.triangulatePoints`` on each
-    pair of views (undistorted pixels), averaged."""
-    pts = []
-    for i in range(len(cameras)):
-        for j in range(i + 1, len(cameras)):
-            a = cv2.undistortPoints(np.asarray(pixels[i], float).reshape(1, 1, 2), cameras[i].K, cameras[i].dist,
-                                    P=cameras[i].K).reshape(2, 1)
-            b = cv2.undistortPoints(np.asarray(pixels[j], float).reshape(1, 1, 2), cameras[j].K, cameras[j].dist,
-                                    P=cameras[j].K).reshape(2, 1)
-            h = cv2.triangulatePoints(cameras[i].P, cameras[j].P, a, b).ravel()
-            pts.append(h[:3] / h[3])
-    return np.mean(pts, axis=0)
 
 
 @dataclass
