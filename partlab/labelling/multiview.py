@@ -26,6 +26,7 @@ boxes get the new ``X, Y, Z`` too, so every view of the target holds the same po
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -75,6 +76,28 @@ def store_take_tracks(store: Store, take_id: int, tracks: pd.DataFrame, tracker:
     return {name: store.save_tracker_run(clips[name], tracks[tracks["camera"].astype(str) == name],
                                          tracker=tracker, seed=seed)
             for name in clips if (tracks["camera"].astype(str) == name).any()}
+
+
+def import_take_folder(store: Store, project_id: int, path: str, tracks: str | None = None):
+    """Add the take folder ``path`` to the project (``Store.import_take``) and, with ``tracks`` (a
+    tracks CSV with a ``camera`` column), store its boxes per view; returns the take. A tracks file
+    that cannot be read or names no stream of the take adds nothing (the check comes first)."""
+    from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
+
+    if not str(path).strip() or not Path(path).is_dir():
+        raise StoreError(f"{path or 'the take folder'}: no such folder")
+    table = None
+    if tracks:
+        try:
+            table = read_tracks_csv(tracks)
+        except (TracksCSVError, OSError) as exc:
+            raise StoreError(f"{tracks}: {exc}") from None
+        if "camera" not in table.columns or table["camera"].astype(str).eq("").all():
+            raise StoreError(f"{tracks}: no camera column (which view is each box in?)")
+    take = store.import_take(project_id, path)
+    if table is not None:
+        store_take_tracks(store, take.id, table)
+    return store.take(take.id)
 
 
 def _row(store: Store, clip_id: int, frame: int, track_id: int, part: str):
