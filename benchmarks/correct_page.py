@@ -16,13 +16,10 @@ from __future__ import annotations
 
 import argparse
 import os
-import socket
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
-import urllib.request
 from pathlib import Path
 
 import pandas as pd
@@ -52,26 +49,14 @@ def main() -> None:
     env = dict(os.environ, PARTLAB_DATA=str(data), PARTLAB_DEMO="0", PYTHONPATH=str(ROOT))
     sys.path.insert(0, str(ROOT))
     os.environ.update(PARTLAB_DATA=str(data))
-    from partlab.commands.app import streamlit_command
+    from partlab.commands.app import serving
     from partlab.labelling.store import Store
 
     store = Store()
     project = store.create_project("PETS09")
     clip = store.add_clip(project.id, PETS / "vtest.avi", name="PETS09-S2L1 view 1")
     store.save_tracker_run(clip.id, pets_boxes(PETS / "gt.csv"), tracker="import")
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
-    proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.STDOUT)
-    url = f"http://127.0.0.1:{port}"
-    try:
-        for _ in range(300):
-            try:
-                if urllib.request.urlopen(url + "/_stcore/health", timeout=1).status == 200:
-                    break
-            except OSError:
-                time.sleep(0.1)
+    with serving(env, subprocess.DEVNULL, cwd=ROOT) as (url, _proc):
         from playwright.sync_api import sync_playwright
 
         with sync_playwright() as p:
@@ -82,12 +67,6 @@ def main() -> None:
                 run(page, url, a.shots and rep == 0, rep)
                 page.close()
             browser.close()
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores (commit {commit()})")
 
 

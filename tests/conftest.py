@@ -14,6 +14,7 @@ import os
 import shutil
 import socket
 import subprocess
+import sys
 import tempfile
 
 import pytest
@@ -31,6 +32,8 @@ def _isolated_data_dir(request, tmp_path, monkeypatch):
     elif TEST_BACKEND != "sqlite":
         pytest.fail(f"PARTLAB_TEST_BACKEND must be sqlite or postgresql, got {TEST_BACKEND!r}")
     yield
+    if "partlab.labelling.store" in sys.modules:  # each test's database: its pool closes with the test
+        sys.modules["partlab.labelling.store"].dispose_engines()
 
 
 def _free_port() -> int:

@@ -8,9 +8,11 @@ and shows each user only the projects they hold a role in. The default is ``none
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 from partlab.cli import CommandError
@@ -75,6 +77,50 @@ def streamlit_command(host: str, port: int, extra_hosts: str = "") -> list[str]:
         "--server.enableCORS", "true",
         "--server.enableXsrfProtection", "true",
     ] + [arg for name in allowed_hosts(host, extra_hosts) for arg in ("--server.allowedHosts", name)]
+
+
+def free_port(host: str = "127.0.0.1") -> int:
+    """A TCP port nothing listens on now (the OS picks it)."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind((host, 0))
+        return s.getsockname()[1]
+
+
+@contextlib.contextmanager
+def serving(env: dict, log, cwd: str | os.PathLike | None = None, port: int | None = None,
+            wait_s: float = 60.0) -> Iterator[tuple[str, subprocess.Popen]]:
+    """Serve the app on 127.0.0.1 in a child process (``env`` its environment, output to the
+    open file ``log``), wait until its health check answers, yield ``(url, process)``, and stop it
+    on exit. For the browser tests and the page benchmark: raises RuntimeError when the app exits
+    or does not answer within ``wait_s``."""
+    import time
+    import urllib.request
+
+    port = port or free_port()
+    proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=cwd, env=env, stdout=log,
+                            stderr=subprocess.STDOUT)
+    url = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + wait_s
+        while True:
+            try:
+                if urllib.request.urlopen(url + "/_stcore/health", timeout=1).status == 200:
+                    break
+            except OSError:
+                time.sleep(0.1)
+            if proc.poll() is not None:
+                raise RuntimeError(f"the app exited with code {proc.returncode}")
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"the app did not answer within {wait_s:.0f} s")
+        yield url, proc
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
 
 
 def is_loopback(host: str) -> bool:

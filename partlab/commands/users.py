@@ -18,7 +18,7 @@ from __future__ import annotations
 import sys
 
 from partlab.cli import CommandError
-from partlab.labelling.store import ROLES
+from partlab.labelling.roles import ROLES
 
 ACTIONS = ("add", "grant", "revoke", "passwd", "list", "remove")
 

@@ -2,9 +2,11 @@
 default, or an existing scheduler by address (``tcp://HOST:8786``).
 
 Tracking is CPU-bound numpy/numba in Python, so a local cluster runs one single-threaded worker
-process per core asked for (threads would share one interpreter lock). Each worker process
-compiles partlab's kernels on its first task; that start-up is part of the per-task overhead
-measured by ``benchmarks/batch_scaling.py``.
+process per core asked for (threads would share one interpreter lock). A worker is one core all
+through: OpenCV's own thread pool (resize, colour conversion, HOG) would otherwise take every core
+of the machine in each worker, and two workers would fight over them (measured: 1.20x for 2
+workers instead of about 2x). Each worker process compiles partlab's kernels on its first task;
+that start-up is part of the per-task overhead measured by ``benchmarks/batch_scaling.py``.
 """
 
 from __future__ import annotations
@@ -16,6 +18,31 @@ import sys
 from collections.abc import Iterator
 
 from partlab.errors import UserError
+
+#: The environment of a local worker process: one thread for every library that keeps a pool.
+ONE_CORE_ENV = {"OPENCV_FOR_THREADS_NUM": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+                "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1"}
+
+
+def one_core() -> None:
+    """Keep this process's OpenCV on one thread (a worker of a cluster started elsewhere, whose
+    environment partlab did not set)."""
+    import cv2
+
+    cv2.setNumThreads(1)
+
+
+def _one_core_everywhere(c) -> None:
+    """Run :func:`one_core` on every worker, now and on workers that join later."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class OneCore(WorkerPlugin):
+        name = "partlab-one-core"
+
+        def setup(self, worker) -> None:
+            one_core()
+
+    c.register_plugin(OneCore())
 
 
 def _quiet_logs() -> None:
@@ -42,6 +69,7 @@ def client(scheduler: str | None = None, workers: int | None = None,
         except (OSError, TimeoutError) as exc:
             raise UserError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
         try:
+            _one_core_everywhere(c)
             yield c
         finally:
             c.close()
@@ -51,7 +79,7 @@ def client(scheduler: str | None = None, workers: int | None = None,
         raise UserError(f"--workers must be at least 1, got {n}")
     with _spawn_safe_main():  # worker processes are spawned once, here
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=dashboard,
-                               silence_logs=logging.ERROR)
+                               silence_logs=logging.ERROR, env=ONE_CORE_ENV)
     try:
         with Client(cluster) as c:
             yield c

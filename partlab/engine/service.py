@@ -25,8 +25,10 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     from distributed import LocalCluster
 
+    from partlab.engine.cluster import ONE_CORE_ENV
+
     cluster = LocalCluster(n_workers=max(1, args.workers), threads_per_worker=1, processes=True,
-                           dashboard_address=args.dashboard, silence_logs=logging.ERROR)
+                           dashboard_address=args.dashboard, silence_logs=logging.ERROR, env=ONE_CORE_ENV)
     path = Path(args.address_file)
     tmp = path.with_suffix(".tmp")
     tmp.write_text(json.dumps({"address": cluster.scheduler_address, "pid": os.getpid(),

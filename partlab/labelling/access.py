@@ -2,7 +2,7 @@
 
 A user has a name and a password, kept as an Argon2id hash (argon2-cffi's ``PasswordHasher``,
 OWASP's baseline parameters; never the password). In each project a user holds at most one role
-(:data:`partlab.labelling.store.ROLES`):
+(:data:`partlab.labelling.roles.ROLES`):
 
 - ``viewer`` sees the project's clips, boxes, runs and bundles, evaluates and exports;
 - ``annotator`` also uploads clips, tracks, corrects boxes, reviews and trains;
@@ -35,7 +35,8 @@ from argon2 import PasswordHasher
 from argon2.exceptions import InvalidHashError, VerificationError
 from sqlalchemy import delete, select
 
-from partlab.labelling.store import ROLES, RoleRow, Store, StoreError, UserRow
+from partlab.labelling.roles import ROLES
+from partlab.labelling.store import RoleRow, Store, StoreError, UserRow
 
 #: shortest password accepted (NIST SP 800-63B asks for at least 8 characters)
 MIN_PASSWORD = 8

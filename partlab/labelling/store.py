@@ -277,11 +277,6 @@ class JobRow(Base):
     finished: Mapped[datetime | None] = mapped_column(DateTime(timezone=True), nullable=True)
 
 
-#: what a user may do in one project (revision 5), weakest first: a ``viewer`` reads, an ``annotator``
-#: also edits, tracks, trains and uploads, an ``owner`` also grants roles (:mod:`partlab.labelling.access`)
-ROLES: tuple[str, ...] = ("viewer", "annotator", "owner")
-
-
 class UserRow(Base):
     """A user who signs in to the app (revision 5); ``password`` is an Argon2id hash, never the password."""
 
@@ -425,6 +420,17 @@ def storage_failure(exc: BaseException) -> str | None:
 def _storage_error(url: str, reason: str) -> StoreError:
     shown = make_url(url).render_as_string(hide_password=True)
     return StoreError(f"{shown}: {reason}; this change was not saved (what was saved before is intact)")
+
+
+def dispose_engines() -> None:
+    """Close every pooled connection of this process's engines and forget them (the next
+    :class:`Store` opens a new one). For tests and workers that open many databases in turn: a
+    PostgreSQL server refuses clients once its connection limit is reached."""
+    with _ENGINES_LOCK:
+        engines = list(_ENGINES.values())
+        _ENGINES.clear()
+    for eng in engines:
+        eng.dispose()
 
 
 def _engine(url: str):

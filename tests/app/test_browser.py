@@ -11,16 +11,13 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import socket
-import subprocess
 import time
-import urllib.request
 from pathlib import Path
 
 import pytest
 from playwright import sync_api as playwright  # the test extra installs it: a broken import fails
 
-from partlab.commands.app import streamlit_command
+from partlab.commands.app import serving
 
 CHROMIUM = "/usr/bin/chromium"
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,41 +28,17 @@ if not os.path.exists(CHROMIUM):
     pytest.skip("chromium is not installed (apt-get install chromium; .ci/run does it)", allow_module_level=True)
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 @contextlib.contextmanager
 def _serving(tmp_path, **extra_env):
-    port = _free_port()
     # no demo project: tests/app/test_demo.py covers it, and rendering it would slow every first page
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]), PARTLAB_DEMO="0",
                **extra_env)
-    log = open(tmp_path / "server.log", "w")
-    proc = subprocess.Popen(streamlit_command("127.0.0.1", port), cwd=ROOT, env=env, stdout=log,
-                            stderr=subprocess.STDOUT)
-    url = f"http://127.0.0.1:{port}"
-    try:
-        for _ in range(300):
-            try:
-                if urllib.request.urlopen(url + "/_stcore/health", timeout=1).status == 200:
-                    break
-            except OSError:
-                time.sleep(0.1)
-            if proc.poll() is not None:
-                raise RuntimeError(f"the app exited: {(tmp_path / 'server.log').read_text()}")
-        else:
-            raise RuntimeError("the app did not answer within 30 s")
-        yield url, proc
-    finally:
-        proc.terminate()
+    with open(tmp_path / "server.log", "w") as log:
         try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-        log.close()
+            with serving(env, log, cwd=ROOT) as running:
+                yield running
+        except RuntimeError as exc:
+            raise RuntimeError(f"{exc}: {(tmp_path / 'server.log').read_text()}") from None
 
 
 @pytest.fixture

@@ -16,7 +16,10 @@ from partlab.labelling.video import VideoClip, VideoError, probe
 from partlab.tracking.tracks import read_tracks_csv, write_tracks_csv
 from tests.tracking.walkers import background, draw_walker
 
-DATA = Path(__file__).resolve().parents[2].parent.parent / "shared" / "data"
+ROOT = Path(__file__).resolve().parents[2]
+#: ../shared/data beside the repository (or beside a worktree's folder)
+DATA = next((p / "shared" / "data" for p in (ROOT.parent, ROOT.parent.parent) if (p / "shared" / "data").is_dir()),
+            ROOT.parent / "shared" / "data")
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,6 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from partlab.tracking.core.box import Box, iou_xywh
 
@@ -152,6 +151,8 @@ def associate(tracks: np.ndarray, detections: np.ndarray, iou_min: float) -> lis
     ``(N, >=4)`` x, y, w, h."""
     if len(tracks) == 0 or len(detections) == 0:
         return []
+    from scipy.optimize import linear_sum_assignment  # lazy: scipy.optimize costs a start-up 2x numpy's
+
     iou = iou_xywh(np.asarray(tracks, float)[:, :4], np.asarray(detections, float)[:, :4])
     rows, cols = linear_sum_assignment(-iou)
     return [(int(t), int(d)) for t, d in zip(rows, cols) if iou[t, d] >= iou_min]
@@ -169,5 +170,7 @@ def associate_near(previous: np.ndarray, detections: np.ndarray, max_distance: f
     d = np.hypot(*(ca[:, None, :] - cb[None, :, :]).transpose(2, 0, 1)) / np.maximum(b[None, :, 3], 1e-6)
     ratio = a[:, None, 3] / np.maximum(b[None, :, 3], 1e-6)
     cost = np.where((ratio <= 1.5) & (ratio >= 1 / 1.5), d, 1e6)
+    from scipy.optimize import linear_sum_assignment
+
     rows, cols = linear_sum_assignment(cost)
     return [(int(i), int(j)) for i, j in zip(rows, cols) if cost[i, j] <= max_distance]

@@ -1,0 +1,30 @@
+"""What `partlab track` loads (issue 12: start-up). A 5-frame track spends most of its time
+importing; these are packages the command line and the tracking path must not pay for (numba
+itself imports scipy and scipy.linalg: those are its price)."""
+
+import subprocess
+import sys
+
+import pytest
+
+HEAVY = ("sqlalchemy", "alembic", "scipy.optimize", "streamlit", "distributed", "sklearn", "plotly")
+
+
+@pytest.fixture(scope="module")
+def clip(tmp_path_factory):
+    out = tmp_path_factory.mktemp("start")
+    subprocess.run([sys.executable, "-m", "partlab", "synth", str(out), "--frames", "5", "--seed", "1"], check=True,
+                   capture_output=True)
+    return out / "clip.mp4"
+
+
+@pytest.mark.parametrize("tracker", ["body", "limbs", "all"])
+def test_a_short_track_loads_no_store_scipy_or_app(clip, tracker, tmp_path):
+    out = tmp_path / "tracks.csv"
+    code = ("import sys\n"
+            "from partlab.cli import main\n"
+            f"assert main(['track', {str(clip)!r}, '--tracker', {tracker!r}, '-o', {str(out)!r}]) == 0\n"
+            f"print('loaded:', *(m for m in {HEAVY!r} if m in sys.modules))\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.is_file()
+    assert run.stdout.splitlines()[-1].split() == ["loaded:"]
