@@ -103,6 +103,7 @@ def summarise(df: pd.DataFrame) -> None:
 
 
 LOAD: list[Path] = []  # --load
+MODELS: list[str] = ["start", "trained"]  # --models
 
 
 def pets(split: int, start, seeds, modes, train_seed: int, out: Path | None) -> pd.DataFrame:
@@ -114,7 +115,9 @@ def pets(split: int, start, seeds, modes, train_seed: int, out: Path | None) -> 
     clip = VideoClip(PETS / "vtest.avi")
     print(f"PETS09-S2L1: training on frames 0-{split - 1} ({len(train)} person boxes, "
           f"{train.track_id.nunique()} people)", flush=True)
-    if LOAD:
+    if MODELS == ["start"]:
+        trained = None
+    elif LOAD:
         from partlab.models.bundle import load_bundle
 
         trained = load_bundle(LOAD[0])
@@ -127,6 +130,7 @@ def pets(split: int, start, seeds, modes, train_seed: int, out: Path | None) -> 
     if not seeds:
         return pd.DataFrame()
     models = {"start": start, **({"trained": trained} if trained is not None else {})}
+    models = {k: v for k, v in models.items() if k in MODELS}
     return compare("PETS", open_take(PETS / "vtest.avi"), truth, split, models, seeds, modes)
 
 
@@ -164,6 +168,8 @@ def main() -> None:
     ap.add_argument("--bundle", type=Path, help="also save the trained PETS bundle here")
     ap.add_argument("--load", type=Path, help="compare with this PETS bundle instead of training one (e.g. one "
                                               "saved by --bundle, to run seeds in parallel)")
+    ap.add_argument("--models", default="start,trained", help="which to track with ('start' alone: no training; "
+                                                              "to run the start's seeds while training runs)")
     ap.add_argument("--synth", type=int, default=0, help="also run N randomized synthetic scenes")
     ap.add_argument("--synth-frames", type=int, default=200)
     ap.add_argument("--skip-pets", action="store_true")
@@ -171,6 +177,7 @@ def main() -> None:
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",") if s]  # none: only train (and save with --bundle)
     LOAD[:] = [a.load] if a.load else []
+    MODELS[:] = [m for m in a.models.split(",") if m]
     modes = [m for m in a.modes.split(",") if m]
     start = default_bundle() if a.start == "default" else None
     tables = []

@@ -16,11 +16,13 @@ but measured against what the tracker and its people detector do on the same fra
    over the corrected boxes of those frames (a false window starts a ghost track or drags a track
    off its person, a missed one leaves a box unsteered); the window's share of the body is the
    median ratio of corrected box to detector window over the true detections;
-3. **when a track without detections ends** (``detector.undetected_frames``): how long the
+3. **when tracks end** (``detector.undetected_frames``, ``detection.leave_fraction``): how long the
    detector goes without finding people who *are* there (the longest run of scans without a
    detection on each corrected track); a track undetected for much longer than the people on the
    corrected frames ever were is a ghost. Where the detector misses people for over
-   :data:`MAX_UNDETECTED_S` seconds, this cannot tell ghosts from people and stays off;
+   :data:`MAX_UNDETECTED_S` seconds, this cannot tell ghosts from people and stays off. And how
+   much of a person is in view where the corrected tracks begin and end at the frame's sides
+   (:func:`fit_leave_fraction`): a track goes on no longer than the annotator would label it;
 4. **the dynamics**: a person's parts move with the person, so the person boxes' constant-velocity
    noise (:func:`partlab.models.variance.fit_body_noise` on the ``person`` rows) widens each part's
    position and velocity noise where it is larger (the fits only ever widen, as for parts).
@@ -185,6 +187,47 @@ def fit_shrink(samples: pd.DataFrame, current: tuple[float, float], min_score: f
     return (round(min(sw, 1.0), 3), round(min(sh, 1.0), 3))
 
 
+def _box_errors(a: pd.DataFrame, suffix: str = "_t") -> np.ndarray:
+    """Squared error of boxes against corrected ones, in the corrected box's height (centre) and
+    in log size, averaged over the four terms: how far off a person-box estimate is."""
+    h = a["h" + suffix]
+    dcx = (a.x + a.w / 2 - a["x" + suffix] - a["w" + suffix] / 2) / h
+    dcy = (a.y + a.h / 2 - a["y" + suffix] - h / 2) / h
+    return ((dcx ** 2 + dcy ** 2 + np.log(a.w / a["w" + suffix]) ** 2 + np.log(a.h / h) ** 2) / 4).to_numpy()
+
+
+def fit_steer(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
+              min_score: float) -> tuple[float | None, dict]:
+    """``detector.steer``, the share of the way a matched detection moves a track's person box,
+    as the blend of two noisy estimates of one box that errs least (the Kalman gain of a scalar
+    state): ``e_t / (e_t + e_d)``, with ``e_t`` the tracker's and ``e_d`` the detector's median
+    squared error (:func:`_box_errors`) against the corrected boxes: the tracker's person boxes
+    on frames where it is on the person, the detections at ``min_score`` matched to a corrected
+    box at IoU >= 0.3 (what the cue matches). To 0.05 in [0.1, 1]; None with fewer than
+    :data:`MIN_PAIRS` of either."""
+    det = samples[samples["score"].notna() & (samples["iou"] >= 0.3) & (samples["score"] >= min_score)]
+    truth_rows = samples[samples["score"].isna()][["frame", "truth", *XYWH]]
+    d = det.merge(truth_rows, on=["frame", "truth"], suffixes=("", "_t"))
+    pairs = []
+    for t, g in zip(tracked, truths):
+        t = t[t["part"] == "person"]
+        t = t[t["frame"] > t.groupby("track_id")["frame"].transform("min")]
+        g = g[g["part"] == "person"]
+        pairs.append(t[["frame", "track_id", *XYWH]].merge(g[["frame", "track_id", *XYWH]],
+                                                           on=["frame", "track_id"], suffixes=("", "_t")))
+    m = pd.concat(pairs, ignore_index=True) if pairs else pd.DataFrame(columns=["x", "x_t"])
+    if len(m):
+        cx, cy = m.x + m.w / 2, m.y + m.h / 2
+        m = m[(m.w > 0) & (m.h > 0) & (cx >= m.x_t) & (cx <= m.x_t + m.w_t) & (cy >= m.y_t) & (cy <= m.y_t + m.h_t)]
+    record = {"tracker_pairs": int(len(m)), "detector_pairs": int(len(d))}
+    if len(m) < MIN_PAIRS or len(d) < MIN_PAIRS:
+        return None, record
+    e_t, e_d = float(np.median(_box_errors(m))), float(np.median(_box_errors(d)))
+    record.update(tracker_error=round(e_t, 5), detector_error=round(e_d, 5))
+    gain = e_t / max(e_t + e_d, 1e-12)
+    return float(np.clip(round(gain * 20) / 20, 0.1, 1.0)), record
+
+
 # -- 3. when an undetected track ends -------------------------------------------------------------
 
 def fit_undetected_frames(samples: pd.DataFrame, min_score: float, every: int, fps: float) -> int | None:
@@ -208,6 +251,31 @@ def fit_undetected_frames(samples: pd.DataFrame, min_score: float, every: int, f
         return None
     value = int(np.ceil(1.5 * np.quantile(gaps, 0.9))) + every
     return value if value <= MAX_UNDETECTED_S * fps else None
+
+
+def fit_leave_fraction(truths: list[pd.DataFrame], sizes: list[tuple[int, int]]) -> float | None:
+    """``detection.leave_fraction`` from where the corrected tracks begin and end at the frame's
+    sides: for each track whose first or last box lies within half its width (height) of a side
+    (top or bottom), that box's width (height) over the track's median, at most 1 (a person's box
+    cut by the frame is narrower); the median over those, to 0.05. None with fewer than 3 such
+    ends. Annotators who draw people only once wholly in view give about 1 (end a track as its
+    person starts to leave); those who draw the visible part of a person half out give less."""
+    shares = []
+    for truth, (W, H) in zip(truths, sizes):
+        t = truth[truth["part"] == "person"]
+        for _tid, g in t.groupby("track_id"):
+            if len(g) < 5:
+                continue
+            g = g.sort_values("frame")
+            mw, mh = float(g["w"].median()), float(g["h"].median())
+            for r in (g.iloc[0], g.iloc[-1]):
+                if min(r.x, W - r.x - r.w) <= 0.5 * r.w:
+                    shares.append(min(r.w / mw, 1.0))
+                elif min(r.y, H - r.y - r.h) <= 0.5 * r.h:
+                    shares.append(min(r.h / mh, 1.0))
+    if len(shares) < 3:
+        return None
+    return float(np.clip(round(np.median(shares) * 20) / 20, 0.05, 1.0))
 
 
 # -- 4. the dynamics ------------------------------------------------------------------------------
@@ -262,17 +330,32 @@ def fit_person(clips, truths: list[pd.DataFrame], tracked: list[pd.DataFrame], b
             changes["detector.shrink"] = shrink
         if changes:
             out.components["detector"] = changes
+        steer, rec = fit_steer(s, tracked, truths, det.min_score if score is None else score)
+        out.record["steer"] = {**rec, "steer": steer}
+        if steer is not None and steer != det.steer:
+            out.components["steer"] = {"detector.steer": steer}
         fps = float(clips[0][1])
         undetected = fit_undetected_frames(s, det.min_score if score is None else score, det.every, fps)
         out.record["undetected_frames"] = undetected
         if undetected is not None and undetected != det.undetected_frames:
-            out.components["ending"] = {"detector.undetected_frames": undetected}
+            out.components.setdefault("ending", {})["detector.undetected_frames"] = undetected
+    sizes = [_frame_size(factory) for factory, _fps, _t in clips]
+    leave = fit_leave_fraction(truths, sizes)
+    out.record["leave_fraction"] = leave
+    if leave is not None and leave != base.detection.leave_fraction:
+        out.components.setdefault("ending", {})["detection.leave_fraction"] = leave
     if noise_table is not None:
         rows = noise_table[(noise_table["tracker"] == "body") & (noise_table["part"] == "person")]
         noise = part_noise_from_person(base.dynamics.noise, rows)
         if noise != base.dynamics.noise:
             out.components["noise"] = {"dynamics.noise": noise}
     return out
+
+
+def _frame_size(factory) -> tuple[int, int]:
+    for _index, frame in factory():
+        return frame.shape[1], frame.shape[0]
+    return 0, 0
 
 
 def person_edits(tracks: list[pd.DataFrame], truths: list[pd.DataFrame]) -> float:
@@ -289,7 +372,7 @@ def person_edits(tracks: list[pd.DataFrame], truths: list[pd.DataFrame]) -> floa
 def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[pd.DataFrame], base: BodyParams,
                   fit: PersonFit, base_tracks: list[pd.DataFrame] | None = None,
                   progress: Callable[[str], None] | None = None) -> tuple[BodyParams, dict]:
-    """Add the fitted components to ``base`` one at a time (detector, extent, ending, noise),
+    """Add the fitted components to ``base`` one at a time (detector, steer, extent, ending, noise),
     keeping each only if the person-box edits on the training clips fall strictly below the best
     so far (a tie keeps the simpler model): ``(params, record)``.
 
@@ -308,7 +391,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
         base_tracks = score(base, "start")[1]
     scores = {"start": person_edits(base_tracks, truths)}
     best, params, tracks, kept, used = scores["start"], base, base_tracks, {}, {}
-    for comp in ("detector", "extent", "ending", "noise"):
+    for comp in ("detector", "steer", "extent", "ending", "noise"):
         changes = fit.components.get(comp)
         if comp == "extent" and (changes is not None or "detector" in kept):
             ext = fit_person_extent(tracks, truths, params.output.person)
@@ -328,25 +411,37 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
                             "the training clips fall strictly below the best so far"}
 
 
-def person_table(record: dict) -> str:
-    """The summary's ``person`` record as text: what was fitted, the edits each component gave on
-    the training clips and whether it was kept."""
+def person_rows(record: dict) -> list[dict]:
+    """The summary's ``person`` record as rows ``component, edits/100, decision, fitted``: what was
+    fitted, the edits each component gave on the training clips and whether it was kept."""
     det = record.get("detector") or {}
     shrink = tuple(det["shrink"]) if det.get("shrink") else "-"
     fitted = {
-        "extent": f"output.person = {tuple(record['person_extent'])}" if record.get("person_extent") else "-",
         "detector": (f"min_score = {det.get('min_score')}, shrink = {shrink} ({det.get('true', 0)} true / "
                      f"{det.get('false', 0)} false detections on {det.get('boxes', 0)} corrected boxes)")
         if det else "-",
-        "ending": f"undetected_frames = {record.get('undetected_frames')}",
+        "steer": f"steer = {(record.get('steer') or {}).get('steer')} (median squared error: tracker "
+                 f"{(record.get('steer') or {}).get('tracker_error')}, detector "
+                 f"{(record.get('steer') or {}).get('detector_error')})",
+        "extent": f"output.person = {tuple(record['person_extent'])}" if record.get("person_extent") else "-",
+        "ending": f"undetected_frames = {record.get('undetected_frames')}, "
+                  f"leave_fraction = {record.get('leave_fraction')}",
         "noise": "parts' position/velocity noise widened to the person's" if "noise" in record.get("fitted", [])
         else "the person moves no faster than the parts' defaults",
     }
     scores, kept = record.get("scores", {}), record.get("kept", {})
-    lines = [f"{'component':9} {'edits/100':>9}  {'decision':12} fitted", f"{'start':9} "
-             f"{scores.get('start', float('nan')):9.2f}  {'baseline':12}"]
+    rows = [dict(component="start", **{"edits/100": scores.get("start")}, decision="baseline", fitted="")]
     for comp, text in fitted.items():
         decision = ("kept" if kept.get(comp) else "dropped") if comp in kept else "not tried"
-        edits = scores.get(f"+{comp}")
-        lines.append(f"{comp:9} {edits if edits is not None else float('nan'):9.2f}  {decision:12} {text}")
+        rows.append(dict(component=comp, **{"edits/100": scores.get(f"+{comp}")}, decision=decision, fitted=text))
+    return rows
+
+
+def person_table(record: dict) -> str:
+    """:func:`person_rows` as aligned text (``partlab train``)."""
+    lines = [f"{'component':9} {'edits/100':>9}  {'decision':10} fitted"]
+    for r in person_rows(record):
+        e = r["edits/100"]
+        lines.append(f"{r['component']:9} {e if e is not None else float('nan'):9.2f}  {r['decision']:10} "
+                     f"{r['fitted']}")
     return "\n".join(lines)

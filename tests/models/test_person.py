@@ -138,3 +138,18 @@ def test_training_from_person_boxes_alone_recalibrates_a_wrong_person_box(tmp_pa
     assert b.failure_detector is None and b.summary["samples"]["total"] == 0
     assert main([*args, "-o", str(tmp_path / "c"), "--no-tracker"]) == 2
     assert "train without --no-tracker" in capsys.readouterr().err and not (tmp_path / "c").exists()
+
+
+def test_leave_fraction_is_how_much_of_a_person_is_in_view_where_corrections_begin_and_end():
+    rows = []
+    for tid in range(1, 5):  # walkers entering at the left side, cut by it, leaving at the right
+        for f in range(30):
+            x = -12.0 + 10 * f
+            visible = x + 30.0 - max(x, 0.0)  # the annotator draws the part in view
+            rows.append(dict(frame=f, track_id=tid, part="person", x=max(x, 0.0), y=50.0 + tid, w=visible, h=80.0))
+    truth = pd.DataFrame(rows)
+    # each first box shows 18 of 30 px: 0.6; each last one (x = 278, 12 px from the right side) is whole: 1.0
+    assert P.fit_leave_fraction([truth], [(320, 240)]) == pytest.approx(0.8)
+    whole = truth[truth.frame >= 2]  # drawn only once wholly in view, until they leave
+    assert P.fit_leave_fraction([whole], [(320, 240)]) == 1.0
+    assert P.fit_leave_fraction([whole[whole.track_id == 1]], [(320, 240)]) is None  # 2 ends: too few

@@ -378,8 +378,8 @@ class BodyOutput:
     # fractions of its size: the box people draw around a whole person need not be the union of
     # the part boxes (a walker's swinging arms and feet reach beyond them; far-away people are
     # cut into parts that leave gaps). (1, 1, 0, 0), the MBR itself, is the paper's. Fitted from
-    # corrected person boxes, which need no part boxes (partlab.models.person). Automatic starts,
-    # the detection cue and the person box compared with detections use the same box.
+    # corrected person boxes, which need no part boxes (partlab.models.person). Only the output
+    # changes, as for ``extent``: automatic starts and the detection cue go on with the MBR.
     person: tuple[float, float, float, float] = pair((1.0, 1.0, 0.0, 0.0), rule=Rule(), n=4)
 
     def check(self, path: str) -> None:

@@ -264,13 +264,16 @@ class BodyTracker:
         self.candidates = fresh
 
     def _reported_person_box(self, person: Person) -> Box:
-        """The person box as written: the MBR of its parts' reported boxes (``output.person`` applied)."""
-        return self.report_person(minimum_bounding_rectangle(self.report_box(n, f.box)
-                                                             for n, f in person.filters.items()))
+        """The person box the tracker reasons with (starts, the detection cue): the MBR of its
+        parts' reported boxes (``output.person`` only changes what is written)."""
+        return minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.filters.items())
 
     def report_person(self, mbr: Box) -> Box:
         """The person box written for the MBR of the reported part boxes: scaled and shifted by
-        ``BodyParams.output.person`` (fitted from corrected person boxes), clipped to the frame."""
+        ``BodyParams.output.person`` (fitted from corrected person boxes), clipped to the frame.
+        Only the output changes: the tracker itself (the detection cue's matching and steering,
+        automatic starts) goes on with the MBR, so a refit of it cannot change how people are
+        tracked, only how their boxes are written."""
         sw, sh, dx, dy = self.params.output.person
         if self.whole or (sw, sh, dx, dy) == (1.0, 1.0, 0.0, 0.0):
             return mbr
