@@ -32,23 +32,39 @@ def one_core() -> None:
     cv2.setNumThreads(1)
 
 
-def _one_core_everywhere(c) -> None:
-    """Run :func:`one_core` on every worker, now and on workers that join later."""
+def no_interrupt() -> None:
+    """Leave Ctrl-C to the parent: a local worker shares the terminal, and the client shuts the
+    cluster down itself (else each worker prints its own KeyboardInterrupt traceback)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _set_up_workers(c, local: bool) -> None:
+    """On every worker, now and on workers that join later: :func:`one_core`, and for a local
+    cluster :func:`no_interrupt`."""
     from distributed.diagnostics.plugin import WorkerPlugin
 
-    class OneCore(WorkerPlugin):
-        name = "partlab-one-core"
+    class PartlabWorker(WorkerPlugin):
+        name = "partlab-worker"
 
         def setup(self, worker) -> None:
             one_core()
+            if local:
+                no_interrupt()
 
-    c.register_plugin(OneCore())
+    c.register_plugin(PartlabWorker())
 
 
-def _quiet_logs() -> None:
-    for name in ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
-                 "distributed.core", "distributed.http.proxy", "bokeh", "tornado"):
-        logging.getLogger(name).setLevel(logging.ERROR)
+_LOGGERS = ("distributed", "distributed.nanny", "distributed.scheduler", "distributed.worker",
+            "distributed.core", "distributed.http.proxy", "bokeh", "tornado", "tornado.application")
+
+
+def _quiet_logs(level: int = logging.ERROR) -> None:
+    for name in _LOGGERS:
+        logging.getLogger(name).setLevel(level)
 
 
 @contextlib.contextmanager
@@ -69,7 +85,7 @@ def client(scheduler: str | None = None, workers: int | None = None,
         except (OSError, TimeoutError) as exc:
             raise UserError(f"--scheduler {scheduler}: cannot reach the Dask scheduler ({exc})") from None
         try:
-            _one_core_everywhere(c)
+            _set_up_workers(c, local=False)
             yield c
         finally:
             c.close()
@@ -82,7 +98,11 @@ def client(scheduler: str | None = None, workers: int | None = None,
                                silence_logs=logging.ERROR, env=ONE_CORE_ENV)
     try:
         with Client(cluster) as c:
+            _set_up_workers(c, local=True)
             yield c
+    except KeyboardInterrupt:  # Ctrl-C: the cluster is torn down mid-task; its shutdown errors are noise
+        _quiet_logs(logging.CRITICAL + 1)
+        raise
     finally:
         cluster.close()
 
