@@ -16,11 +16,11 @@ the init boxes count as drawn), person rate, MOTA and IDF1 as in ``benchmarks/an
 mean ± standard deviation over seeds and the paired difference (trained - start) per seed.
 Nothing of frames ``[--split, 795)`` is seen by training.
 
-``--synth N``: the same on N scenes of the randomized synthetic suite (scenario ``random``, seed
-100 + s, person rows of the truth only): train on the first half, track the second.
+``--synth 100,101``: the same on scenes of the randomized synthetic suite (scenario ``random`` at
+those seeds, person rows of the truth only): train on the first half, track the second.
 
     nice python benchmarks/retrain_pets.py                       # PETS, seeds 1-4, init and auto
-    nice python benchmarks/retrain_pets.py --modes init --seeds 1 --synth 2
+    nice python benchmarks/retrain_pets.py --skip-pets --modes init --seeds 1,2 --synth 104
 """
 
 from __future__ import annotations
@@ -134,14 +134,13 @@ def pets(split: int, start, seeds, modes, train_seed: int, out: Path | None) -> 
     return compare("PETS", open_take(PETS / "vtest.avi"), truth, split, models, seeds, modes)
 
 
-def synth(n_scenes: int, start, seeds, modes, train_seed: int, frames: int) -> pd.DataFrame:
+def synth(scenes: list[int], start, seeds, modes, train_seed: int, frames: int) -> pd.DataFrame:
     from partlab.labelling.synth import make_scene
     from partlab.labelling.synth.scene import random_size
     from partlab.models.training import iterate_frames
 
     out = []
-    for s in range(n_scenes):
-        seed = 100 + s
+    for seed in scenes:
         w, h = random_size(seed)
         scene = make_scene("random", seed=seed, n_frames=frames, width=w, height=h)
         truth = scene.truth[scene.truth["part"] == "person"][["frame", "track_id", "part", "x", "y", "w", "h"]]
@@ -170,7 +169,8 @@ def main() -> None:
                                               "saved by --bundle, to run seeds in parallel)")
     ap.add_argument("--models", default="start,trained", help="which to track with ('start' alone: no training; "
                                                               "to run the start's seeds while training runs)")
-    ap.add_argument("--synth", type=int, default=0, help="also run N randomized synthetic scenes")
+    ap.add_argument("--synth", default="", help="also run these scenes of the randomized synthetic suite "
+                                                "(scenario random at these seeds, e.g. 100,101)")
     ap.add_argument("--synth-frames", type=int, default=200)
     ap.add_argument("--skip-pets", action="store_true")
     ap.add_argument("--csv", type=Path)
@@ -185,7 +185,8 @@ def main() -> None:
         out = a.bundle or Path(tempfile.mkdtemp(prefix="retrain_pets_")) / "bundle"
         tables.append(pets(a.split, start, seeds, modes, a.train_seed, out))
     if a.synth:
-        tables.append(synth(a.synth, start, seeds, modes, a.train_seed, a.synth_frames))
+        scenes = [int(v) for v in a.synth.split(",") if v]
+        tables.append(synth(scenes, start, seeds, modes, a.train_seed, a.synth_frames))
     df = pd.concat(tables, ignore_index=True)
     if df.empty:
         return

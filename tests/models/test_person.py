@@ -153,3 +153,18 @@ def test_leave_fraction_is_how_much_of_a_person_is_in_view_where_corrections_beg
     whole = truth[truth.frame >= 2]  # drawn only once wholly in view, until they leave
     assert P.fit_leave_fraction([whole], [(320, 240)]) == 1.0
     assert P.fit_leave_fraction([whole[whole.track_id == 1]], [(320, 240)]) is None  # 2 ends: too few
+
+
+def test_steering_gain_blends_tracker_and_detector_by_their_errors():
+    truth = _people(walking_truth(3, 30, seed=7))
+    rng = np.random.default_rng(2)
+    # the tracker's person boxes err twice as far (in centre, per box height) as the detections
+    tracked = truth.assign(x=truth.x + rng.choice([-1, 1], len(truth)) * 0.10 * truth.h)
+    rows = [(r.frame, r.x + 0.05 * r.h * rng.choice([-1, 1]), r.y, r.w, r.h, 1.0, 0.8, r.track_id)
+            for r in truth.itertuples()]
+    rows += [(r.frame, r.x, r.y, r.w, r.h, np.nan, np.nan, r.track_id) for r in truth.itertuples()]
+    samples = pd.DataFrame(rows, columns=["frame", "x", "y", "w", "h", "score", "iou", "truth"])
+    gain, rec = P.fit_steer(samples, [tracked], [truth], 0.3)
+    # squared errors 0.01 / 4 and 0.0025 / 4: gain 0.01 / 0.0125 = 0.8
+    assert gain == pytest.approx(0.8) and rec["tracker_error"] == pytest.approx(0.0025, rel=1e-3)
+    assert P.fit_steer(samples[samples.score.isna()], [tracked], [truth], 0.3)[0] is None  # no detections
