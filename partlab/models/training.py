@@ -110,7 +110,9 @@ def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None
     """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
     if with_sharpness is None:
         with_sharpness = sharpness_available()
-    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
+    person = (1 + n_clips + 5) * int(with_tracker)  # learning from person boxes: start, detections, validations
+    return (n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
+            + person)
 
 
 def _apply_lam(body: BodyParams, table: pd.DataFrame,
