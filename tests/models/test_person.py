@@ -168,3 +168,17 @@ def test_steering_gain_blends_tracker_and_detector_by_their_errors():
     # squared errors 0.01 / 4 and 0.0025 / 4: gain 0.01 / 0.0125 = 0.8
     assert gain == pytest.approx(0.8) and rec["tracker_error"] == pytest.approx(0.0025, rel=1e-3)
     assert P.fit_steer(samples[samples.score.isna()], [tracked], [truth], 0.3)[0] is None  # no detections
+
+
+def test_a_bundle_applies_the_person_box_fields_its_summary_lists_and_no_others(tmp_path):
+    from partlab.models.bundle import Bundle, load_bundle, save_bundle
+
+    body = BodyParams().updated({"output.person": (0.9, 1.1, 0.0, -0.02), "detector.steer": 0.7,
+                                 "detection.leave_fraction": 1.0})
+    save_bundle(Bundle(body_params=body, summary={"person": {"fields": ["output.person", "detector.steer"]}}),
+                tmp_path / "b")
+    loaded = load_bundle(tmp_path / "b").body_params
+    assert loaded.output.person == (0.9, 1.1, 0.0, -0.02) and loaded.detector.steer == 0.7
+    assert loaded.detection.leave_fraction == BodyParams().detection.leave_fraction  # not learnt: the default
+    save_bundle(Bundle(body_params=body), tmp_path / "c")  # a bundle that learnt none of them
+    assert load_bundle(tmp_path / "c").body_params.output.person == (1.0, 1.0, 0.0, 0.0)
