@@ -126,6 +126,24 @@ def handshakes_called_exchanges(truth: pd.DataFrame, pred: pd.DataFrame) -> int:
                and not any(temporal_iou(p, t) > 0 for t in exchanges))
 
 
+def per_seed(truths: list[pd.DataFrame], preds: list[pd.DataFrame], kind: str) -> list[dict]:
+    """Per seed (the clips ``name/seed`` of one seed summed): precision and recall of ``kind`` (NaN
+    where the seed has no such truth or prediction)."""
+    counts: dict[str, np.ndarray] = {}
+    for t, p in zip(truths, preds):
+        seed = str(t["clip"].iloc[0]).split("/")[1] if len(t) else str(p["clip"].iloc[0]).split("/")[1]
+        table = evaluate_events(t, p)
+        row = table.loc[kind, ["truth", "predicted", "matched"]].to_numpy(float) if kind in table.index else np.zeros(3)
+        counts[seed] = counts.get(seed, np.zeros(3)) + row
+    return [dict(precision=m / n_p if n_p else float("nan"), recall=m / n_t if n_t else float("nan"))
+            for n_t, n_p, m in counts.values()]
+
+
+def _spread(values: list[float]) -> str:
+    return f"{np.mean(values):.2f} +- {np.std(values):.2f} (min {np.min(values):.2f}, n {len(values)})" if values \
+        else "-"
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", default="0-9")
@@ -171,6 +189,10 @@ def report(args, w: int, h: int, hands: str) -> None:
     total["recall"] = total["matched"] / total["truth"].replace(0, np.nan)
     print("\nper kind, all seeds (temporal IoU >= 0.5):")
     print(total.astype({"truth": int, "predicted": int, "matched": int}).round(3).to_string())
+    print("\nper kind, mean +- sd over seeds (a seed's precision/recall over its scenes; n = seeds with that kind):")
+    for kind in total.index.drop("all", errors="ignore"):
+        pr = {m: [v[m] for v in per_seed(truths, preds, kind) if v[m] == v[m]] for m in ("precision", "recall")}
+        print(f"  {kind:10s} precision {_spread(pr['precision'])}  recall {_spread(pr['recall'])}")
     print("\nper-scene recall over seeds: " + "; ".join(
         f"{k} {np.mean(v):.2f} +- {np.std(v):.2f} (min {np.min(v):.2f})" for k, v in recalls.items()))
     print(f"handshakes called an exchange: {swaps}")

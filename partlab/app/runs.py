@@ -103,15 +103,22 @@ def start_tracking(store: Store, clip: Clip, tracker: str = "body", bundle_path:
         return jobs.submit_engine("track", what, tasks.track_clip, dict(clip_id=clip.id, project_id=clip.project_id),
                                   url=store.url, clip_id=clip.id, tracker=tracker,
                                   bundle_path=str(bundle_path) if bundle_path else None, seed=seed, start=start,
-                                  stop=stop, init=None if init is None else init.to_dict("records"))
+                                  stop=stop, init=None if init is None else init.to_dict("records"),
+                                  track_ids=track_ids)
 
     def work(progress):
+        from partlab.labelling.events import store_run_events
+
         model = _load_model(bundle_path)
+        found: list = []
         df = pipeline.track_video(str(clip.path), tracker=tracker, init=init, model=model, occluders=occluders,
-                                  seed=seed, progress=progress, start=start, stop=stop)
+                                  seed=seed, progress=progress, start=start, stop=stop, events_out=found)
         run_id = store.save_tracker_run(clip.id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
                                         start_frame=start, stop_frame=stop, track_ids=track_ids)
-        return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop, track_ids=track_ids)
+        event_ids = store_run_events(store, clip.id, found[0] if found else None, start=start, stop=stop,
+                                     track_ids=track_ids)
+        return dict(run_id=run_id, boxes=int(len(df)), events=len(event_ids), start=start, stop=stop,
+                    track_ids=track_ids)
 
     what = f"re-track {clip.name} from frame {start}" + (f" to {stop}" if stop is not None else "") \
         + (f" (tracks {', '.join(map(str, track_ids))})" if track_ids else "") if retrack \

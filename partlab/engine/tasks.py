@@ -11,9 +11,14 @@ import pandas as pd
 
 
 def track_clip(progress, *, url: str, clip_id: int, tracker: str, bundle_path: str | None, seed: int,
-               start: int = 0, stop: int | None = None, init: list[dict] | None = None) -> dict:
-    """Track a stored clip and save the result as a tracker run (frames ``[start, stop)``)."""
+               start: int = 0, stop: int | None = None, init: list[dict] | None = None,
+               track_ids: list[int] | None = None) -> dict:
+    """Track a stored clip and save the result as a tracker run (frames ``[start, stop)``; of the
+    tracks ``track_ids`` only when given, as a re-track), with the
+    events it recognised (activities, joins: :func:`partlab.labelling.events.store_run_events`), so
+    the Correct page's timeline shows them."""
     from partlab.app.pipeline import track_video
+    from partlab.labelling.events import store_run_events
     from partlab.labelling.store import Store
     from partlab.models.bundle import load_bundle
 
@@ -21,11 +26,16 @@ def track_clip(progress, *, url: str, clip_id: int, tracker: str, bundle_path: s
     clip = store.clip(clip_id)
     model = load_bundle(bundle_path) if bundle_path else None
     init_df = pd.DataFrame(init) if init else None
+    found: list = []
     df = track_video(str(clip.path), tracker=tracker, init=init_df, model=model,
-                     occluders=tuple(store.occluders(clip_id)), seed=seed, progress=progress, start=start, stop=stop)
+                     occluders=tuple(store.occluders(clip_id)), seed=seed, progress=progress, start=start, stop=stop,
+                     events_out=found)
     run_id = store.save_tracker_run(clip_id, df, tracker=tracker, bundle=str(bundle_path or ""), seed=seed,
-                                    start_frame=start, stop_frame=stop)
-    return dict(run_id=run_id, boxes=int(len(df)), start=start, stop=stop)
+                                    start_frame=start, stop_frame=stop, track_ids=track_ids)
+    event_ids = store_run_events(store, clip_id, found[0] if found else None, start=start, stop=stop,
+                                 track_ids=track_ids)
+    return dict(run_id=run_id, boxes=int(len(df)), events=len(event_ids), start=start, stop=stop,
+                track_ids=track_ids)
 
 
 def train_bundle(progress, *, url: str, project_id: int, clip_ids: list[int], name: str, out: str, seed: int = 0,

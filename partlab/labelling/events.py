@@ -151,3 +151,34 @@ def to_store(store, clip_id: int, events: pd.DataFrame, source: str = "tracker",
                                    confidence=None if conf is None or conf != conf else float(conf),
                                    attributes=attrs))
     return ids
+
+
+def store_run_events(store, clip_id: int, events: pd.DataFrame | None, start: int = 0, stop: int | None = None,
+                     track_ids=None, author: str = "") -> list[int]:
+    """Record a tracker run's events over frames ``[start, stop)`` the way a run records its boxes:
+    the tracker's earlier events there that nobody edited (``source == "tracker"``, one revision) are
+    deleted (as a revision, so the history keeps them) and replaced; an event a person added or edited
+    is never touched, and a new one of its kind that overlaps it by half (temporal IoU >= 0.5) is not
+    added again. With ``track_ids`` (a re-track of some tracks) only events of those tracks are
+    replaced. Events are clipped to the run's frames. Returns the new event ids."""
+    frame_count = store.clip(clip_id).frame_count
+    stop = frame_count if stop is None else min(int(stop), frame_count)
+    hist = store.events(clip_id, history=True)
+    now = store.events(clip_id)
+    revisions = hist.groupby("event_id")["revision"].max() if len(hist) else pd.Series(dtype=int)
+    kept = []
+    for r in now.itertuples(index=False):
+        inside = start <= int(r.start_frame) and int(r.end_frame) < stop
+        ours = track_ids is None or set(r.tracks or []) <= {int(t) for t in track_ids}
+        if r.source == "tracker" and int(revisions.get(r.event_id, 1)) == 1 and inside and ours:
+            store.edit_event(clip_id, int(r.event_id), expected_revision=1, author=author, delete=True)
+        else:
+            kept.append((str(r.type), int(r.start_frame), int(r.end_frame)))
+    if events is None or not len(events):
+        return []
+    new = events.assign(start_frame=events["start_frame"].clip(lower=start),
+                        end_frame=events["end_frame"].clip(upper=stop - 1))
+    new = new[new["start_frame"] <= new["end_frame"]]
+    new = new[[not any(k == r.kind and temporal_iou((a, b), (r.start_frame, r.end_frame)) >= 0.5 for k, a, b in kept)
+               for r in new.itertuples(index=False)]]
+    return to_store(store, clip_id, new, source="tracker", author=author)

@@ -10,7 +10,7 @@ from partlab.labelling.events import evaluate_events, temporal_iou
 from partlab.labelling.synth import make_scene
 from partlab.tracking.activities.objects import colour_masses, fuse, hand_colour
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.recognise import contacts, merged_joins, still_moments
+from partlab.tracking.activities.recognise import contacts, merged_joins, stays_behind, still_moments
 from partlab.tracking.activities.table import one_hand, two_hands
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
@@ -75,20 +75,56 @@ def test_table_one_read_per_colour():
     assert one_hand({blue: 0.4, shirt: 0.2}, {shirt: 0.2}, P).kind == "place"
     assert one_hand({shirt: 0.2}, {shirt: 0.2}, P) is None
     assert one_hand({blue: 0.02}, {blue: 0.4}, P).kind == "pick"  # already near the hand: a small share
+    # the hand rests beside the object it put down: still some blue around it, but the blue stayed
+    assert one_hand({blue: 0.4}, {blue: 0.3}, P) is None
+    assert one_hand({blue: 0.4}, {blue: 0.3}, P, stays=lambda hue: hue == blue).kind == "place"
+    assert one_hand({}, {blue: 0.4}, P, stays=lambda hue: True) is None  # lay beside the hand: not picked
+
+
+def test_a_colour_that_stays_behind_is_told_from_one_that_moves_with_the_hand():
+    still = {f: (100.0, 100.0, 20.0) for f in range(10, 30)}
+    away = {f: (100.0 + 2.0 * (f - 29), 100.0, 20.0) for f in range(30, 50)}  # then 2 px a frame to the right
+    centres = still | away
+    left = {f: ((40, 100.0, 110.0),) for f in range(10, 50)}  # the object stays at (100, 110)
+    held = {f: ((40, centres[f][0], 110.0),) for f in range(10, 50)}  # ... or moves with the hand
+    assert stays_behind(left, centres, 40, 10, 29, P) is True
+    assert stays_behind(held, centres, 40, 10, 29, P) is False
+    assert stays_behind(held, centres, 90, 10, 29, P) is None  # a colour never seen there
+    assert stays_behind(left, still, 40, 10, 29, P) is None  # the hand never left
 
 
 def test_still_moments_and_contacts_from_tracks():
     centres = {f: (100.0 + (0 if 10 <= f <= 30 else 4 * (f - 10)), 50.0, 10.0) for f in range(10, 60)}
     (s0, s1), = still_moments(centres, P)
     assert 10 <= s0 <= 13 and 28 <= s1 <= 31
-    rows = [(f, 1, "left_hand", 100 + (0 if 20 <= f <= 25 else 30), 50) for f in range(40)]
-    rows += [(f, 1, "right_hand", 110, 50) for f in range(40)]
+    # the hands touch over 20-25 (10 px apart: one side), part 18 px (1.8 sides, under the release
+    # distance) at 23, and 4 sides after; over 60-70 the left hand is lost from 64 to 67 and comes
+    # back apart at 68: the touch ends in the unseen gap
+    def left_x(f):
+        return 100 if 20 <= f <= 25 and f != 23 or 60 <= f < 64 else 108 if f == 23 else 140
+
+    rows = [(f, 1, "left_hand", left_x(f), 50) for f in range(80) if not 64 <= f < 68]
+    rows += [(f, 1, "right_hand", 110, 50) for f in range(80)]
     tracks = pd.DataFrame([dict(frame=f, track_id=t, part=p, x=x, y=y, w=10, h=10, camera="")
                            for f, t, p, x, y in rows])
     found = contacts(tracks, P)
-    assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[20, 25, "clap"]]
-    twice = pd.concat([found, found.assign(start_frame=40, end_frame=45)])
+    assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[20, 25, "clap"], [60, 65, "clap"]]
+    twice = pd.concat([found.iloc[:1], found.iloc[:1].assign(start_frame=40, end_frame=45)])
     assert [(j["start_frame"], j["end_frame"]) for j in merged_joins(twice, P)] == [(20, 45)]
+
+
+def test_3d_touches_come_from_whichever_view_saw_each_hand():
+    # two people's right hands 60 mm apart over frames 10-19 (else 600 mm); view cam0 sees hand 1
+    # only, cam1 sees hand 2 only: in 3D they touch although no view shows both
+    rows = []
+    for f in range(30):
+        gap = 60.0 if 10 <= f <= 19 else 600.0
+        rows.append(dict(frame=f, track_id=1, part="right_hand", x=100, y=100, w=10, h=10, camera="cam0",
+                         X=0.0, Y=0.0, Z=1000.0))
+        rows.append(dict(frame=f, track_id=2, part="right_hand", x=300, y=100, w=10, h=10, camera="cam1",
+                         X=gap, Y=0.0, Z=1000.0))
+    found = contacts(pd.DataFrame(rows), P)
+    assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
 
 
 def test_temporal_matching():

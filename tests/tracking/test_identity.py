@@ -57,9 +57,29 @@ def test_automatic_limb_rows_are_kept_only_on_people():
     limbs = pd.DataFrame([
         (0, 7, "head", 110, 55, 16, 16),        # top of the person: kept
         (0, 7, "left_hand", 100, 110, 10, 10),  # inside the box: kept
-        (0, 8, "head", 112, 120, 16, 16),       # centre 128 below the top 0.4 (50 + 48 = 98): dropped
+        (0, 8, "head", 112, 120, 16, 16),       # centre 128 below the top third (50 + 40 = 90): dropped
+        (1, 8, "head", 114, 82, 16, 16),        # centre 90 at the top third's edge: kept
+        (1, 8, "left_hand", 114, 86, 16, 16),   # ... a hand there is inside the box: kept
         (1, 9, "head", 400, 60, 16, 16),        # on a wall, nobody there: dropped
         (2, 7, "head", 110, 55, 16, 16),        # a frame without people: dropped
     ], columns=["frame", "track_id", "part", "x", "y", "w", "h"])
     kept = on_people(limbs, body)
-    assert list(zip(kept.frame, kept.part, kept.track_id)) == [(0, "head", 7), (0, "left_hand", 7)]
+    assert list(zip(kept.frame, kept.part, kept.track_id)) == [(0, "head", 7), (0, "left_hand", 7),
+                                                                (1, "head", 8), (1, "left_hand", 8)]
+    limbs.loc[3, "y"] = 84  # centre 92: below the top third
+    assert (1, "head") not in set(zip(on_people(limbs, body).frame, on_people(limbs, body).part))
+
+
+def test_coasted_body_heads_give_way_to_the_limb_trackers_measured_head():
+    from partlab.tracking.combined import measured_heads
+
+    body, limbs = _scene()
+    body["occluded"] = 0.0
+    hidden = (body.track_id == 1) & body.frame.between(10, 14)  # person 1 coasts behind someone
+    body.loc[hidden, "occluded"] = 1.0
+    kept = measured_heads(body)
+    assert len(kept[(kept.track_id == 1) & (kept.part == "person")]) == 30  # the person stays
+    assert set(kept[(kept.track_id == 1) & (kept.part == "head")].frame) == set(range(30)) - set(range(10, 15))
+    out = merge_tracks(kept, limbs, match_limb_people(kept, limbs), offset=100000)
+    p1 = out[(out.track_id == 1) & (out.part == "head")].set_index("frame").sort_index()
+    assert len(p1) == 30 and (p1.loc[10:14, "w"] == 14).all() and (p1.loc[15:, "w"] == 20).all()

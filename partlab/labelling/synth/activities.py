@@ -8,8 +8,9 @@
 
 Each builder returns a :class:`~partlab.labelling.synth.scenarios.Script` with ``objects``
 (what is carried and where it rests) and ``events`` (the truth: kind, start and end frame, the
-tracks and hands involved, the object's colour). Timings are fractions of the clip, jittered per
-seed; people, clothes, skin and object colours come from the seed too.
+tracks and hands involved, the object's colour). Timings are fractions of the clip drawn per seed
+(when an activity starts and how long it lasts vary by a factor of two or more); people, clothes,
+skin and object colours come from the seed too.
 """
 
 from __future__ import annotations
@@ -70,7 +71,7 @@ def _hue_sat(bgr) -> tuple[int, int]:
     return int(h), int(s)
 
 
-def _object_colour(rng, people=()) -> tuple[int, int, int]:
+def object_colour(rng, people=()) -> tuple[int, int, int]:
     """An object colour whose hue is at least 30 degrees from every saturated colour the people wear:
     the paper's colour analysis cannot tell an object from a sleeve of its own hue (docs state the
     limitation), and the scenes measure the recognition, not that coincidence."""
@@ -112,8 +113,10 @@ def pick_place(rng, camera, n_frames, fps) -> Script:
     # the right hand (image left) picks the box at p1 and places it at p2, stopping a moment at each
     p1 = np.array([-0.55 + _j(rng, 0.05), 0.5 + _j(rng, 0.05), desk_h + 1.2 * hr])
     p2 = np.array([-0.3 + _j(rng, 0.04), 0.82 + _j(rng, 0.03), desk_h + 1.2 * hr])
-    a0, a1 = 0.18 + _j(rng, 0.02), 0.36 + _j(rng, 0.02)  # at p1 between these (reach in, still, ...)
-    b0, b1 = 0.58 + _j(rng, 0.02), 0.76 + _j(rng, 0.02)  # at p2
+    # at p1 between a0 and a1 (reach in, still, ...), at p2 between b0 and b1: each still 18 to 48 frames of 150
+    # (one draw each, as when they were jittered by 0.02: the people and rooms of a seed are unchanged)
+    a0, a1 = rng.uniform(0.10, 0.22), rng.uniform(0.34, 0.42)
+    b0, b1 = rng.uniform(0.52, 0.62), rng.uniform(0.74, 0.86)
     w1 = bump(t, a0, a1, ramp=0.06)
     carry = np.clip((t - a1) / max(b0 - a1, 1e-6), 0, 1) * ((t > a1) & (t < b0))
     w2 = bump(t, b0, b1, ramp=0.06)
@@ -130,7 +133,7 @@ def pick_place(rng, camera, n_frames, fps) -> Script:
     for lo, hi, p in ((0, pick_f, p1), (place_f, n, p2)):
         q = p + box_off
         restp[lo:hi] = (view.x0 + s * q[0], view.y0 - s * q[2] + s * k * q[1])
-    colour = _object_colour(rng, (app,))
+    colour = object_colour(rng, (app,))
     obj = CarriedObject(holder, restp, colour, radius=1.6, rest_radius_px=1.6 * s * hr)
     zeros = np.zeros(n)
     yaw = -0.4 * np.maximum(w1, w2) + 0.2 * np.sin(2 * np.pi * np.arange(n) / (fps * 4.0) + rng.uniform(0, 6.3))
@@ -152,7 +155,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
     gap = 0.62 + _j(rng, 0.04)  # metres between the two people's feet
     xa, xb = -gap / 2 + _j(rng, 0.05), gap / 2 + _j(rng, 0.05)
     # a faces +x (image right), b faces -x: each one's right hand is on the camera's side for one of them
-    t0, t1 = 0.34 + _j(rng, 0.03), 0.58 + _j(rng, 0.03)  # hands together between t0 and t1
+    t0, t1 = rng.uniform(0.24, 0.42), rng.uniform(0.52, 0.68)  # hands together between t0 and t1
     w = bump(t, t0, t1, ramp=0.08)
     meet_u = 1.0 + _j(rng, 0.04)
 
@@ -174,7 +177,7 @@ def _face_to_face(rng, camera, n_frames, with_object: bool) -> Script:
     objects, events = [], []
     start, end = _frame(t0, n), _frame(t1, n)  # the hands together
     if with_object:
-        colour = _object_colour(rng, (a, b))
+        colour = object_colour(rng, (a, b))
         holder = np.full(n, 1)  # a's right hand, then b's right hand from the middle of the meeting
         holder[(start + end) // 2:] = 3
         objects.append(CarriedObject(holder, np.full((n, 2), np.nan), colour, radius=1.5))
@@ -202,7 +205,7 @@ def clap(rng, camera, n_frames, fps) -> Script:
     hands = np.full((n, 2, 3), np.nan)
     hands[:, 0] = (0.2 * H, 0.03, 0.5 * H)
     hands[:, 1] = (-0.2 * H, 0.03, 0.5 * H)
-    t0, t1 = 0.3 + _j(rng, 0.04), 0.55 + _j(rng, 0.04)
+    t0, t1 = rng.uniform(0.18, 0.40), rng.uniform(0.50, 0.66)
     c = bump(t, t0, t1, ramp=0.06)
     u = np.clip((t - t0) / (t1 - t0), 0, 1)
     hr = HAND_R * H

@@ -31,6 +31,7 @@ import cv2
 import numpy as np
 import pandas as pd
 
+from partlab.labelling.synth.activities import object_colour
 from partlab.labelling.synth.appearance import Appearance, sample_appearances
 from partlab.labelling.synth.background import CameraEffects, smooth_noise
 from partlab.labelling.synth.figure import HAND_R, FigurePose, colour_table, draw_figure
@@ -200,7 +201,14 @@ def _people(rng, n: int) -> list[Appearance]:
     return [replace(a, short_sleeves=False) for a in sample_appearances(rng, n)]
 
 
-def _standing(rng, n) -> Script3D:
+def _span(story: np.random.Generator, lo: float, hi: float, length: tuple[float, float]) -> tuple[int, int]:
+    """An activity's story frames: it starts between ``lo`` and ``hi`` and lasts ``length`` frames
+    (drawn from ``story``, the scene's timing generator, so that the detector meets no fixed timing)."""
+    a = int(round(story.uniform(lo, hi)))
+    return a, a + int(round(story.uniform(*length)))
+
+
+def _standing(rng, n, story) -> Script3D:
     (app,) = _people(rng, 1)
     H = app.height_m
     t = _story_time(n)
@@ -211,23 +219,24 @@ def _standing(rng, n) -> Script3D:
         hands[:, i, 0] = side * (0.22 + np.abs(_wander(rng, n, 0.16)))
         hands[:, i, 1] = 0.28 + _wander(rng, n, 0.12)
         hands[:, i, 2] = (0.62 + 0.1 * rng.uniform(-1, 1)) * H + _wander(rng, n, 0.22 * H, 0.2, 0.6)
-    # a clap around frames 60-80 of 150: the hands meet in front of the chest three times
-    c = bump(t, 60 / 149, 80 / 149, ramp=0.04)
-    u = np.clip((t - 60 / 149) / (20 / 149), 0, 1)
+    # a clap (about frames 45-95 of 150, 16-26 frames long): the hands meet in front of the chest three times
+    c0, c1 = _span(story, 45, 70, (16, 26))
+    c = bump(t, c0 / 149, c1 / 149, ramp=0.04)
+    u = np.clip((t - c0 / 149) / ((c1 - c0) / 149), 0, 1)
     sep = HAND_R * H * 1.05 + 0.1 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))
     clap = np.stack([np.stack([sep, np.full(n, 0.32), np.full(n, 0.72 * H)], 1),
                      np.stack([-sep, np.full(n, 0.32), np.full(n, 0.72 * H)], 1)], 1)
     hands = hands * (1 - c)[:, None, None] + clap * c[:, None, None]
     yaw = _wander(rng, n, 0.3, 0.1, 0.3)
     return Script3D([Actor3D(app, pos, heading, yaw, hands)], facing=float(heading[0]),
-                    events=[("clap", 60, 80, 1, "left_hand", 1, "right_hand")])
+                    events=[("clap", c0, c1, 1, "left_hand", 1, "right_hand")])
 
 
 TABLE_H = 740.0
 TABLE_COLOURS = ((150, 150, 148), (215, 215, 210), (120, 80, 50), (70, 110, 70))
 
 
-def _seated(rng, n) -> Script3D:
+def _seated(rng, n, story) -> Script3D:
     (app,) = _people(rng, 1)
     H = app.height_m
     t = _story_time(n)
@@ -242,13 +251,15 @@ def _seated(rng, n) -> Script3D:
     for i in range(2):
         for d in (0, 1):
             hands[:, i, d] += _wander(rng, n, 0.06, 0.2, 0.5)
-    c = bump(t, 40 / 149, 60 / 149, ramp=0.04)  # clap in front of the chest
-    u = np.clip((t - 40 / 149) / (20 / 149), 0, 1)
+    c0, c1 = _span(story, 30, 50, (16, 24))  # a clap in front of the chest
+    c = bump(t, c0 / 149, c1 / 149, ramp=0.04)
+    u = np.clip((t - c0 / 149) / ((c1 - c0) / 149), 0, 1)
     sep = hr * 1.05 + 0.11 * (0.5 - 0.5 * np.cos(2 * np.pi * 3 * u))
     clap = np.stack([np.stack([sep, np.full(n, 0.3), np.full(n, desk + 0.25)], 1),
                      np.stack([-sep, np.full(n, 0.3), np.full(n, desk + 0.25)], 1)], 1)
     hands = hands * (1 - c)[:, None, None] + clap * c[:, None, None]
-    r = bump(t, 85 / 149, 105 / 149, ramp=0.035)  # the right hand reaches across the table and back
+    r0, r1 = _span(story, c1 + 20, c1 + 40, (16, 24))  # the right hand reaches across the table and back
+    r = bump(t, r0 / 149, r1 / 149, ramp=0.035)
     reach = np.array([-0.45, 0.55, desk + 0.06])
     hands[:, 1] = _blend(hands[:, 1], np.repeat(reach[None], n, 0), r)
     yaw = 0.3 * np.sin(2 * np.pi * frames / (FPS * 3.5) + rng.uniform(0, 6.3)) * (1 - r) - 0.5 * r
@@ -260,14 +271,16 @@ def _seated(rng, n) -> Script3D:
         for fl, ll in ((0.2, -0.65), (0.2, 0.65), (0.9, 0.65), (0.9, -0.65)):
             corners.append([*(1000 * (fl * F + ll * L)), z])
     return Script3D([Actor3D(app, pos, heading, yaw, hands, seated=True)], facing=float(heading0),
-                    table=np.array(corners), events=[("clap", 40, 60, 1, "left_hand", 1, "right_hand")])
+                    table=np.array(corners), events=[("clap", c0, c1, 1, "left_hand", 1, "right_hand")])
 
 
-def _handshake(rng, n) -> Script3D:
+def _handshake(rng, n, story) -> Script3D:
     apps = _people(rng, 2)
     t = _story_time(n)
     axis = rng.uniform(-np.pi, np.pi)  # the line between the two people
-    gap = rng.uniform(1050, 1250)  # mm between their feet
+    # mm between their feet: close enough for the hands to meet halfway (an arm reaches about 0.35 H
+    # from the shoulder; at 1.05-1.25 m they stopped 0.3 m short of each other)
+    gap = rng.uniform(700, 850)
     u = np.array([np.cos(axis), np.sin(axis)])
     side = np.array([-u[1], u[0]])
     posA = np.repeat((-u * gap / 2)[None], n, 0)
@@ -283,13 +296,15 @@ def _handshake(rng, n) -> Script3D:
             hands[:, i, 2] = 0.5 * H + _wander(rng, n, 0.05 * H)
         actors_h.append((app, pos, hd, hands))
     hmean = 0.5 * (apps[0].height_m + apps[1].height_m)
-    # handshake: both right hands meet at the midpoint, shaking up and down (frames ~25-65)
-    shake = bump(t, 32 / 149, 55 / 149, ramp=0.06)
+    # handshake: both right hands meet at the midpoint, shaking up and down (about frames 25-70, 18-28 long)
+    s0, s1 = _span(story, 25, 40, (18, 28))
+    shake = bump(t, s0 / 149, s1 / 149, ramp=0.06)
     mid = np.zeros((n, 3))
-    mid[:, 2] = 0.56 * hmean + 0.045 * np.sin(2 * np.pi * 3.0 * np.arange(n) / FPS) * (shake > 0.99)
+    mid[:, 2] = 0.62 * hmean + 0.045 * np.sin(2 * np.pi * 3.0 * np.arange(n) / FPS) * (shake > 0.99)
     mid[:, :2] = -0.02 * side
-    # passing: A's left hand gives an object to B's right hand (frames ~80-125), B keeps it
-    give = bump(t, 90 / 149, 104 / 149, ramp=0.06)
+    # passing: A's left hand gives an object to B's right hand (about frames 80-125), B keeps it
+    g0, g1 = _span(story, s1 + 25, s1 + 45, (12, 18))
+    give = bump(t, g0 / 149, g1 / 149, ramp=0.06)
     meet = np.zeros((n, 3))
     meet[:, :2] = 0.22 * side
     meet[:, 2] = 0.6 * hmean
@@ -300,12 +315,15 @@ def _handshake(rng, n) -> Script3D:
         g = _to_body(meet, pos_m, hd)
         hi = 0 if k == 0 else 1  # A gives with the left hand, B takes with the right
         hands[:, hi] = _blend(hands[:, hi], g, give)
-    holder = np.where(t < 100 / 149, 1, 2)
-    obj = (holder, np.where(holder == 1, 0, 1), float(rng.uniform(38, 48)),
-           tuple(int(v) for v in rng.choice([(40, 160, 60), (170, 90, 40), (50, 50, 60), (40, 200, 220)])))
+    holder = np.where(t < (g0 + g1) / 2 / 149, 1, 2)
+    radius = float(rng.uniform(38, 48))
+    rng.choice(4)  # drawn as before, so that the cameras and rooms of a seed are those of earlier versions
+    # a saturated colour far from both people's clothes (hue cannot see a grey object, nor one of a
+    # sleeve's colour: docs/trackers/activities.md)
+    obj = (holder, np.where(holder == 1, 0, 1), radius, object_colour(story, apps))
     actors = [Actor3D(app, pos, hd, _wander(rng, n, 0.25, 0.1, 0.3), hands) for app, pos, hd, hands in actors_h]
-    events = [("handshake", 32, 55, 1, "right_hand", 2, "right_hand"),
-              ("exchange", 90, 104, 1, "left_hand", 2, "right_hand")]
+    events = [("handshake", s0, s1, 1, "right_hand", 2, "right_hand"),
+              ("exchange", g0, g1, 1, "left_hand", 2, "right_hand")]
     return Script3D(actors, facing=float(axis - np.pi / 2 if rng.random() < 0.5 else axis + np.pi / 2),
                     objects=[obj], events=events)
 
@@ -452,7 +470,9 @@ def make_multiview_scene(name: str, n_cameras: int = 3, seed: int = 0, n_frames:
     """Render scenario ``name`` (:data:`SCENARIOS_3D`) from ``n_cameras`` cameras, deterministically."""
     _check(name, n_cameras, seed, n_frames, width, height)
     rng = np.random.default_rng([seed, 100 + SCENARIOS_3D.index(name)])
-    script = BUILDERS_3D[name](rng, n_frames)
+    # the activities' timings come from a generator of their own: the people, cameras and rooms of a
+    # seed stay what they were when the timings were fixed
+    script = BUILDERS_3D[name](rng, n_frames, np.random.default_rng([seed, 200 + SCENARIOS_3D.index(name)]))
     cams = place_cameras(rng, n_cameras, (width, height), script.facing)
     luts = [colour_table(a.appearance) for a in script.actors]
     colours = _room_colours(rng)

@@ -39,10 +39,13 @@ DEGREES_PER_BIN = 2.0
 @dataclass(frozen=True)
 class HandColour:
     """One view of one hand at one frame: ``shares`` ``(180,)`` the share of the region per hue bin
-    of the kept (non-skin, connected) modes; ``rho`` eq. 28's reliability."""
+    of the kept (non-skin, connected) modes; ``rho`` eq. 28's reliability; ``where``: per kept mode
+    ``(hue bin, x, y)``, the image position (centroid) of its pixels, which tells an object that moves
+    with the hand from one it passes by."""
 
     shares: np.ndarray
     rho: float
+    where: tuple[tuple[int, float, float], ...] = ()
 
 
 @lru_cache(maxsize=1)
@@ -132,14 +135,17 @@ def hand_colour(frame: np.ndarray, foreground: np.ndarray | None, hand: Box, par
         margin = params.modes.skin_margin / DEGREES_PER_BIN
         modes = [m for m in modes if _hue_distance(m, skin_bin) > margin]
     shares = np.zeros(HUE_BINS)
+    where = []
     if modes:
         hist = np.bincount(hues[valid].ravel(), minlength=HUE_BINS).astype(np.float64) / size
         reach = params.decision.same_colour / DEGREES_PER_BIN
         keep = np.zeros(HUE_BINS, bool)
         for m in modes:
             keep |= _hue_distance(np.arange(HUE_BINS), m) <= reach
+            px = valid & (_hue_distance(hues, m) <= reach)
+            where.append((int(m), float(xx[px].mean() + 0.5), float(yy[px].mean() + 0.5)))
         shares = np.where(keep, hist, 0.0)
-    return HandColour(shares, rho)
+    return HandColour(shares, rho, tuple(where))
 
 
 def body_colours(frame: np.ndarray, foreground: np.ndarray | None, head: Box, params: ActivityParams) -> np.ndarray:

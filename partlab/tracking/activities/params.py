@@ -81,6 +81,9 @@ class Decision:
     # ... and, with 3D positions (a multi-camera tracker), when their centres are at most this many mm
     # apart: 1.5 hand sides of an adult hand (about 45 mm radius)
     contact_mm: float = number(135.0, POSITIVE)
+    # hysteresis: a touch lasts until the hands are this many times the touching distance apart
+    # (a clap's hands part a little between the beats; a shaking pair's boxes jitter)
+    release_ratio: float = number(1.4, POSITIVE)
     # joins of the same two hands this close in time are one activity (three claps, a shake with
     # a few contacts): frames between one separation and the next join
     merge_gap: int = number(30, POSITIVE_COUNT)
@@ -91,6 +94,15 @@ class Decision:
     # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
     still_speed: float = number(0.05, POSITIVE)
     still_frames: int = number(8, POSITIVE_COUNT)
+    # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
+    # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the
+    # colour's position moved along the hand's displacement by less than ``follow_ratio`` of it
+    # (median over the frames): a held object moves with the hand (about 1), a resting one does not
+    # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
+    # than following. Seen in at least ``follow_frames`` such frames.
+    follow_move: float = number(0.5, POSITIVE)
+    follow_ratio: float = number(0.5, FRACTION)
+    follow_frames: int = number(3, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ ACTIVITY_COLUMNS: tuple[str, ...] = ("start_frame", "end_frame", "kind", "track_
 KINDS = ("clap", "handshake", "exchange", "pick", "place", "hand_head")
 
 Key = tuple[int, str]  # (track_id, part)
+LOST = "lost"  # the state of a target the tracker no longer sees (limbs' state machine)
 
 
 class ActivityTracker:
@@ -55,13 +56,14 @@ class ActivityTracker:
         self._centres: dict[Key, dict[int, tuple[float, float, float]]] = defaultdict(dict)
         self._clothes: dict[int, np.ndarray] = defaultdict(lambda: np.zeros(HUE_BINS))
         self._clothes_n: dict[int, int] = defaultdict(int)
+        self._where: dict[Key, dict[int, tuple]] = defaultdict(dict)
         self.events: pd.DataFrame | None = None
 
     def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
         rows = self.inner.step(frames, foreground)
         for r in rows:
-            if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0:
-                continue
+            if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0 or r.state == LOST:
+                continue  # a lost target's box is where it was last seen, not where it is
             stream = r.camera or next(iter(frames.views))
             view = frames.views.get(stream)
             if view is None or view.color is None:
@@ -72,20 +74,22 @@ class ActivityTracker:
                 self._clothes_n[r.track_id] += 1
                 continue
             key = (r.track_id, r.part)
-            self._colours[key][r.frame].append(
-                hand_colour(view.color, foreground.get(stream), r.box, self.activity_params))
+            seen = hand_colour(view.color, foreground.get(stream), r.box, self.activity_params)
+            self._colours[key][r.frame].append(seen)
             if stream == next(iter(frames.views)):  # still moments are measured in the first view
                 self._centres[key][r.frame] = (r.box.x + r.box.w / 2, r.box.y + r.box.h / 2, max(r.box.w, r.box.h))
+                self._where[key][r.frame] = seen.where
         return rows
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
         out = self.inner.table(records)
         joins = getattr(self.inner, "events", None)
-        found = contacts(out, self.activity_params)
+        seen = out[out["state"] != LOST] if "state" in out.columns else out
+        found = contacts(seen, self.activity_params)
         joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
         clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
                    for t, n in self._clothes_n.items()}
-        self.events = recognise(joins, self._colours, self._centres, self.activity_params, clothes)
+        self.events = recognise(joins, self._colours, self._centres, self.activity_params, clothes, self._where)
         return out
 
 
@@ -109,6 +113,18 @@ def _held(colours: dict[int, list[HandColour]], lo: int, hi: int, params: Activi
     if len(obs) < max(2, params.decision.window // 3):
         return None
     return colour_masses(fuse(obs), params)
+
+
+def _held_seen(colours: dict[int, list[HandColour]], lo: int, hi: int, away: int,
+               params: ActivityParams) -> dict[int, float] | None:
+    """:func:`_held` over ``lo..hi``, or, where the hand was unseen there (lost while it touched the
+    other), over the window widened away from the activity (``away`` -1: earlier, +1: later) by up
+    to ``apart_search`` frames until it has been seen often enough."""
+    for extra in range(0, params.decision.apart_search + 1, max(1, params.decision.window // 2)):
+        held = _held(colours, lo - extra if away < 0 else lo, hi + extra if away > 0 else hi, params)
+        if held is not None:
+            return held
+    return None
 
 
 def _windows(start: int, end: int, params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
@@ -151,37 +167,62 @@ def _near(hands: pd.DataFrame, params: ActivityParams) -> tuple[np.ndarray, np.n
     return centre, params.decision.contact_size * 0.5 * np.maximum(hands["w"], hands["h"]).to_numpy()
 
 
-def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
-    """Frames where two hands touch (:func:`_near`), as join rows: one per run of touching frames of a pair."""
-    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
-    hands = tracks[tracks["part"].isin(HAND_PARTS)]
-    if "camera" in hands.columns and (hands["camera"] != "").any():
-        hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
-    if hands.empty:
-        return pd.DataFrame(columns=cols)
+def _pair_distances(hands: pd.DataFrame, params: ActivityParams) -> dict[tuple, dict[int, float]]:
+    """Per pair of hands and frame where both are seen: their distance over the sum of their reaches
+    (:func:`_near`): at most 1 is a touch."""
     centre, reach = _near(hands, params)
     frame, tid, part = hands["frame"].to_numpy(), hands["track_id"].to_numpy(), hands["part"].to_numpy()
-    touching: dict[tuple, list[int]] = defaultdict(list)
+    out: dict[tuple, dict[int, float]] = defaultdict(dict)
     order = np.argsort(frame, kind="stable")
     bounds = np.flatnonzero(np.diff(frame[order])) + 1
     for idx in np.split(order, bounds):
         for i in range(len(idx)):
             for j in range(i + 1, len(idx)):
                 p, q = idx[i], idx[j]
-                if np.linalg.norm(centre[p] - centre[q]) <= reach[p] + reach[q]:
-                    key = tuple(sorted(((int(tid[p]), str(part[p])), (int(tid[q]), str(part[q])))))
-                    touching[key].append(int(frame[p]))
-    rows = []
-    for (a, b), fs in touching.items():
-        fs = sorted(set(fs))
-        start = prev = fs[0]
-        for f in fs[1:] + [None]:
-            if f is not None and f - prev <= 2:
-                prev = f
-                continue
-            rows.append((start, prev, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact"))
-            if f is not None:
-                start = prev = f
+                key = tuple(sorted(((int(tid[p]), str(part[p])), (int(tid[q]), str(part[q])))))
+                out[key][int(frame[p])] = float(np.linalg.norm(centre[p] - centre[q]) / max(reach[p] + reach[q], 1e-9))
+    return out
+
+
+def touch_runs(ratio: Mapping[int, float], params: ActivityParams) -> list[tuple[int, int]]:
+    """Frames two hands touch, with hysteresis: a touch starts where their distance ratio
+    (:func:`_pair_distances`) is at most 1 and lasts until it exceeds ``release_ratio``; frames where
+    either hand is unseen (a hand lost while the two are together, what a tracker of blobs does
+    when two hands make one blob) do not end it, and it ends at its last frame not apart."""
+    rel = params.decision.release_ratio
+    runs, cur, last_ok = [], None, None
+    for f in sorted(ratio):
+        r = ratio[f]
+        if cur is None:
+            if r <= 1.0:
+                cur, last_ok = f, f
+            continue
+        if r > rel:
+            runs.append((cur, last_ok))
+            cur = None
+            if f - last_ok > 1:  # unseen in between: the touch ended somewhere there, at its middle
+                runs[-1] = (runs[-1][0], (last_ok + f) // 2)
+            continue
+        last_ok = f
+    if cur is not None:
+        runs.append((cur, last_ok))
+    return runs
+
+
+def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
+    """Touches of two hands (:func:`touch_runs`), as join rows: one per touch of a pair."""
+    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
+    hands = tracks[tracks["part"].isin(HAND_PARTS)]
+    if "camera" in hands.columns and (hands["camera"] != "").any():
+        if {"X", "Y", "Z"} <= set(hands.columns) and hands[["X", "Y", "Z"]].notna().all(axis=None):
+            # a 3D tracker: a hand is where it is, whichever view saw it (one view may not see it)
+            hands = hands.drop_duplicates(["frame", "track_id", "part"])
+        else:
+            hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
+    if hands.empty:
+        return pd.DataFrame(columns=cols)
+    rows = [(start, end, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact")
+            for (a, b), ratio in _pair_distances(hands, params).items() for start, end in touch_runs(ratio, params)]
     return pd.DataFrame(rows, columns=cols)
 
 
@@ -212,9 +253,9 @@ def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, 
                   params: ActivityParams) -> tuple[tuple[int, int], tuple[int, int]]:
     """The two decision windows of a join: ending at the last frame before ``start`` and starting at
     the first frame after ``end`` where the hands are ``apart_size`` hand sides apart (the gap
-    windows of :func:`_windows` where they never are). The activity lasts from the first to the
-    second decision point (a touch the tracker saw only briefly, a hand lost while the hands were
-    together, still lasts as long as the hands were near)."""
+    windows of :func:`_windows` where they never are). The activity itself lasts as long as the
+    touch (:func:`touch_runs`): the decision points are where colour is read, not its ends.
+    """
     d = params.decision
 
     def apart(f: int) -> bool:
@@ -269,10 +310,9 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
             (b0, b1), (a0, a1) = apart_windows(centres.get(a, {}), centres.get(b, {}), start, end, params)
-            base.update(start_frame=min(start, b1 + 1), end_frame=max(end, a0 - 1))
             worn = np.union1d(clothes.get(a[0], np.zeros(0, int)), clothes.get(b[0], np.zeros(0, int)))
-            seen = [_without(_held(colours.get(k, {}), lo, hi, params), worn)
-                    for k in (a, b) for lo, hi in ((b0, b1), (a0, a1))]
+            seen = [_without(_held_seen(colours.get(k, {}), lo, hi, away, params), worn)
+                    for k in (a, b) for lo, hi, away in ((b0, b1, -1), (a0, a1, 1))]
             if all(s is not None for s in seen):
                 ab, aa, bb, ba = seen
                 v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
@@ -288,29 +328,67 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
 
 def _distinct(rows: list[dict]) -> list[dict]:
     """One activity where several pairs of hands report the same one: of rows of one kind that share
-    a hand and overlap by more than half (temporal IoU), the most confident (a person's right hand
+    a hand and overlap by more than half of the shorter (:func:`_overlap`), the most confident (a person's right hand
     meets the other's right and left hand in the same exchange)."""
     kept: list[dict] = []
     for r in sorted(rows, key=lambda r: -r["confidence"]):
         hands = {(r["track_id_a"], r["part_a"]), (r["track_id_b"], r["part_b"])} - {(0, "")}
         span = (r["start_frame"], r["end_frame"])
         if not any(k["kind"] == r["kind"] and hands & {(k["track_id_a"], k["part_a"]), (k["track_id_b"], k["part_b"])}
-                   and _iou(span, (k["start_frame"], k["end_frame"])) > 0.5 for k in kept):
+                   and _overlap(span, (k["start_frame"], k["end_frame"])) > 0.5 for k in kept):
             kept.append(r)
     return kept
 
 
-def _iou(a: tuple[int, int], b: tuple[int, int]) -> float:
+def _overlap(a: tuple[int, int], b: tuple[int, int]) -> float:
+    """Frames in common over the frames of the shorter span: one activity reported over 45-52 and
+    45-89 by two pairs of hands is one (their IoU is only 0.18)."""
     inter = min(a[1], b[1]) - max(a[0], b[0]) + 1
-    return max(inter, 0) / (max(a[1], b[1]) - min(a[0], b[0]) + 1)
+    return max(inter, 0) / min(a[1] - a[0] + 1, b[1] - b[0] + 1)
+
+
+def stays_behind(where: Mapping[int, tuple], centres: Mapping[int, tuple], hue: int, s0: int, s1: int,
+                 params: ActivityParams) -> bool | None:
+    """Whether colour ``hue`` stayed where the hand stood still over ``s0..s1`` while the hand moved
+    on (True: an object left there, or one it only passed), moved with it (False: held), or cannot
+    be told (None: the hand never moved ``follow_move`` hand sides away within ``apart_search``
+    frames while the colour was seen). Positions from :attr:`HandColour.where` (the first view)."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+
+    def at(f):
+        pts = [(x, y) for h, x, y in where.get(f, ()) if min((h - hue) % HUE_BINS, (hue - h) % HUE_BINS) <= reach]
+        return pts[0] if pts else None
+
+    # where the colour was last seen while the hand stood still (an object put down during the still
+    # moment has moved from the hand to where it rests)
+    ref = [at(f) for f in range(s0, s1 + 1) if at(f) is not None][-max(1, d.window // 2):]
+    if not ref or s1 not in centres:
+        return None
+    rx, ry = np.median(np.array(ref), axis=0)
+    hx, hy, side = centres[s1]
+    ratios = []
+    for f in range(s1 + 1, s1 + d.apart_search):
+        p = at(f)
+        if p is None or f not in centres:
+            continue
+        dx, dy = centres[f][0] - hx, centres[f][1] - hy
+        moved = np.hypot(dx, dy)
+        if moved >= d.follow_move * side:  # the colour's displacement along the hand's, in units of it
+            ratios.append(((p[0] - rx) * dx + (p[1] - ry) * dy) / moved**2)
+    if len(ratios) < d.follow_frames:
+        return None
+    return bool(np.median(ratios) < d.follow_ratio)
 
 
 def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, list[HandColour]]],
               centres: Mapping[Key, Mapping[int, tuple[float, float, float]]], params: ActivityParams,
-              clothes: Mapping[int, np.ndarray] | None = None) -> pd.DataFrame:
+              clothes: Mapping[int, np.ndarray] | None = None,
+              where: Mapping[Key, Mapping[int, tuple]] | None = None) -> pd.DataFrame:
     """The activities table (:data:`ACTIVITY_COLUMNS`) from the join events and what each hand held;
-    ``clothes``: per track, the hue bins the person wears (never taken for objects)."""
-    clothes = clothes or {}
+    ``clothes``: per track, the hue bins the person wears (never taken for objects); ``where``: per
+    hand and frame, the positions of the colours around it (:func:`stays_behind`)."""
+    clothes, where = clothes or {}, where or {}
     rows, busy = _join_rows(joins, colours, centres, params, clothes)
     d = params.decision
     for key, cs in centres.items():
@@ -323,7 +401,8 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
                              for lo, hi in ((b0, b1), (a0, a1)))
             if before is None or after is None:
                 continue
-            v = one_hand(before, after, params)
+            v = one_hand(before, after, params,
+                         lambda hue, k=key, c=cs, a=s0, b=s1: stays_behind(where.get(k, {}), c, hue, a, b, params))
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),

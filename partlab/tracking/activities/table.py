@@ -42,7 +42,8 @@ def _mass(held: dict[int, float], hue: int, params: ActivityParams) -> float:
 def _margin(present: list[float], absent: list[float], params: ActivityParams) -> float:
     d = params.decision
     up = min((m - d.min_mass) / max(1e-9, 1 - d.min_mass) for m in present)
-    down = min(1.0 - m / max(1e-9, max(d.max_mass_absent, d.absent_ratio * max(present))) for m in absent)
+    down = min((1.0 - m / max(1e-9, max(d.max_mass_absent, d.absent_ratio * max(present))) for m in absent),
+               default=1.0)
     return float(max(0.0, min(1.0, 0.5 * (up + down) + 0.5)))
 
 
@@ -69,19 +70,31 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
     return Verdict("clap" if same_person else "handshake", None, float(max(0.2, min(1.0, 0.6 + 0.4 * margin))))
 
 
-def one_hand(before: dict, after: dict, params: ActivityParams) -> Verdict | None:
+def one_hand(before: dict, after: dict, params: ActivityParams, stays=None) -> Verdict | None:
     """Rows 4-5 of Table 1: a colour that appears in a hand at a still moment is picked up, one
-    that disappears is placed; None when nothing changed."""
+    that disappears is placed; None when nothing changed.
+
+    ``stays(hue)``: whether that colour stayed where the hand stood still while the hand moved on
+    (True), moved with it (False) or cannot be told (None). An object put down stays, so a colour
+    held before that stays behind is placed even when the hand, resting beside it, still shows some
+    of it; a colour that appears around the hand but stays behind lay beside it, not picked up."""
     d = params.decision
+    stays = stays or (lambda hue: None)
     best = None
     for hue, m in after.items():
         was = _mass(before, hue, params)
-        if m >= d.min_mass and _absent(was, m, params):
+        if m >= d.min_mass and _absent(was, m, params) and stays(hue) is not True:
             v = Verdict("pick", hue, _margin([m], [was], params))
             best = v if best is None or v.margin > best.margin else best
     for hue, m in before.items():
         now = _mass(after, hue, params)
-        if m >= d.min_mass and _absent(now, m, params):
+        if m < d.min_mass:
+            continue
+        if _absent(now, m, params):
             v = Verdict("place", hue, _margin([m], [now], params))
-            best = v if best is None or v.margin > best.margin else best
+        elif stays(hue) is True:
+            v = Verdict("place", hue, _margin([m], [], params))
+        else:
+            continue
+        best = v if best is None or v.margin > best.margin else best
     return best
