@@ -127,7 +127,8 @@ def plot(results: dict, path: Path) -> None:
 
     W, H, m = 640, 420, 60
     img = np.full((H, W, 3), 255, np.uint8)
-    pts = [(r["cpu_ms"], r["eps"]) for key, rows in results.items() if key.endswith("colour") for r in rows]
+    pts = [(r["cpu_ms"], r["eps"]) for key, rows in results.items()
+           if key.endswith("colour") and key[:2] in ("S1", "S2") for r in rows]
     xs, ys = zip(*pts)
     x1, y1 = max(xs) * 1.1, max(ys) * 1.15
     sx = lambda x: int(m + (W - 2 * m) * x / x1)  # noqa: E731

@@ -145,8 +145,8 @@ def follow(store: Store, clip_id: int, frame: int, track_id: int, part: str, box
     """The changes (``Store.edit_boxes``' dicts, by clip id) that make every view of the take agree
     with ``box``, the correction of ``(frame, track_id, part)`` in ``clip_id`` about to be written:
     for ``clip_id`` itself that box with the new point, for the other views their reprojected boxes.
-    Empty when the clip is no calibrated take's view, the part has no 3D point or the point cannot
-    be found."""
+    Empty when the clip is no calibrated take's view, the part has no 3D point, the box did not move
+    (only a flag changed) or the point cannot be found."""
     views = take_views(store, clip_id)
     if part not in MULTIVIEW_PARTS or not views:
         return {}
@@ -155,6 +155,8 @@ def follow(store: Store, clip_id: int, frame: int, track_id: int, part: str, box
         return {}
     rows = {v.name: _row(store, v.clip_id, frame, track_id, part) for v in views}
     old = rows[edited.name]
+    if old is not None and np.allclose([old.x, old.y, old.w, old.h], [box.x, box.y, box.w, box.h], atol=1e-6):
+        return {}  # the box did not move (a flag was toggled): the point stays
     rows[edited.name] = pd.Series(dict(x=box.x, y=box.y, w=box.w, h=box.h, source="human",
                                        X=np.nan if old is None else old.X, Y=np.nan if old is None else old.Y,
                                        Z=np.nan if old is None else old.Z,

@@ -109,6 +109,8 @@ def test_a_hand_moved_in_one_view_moves_the_other_views_to_the_reprojection(take
         assert (b.w, b.h) == (before[name].w, before[name].h)
         assert np.hypot(b.x - before[name].x, b.y - before[name].y) > 2  # the box moved
     assert follow(store, clips["cam0"], 2, 1, "torso", moved) == {}  # no 3D point for body parts
+    same = Box(before["cam0"].x, before["cam0"].y, before["cam0"].w, before["cam0"].h)
+    assert follow(store, clips["cam0"], 2, 1, "right_hand", same) == {}  # a flag toggled: nothing moves
 
 
 def test_the_editor_edit_moves_every_view_and_one_undo_takes_them_all_back(take):

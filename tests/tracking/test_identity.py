@@ -83,3 +83,29 @@ def test_coasted_body_heads_give_way_to_the_limb_trackers_measured_head():
     out = merge_tracks(kept, limbs, match_limb_people(kept, limbs), offset=100000)
     p1 = out[(out.track_id == 1) & (out.part == "head")].set_index("frame").sort_index()
     assert len(p1) == 30 and (p1.loc[10:14, "w"] == 14).all() and (p1.loc[15:, "w"] == 20).all()
+
+
+def test_unmatched_limb_rows_go_to_the_body_person_they_are_on():
+    from partlab.tracking.identity import relabel_on_people
+
+    body, limbs = _scene()
+    # limb person 11: a fragment whose head is on person 2 (frames 0-4) then on person 1 (frames 5-9),
+    # never long enough on one body person to be matched; a left hand on person 2 where 7's is too
+    extra = pd.DataFrame(
+        _rows(11, "head", [(f, (312, 64, 14, 14)) for f in range(5)])
+        + _rows(11, "head", [(f, (22 + 3 * f, 54, 14, 14)) for f in range(5, 10)])
+        + _rows(11, "left_hand", [(f, (295, 125, 10, 10)) for f in range(3)]))
+    limbs = pd.concat([limbs, extra], ignore_index=True)
+    mapping = match_limb_people(body, limbs)
+    assert 11 not in mapping and mapping == {7: 2, 8: 1}
+    out, given = relabel_on_people(body, limbs, mapping, head_top=1 / 3)
+    assert not (out.x == 600).any()  # limb person 9's head on the wall: on nobody, dropped
+    moved = out[out.relabelled]
+    heads = moved[moved.part == "head"].set_index("frame").sort_index()["track_id"]
+    assert heads.loc[0:4].eq(2).all() and heads.loc[5:9].eq(1).all()
+    assert given == {11: 2} or given == {11: 1}
+    # person 2's own (matched) left hand wins over the relabelled one in frames 0-2
+    assert moved[moved.part == "left_hand"].empty
+    merged = merge_tracks(body, out, mapping, offset=100000)
+    assert sorted(merged.track_id.unique()) == [1, 2]
+    assert not merged.duplicated(["frame", "track_id", "part"]).any()
