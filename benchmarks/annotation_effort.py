@@ -172,16 +172,33 @@ def summarise(df: pd.DataFrame) -> pd.DataFrame:
     return out.reset_index()
 
 
-def synth_suite(n_scenes: int, seeds, keys, frames: int) -> pd.DataFrame:
-    """The randomized suite: scene ``s`` is scenario ``random`` at seed ``100 + s``."""
+def random_scene(seed: int, frames: int, cache: Path | None = None):
+    """Scenario ``random`` at ``seed`` in its suite size (rendered once into ``cache`` when given:
+    rendering costs more than tracking)."""
+    import pickle
+
     from partlab.labelling.synth import make_scene
     from partlab.labelling.synth.scene import random_size
 
+    path = None if cache is None else cache / f"random{seed}_{frames}.pkl"
+    if path is not None and path.exists():
+        with open(path, "rb") as f:  # our own cache of our own scenes
+            return pickle.load(f)
+    w, h = random_size(seed)
+    scene = make_scene("random", seed=seed, n_frames=frames, width=w, height=h)
+    if path is not None:
+        cache.mkdir(parents=True, exist_ok=True)
+        with open(path, "wb") as f:
+            pickle.dump(scene, f)
+    return scene
+
+
+def synth_suite(n_scenes: int, seeds, keys, frames: int, first: int = 100, cache: Path | None = None) -> pd.DataFrame:
+    """The randomized suite: scene ``s`` is scenario ``random`` at seed ``first + s``."""
     out = []
     for s in range(n_scenes):
-        seed = 100 + s
-        scene = make_scene("random", seed=seed, n_frames=frames, width=random_size(seed)[0],
-                           height=random_size(seed)[1])
+        seed = first + s
+        scene = random_scene(seed, frames, cache)
         # the truth from each track's init frame on (people walking in: once wholly in view, as an
         # annotator would start them); the slivers before are not counted
         start = scene.init.groupby("track_id")["frame"].min()
@@ -203,6 +220,8 @@ def main() -> None:
     ap.add_argument("--pets-frames", type=int, default=None, help="only the first N frames of PETS")
     ap.add_argument("--synth-scenes", type=int, default=6, help="scenes of the randomized suite")
     ap.add_argument("--synth-frames", type=int, default=150)
+    ap.add_argument("--synth-first", type=int, default=100, help="seed of the suite's first scene")
+    ap.add_argument("--scene-cache", type=Path, help="keep rendered synthetic scenes here (pickles) for reruns")
     ap.add_argument("--hog", action="store_true", help="also run the HOG+SORT baseline on PETS")
     ap.add_argument("--skip-pets", action="store_true")
     ap.add_argument("--skip-otb", action="store_true")
@@ -228,7 +247,7 @@ def main() -> None:
             print(f"OTB {name}: {len(frames)} frames", flush=True)
             tables.append(clip_table(name, MemoryTake(frames, fps), truth, seeds, auto=False, keys=keys))
     if not a.skip_synth:
-        tables.append(synth_suite(a.synth_scenes, seeds, keys, a.synth_frames))
+        tables.append(synth_suite(a.synth_scenes, seeds, keys, a.synth_frames, a.synth_first, a.scene_cache))
     df = pd.concat(tables, ignore_index=True)
     if a.csv:
         df.to_csv(a.csv, index=False)

@@ -44,12 +44,34 @@ from partlab.tracking.topview.model import JOINTS, WEIGHT_PARTS, joints, primiti
 from partlab.tracking.topview.params import LikelihoodParams, ResamplingParams, TopViewParams  # noqa: E402
 from partlab.tracking.topview.tracker import Geometry, TopViewTracker  # noqa: E402
 
+_HANDS = ((5, 4), (8, 5))  # (hand primitive, weighting part + 1 of its arm), right then left
+
+
+def hand_pixels(scene, f: int, k: int, geo: Geometry, min_height_mm: float) -> list[int]:
+    """Per hand (right, left) of person ``k`` at frame ``f``: how many measured depth pixels of
+    the ROI's height see its true hand (the arm's labelled pixels within 15 mm of the hand's plane)."""
+    person = scene.people[k - 1]
+    prims = primitives(person.states[f][None], person.body)[0]
+    out = []
+    for prim, label in _HANDS:
+        px = np.flatnonzero(((scene.person[f] == k) & (scene.part[f] == label)).ravel()
+                            & np.isfinite(scene.depth[f]).ravel())
+        if not len(px):
+            out.append(0)
+            continue
+        pts = geo.points(scene.depth[f], px)
+        only = prims.copy()
+        only[np.arange(len(prims)) != prim, 0:3] = 1e6  # the other primitives moved far away: the hand alone
+        d, _ = nearest(pts, only)
+        out.append(int(((d < 15.0) & (pts[:, 2] >= min_height_mm)).sum()))
+    return out
+
 
 def run(scene, params: TopViewParams, seed: int) -> dict:
     """Track ``scene`` from its frame-0 truth and measure it."""
     tr = TopViewTracker(params, np.random.default_rng(seed), init=scene.init, cameras={"cam0": scene.camera})
     geo = Geometry(scene.camera)
-    eps, errs, surv, assign = [], [], [], []
+    eps, errs, surv, assign, seen = [], [], [], [], []
     cpu = wall = 0.0
     for f in range(len(scene.depth)):
         fs = FrameSet.single(f, scene.color[f], scene.depth[f], camera=scene.camera)
@@ -74,15 +96,22 @@ def run(scene, params: TopViewParams, seed: int) -> dict:
                                - joints(person.states[f][None], person.body)[0], axis=1)
             errs.append(e)
             surv.append(t.filter.survival.copy())
+            seen.append(hand_pixels(scene, f, k, geo, params.roi.min_height_mm))
     e = np.array(errs)
     arm = e[:, 3:]  # elbows and hands (JOINTS order)
+    # a missed frame (an arm joint 80 mm off or more) "with a hidden hand": a hand 80 mm off or
+    # more whose true hand no depth pixel sees
+    missed = arm.max(1) >= 80
+    hidden = ((e[:, 5:7] >= 80) & (np.array(seen) == 0)).any(1)
     frames = max(len(scene.depth) - 1, 1)
     n = frames * len(scene.people)
     return {"eps": float(np.mean(eps)), "cpu_ms": 1000 * cpu / frames, "wall_ms": 1000 * wall / frames,
             "cpu_ms_per_person": 1000 * cpu / n, "arm80": float((arm < 80).mean()),
             "frames80": float((arm.max(1) < 80).mean()), "head_mm": float(e[:, 0].mean()),
             "arm_mm": float(arm.mean()), "survival": np.mean(surv, 0).tolist(), "assign": float(np.nanmean(assign)),
-            "joint_mm": e.mean(0).tolist(), "joint80": (e < 80).mean(0).tolist()}
+            "joint_mm": e.mean(0).tolist(), "joint80": (e < 80).mean(0).tolist(),
+            "missed": int(missed.sum()), "missed_hidden": int((missed & hidden).sum()), "rows": len(e),
+            "hand_hidden": float((np.array(seen) == 0).mean())}
 
 
 def summary(rows: list[dict], key: str) -> str:
@@ -98,7 +127,8 @@ def plot(results: dict, path: Path) -> None:
 
     W, H, m = 640, 420, 60
     img = np.full((H, W, 3), 255, np.uint8)
-    pts = [(r["cpu_ms"], r["eps"]) for key, rows in results.items() if key.endswith("colour") for r in rows]
+    pts = [(r["cpu_ms"], r["eps"]) for key, rows in results.items()
+           if key.endswith("colour") and key[:2] in ("S1", "S2") for r in rows]
     xs, ys = zip(*pts)
     x1, y1 = max(xs) * 1.1, max(ys) * 1.15
     sx = lambda x: int(m + (W - 2 * m) * x / x1)  # noqa: E731
@@ -213,6 +243,16 @@ def print_tables(results: dict[str, list[dict]], args) -> None:
             cells.append(summary(sel, "assign") if key.startswith("S3") else "")
             widths = (14, 14, 14, 16, 16, 16)
             print(f"{key:28s} {n:4d} {len(sel):5d} " + " ".join(f"{c:>{w}s}" for c, w in zip(cells, widths)))
+    print("\nmissed frames (an arm joint >= 80 mm off) and those with a hand >= 80 mm off that no depth pixel "
+          "sees (the true hand hidden); share of (frame, hand) pairs hidden")
+    for key, rows in results.items():
+        sel = [r for r in rows if r["n"] == args.default_particles and "missed" in r]
+        if sel:
+            m, h = sum(r["missed"] for r in sel), sum(r["missed_hidden"] for r in sel)
+            rows_n = sum(r["rows"] for r in sel)
+            print(f"{key:28s} missed {m:4d} of {rows_n:5d}, with the hand hidden {h:4d} ({h / max(m, 1):.2f}); "
+                  f"hands hidden {np.mean([r['hand_hidden'] for r in sel]):.3f}; frames<80 if those counted right "
+                  f"{1 - (m - h) / max(rows_n, 1):.3f}")
     print("\nsurvival (distinct particles kept / N, mean over frames and seeds) at N =", args.default_particles)
     print(f"{'':28s} " + " ".join(f"{p:>10s}" for p in WEIGHT_PARTS))
     for key, rows in results.items():

@@ -51,6 +51,10 @@ class Step:
     events: list[tuple[int, dict | None, dict | None]] = field(default_factory=list)
     refined: list[int] = field(default_factory=list)
     fills: dict[tuple[int, str], int] = field(default_factory=dict)  # EditHistory.fills when it refilled
+    #: what it wrote in the other views of a take: ``(clip_id, step of that clip)`` (undone with it)
+    views: list[tuple[int, Step]] = field(default_factory=list)
+    #: other views it could not write (their messages)
+    view_errors: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -67,6 +71,8 @@ class EditHistory:
     #: the revision this session wrote last for each event
     event_revs: dict[int, int] = field(default_factory=dict)
     fills: dict[tuple[int, str], int] = field(default_factory=dict)
+    #: ``revs`` of the other views of a take this session wrote into, by clip id
+    view_revs: dict[int, dict[tuple[int, int, str], int]] = field(default_factory=dict)
     lock: threading.RLock = field(default_factory=threading.RLock, repr=False, compare=False)
 
     def touched(self, refill: list[tuple[int, str, int]]) -> dict[tuple[int, str], int]:
@@ -156,13 +162,24 @@ def _refill(store: Store, clip_id: int, refill: list[tuple[int, str, int]]) -> i
     return run
 
 
-def _rewrite(store: Store, clip_id: int, history: EditHistory, step: Step, contents: list[dict],
-             author: str) -> list:
-    """Write ``contents`` over the keys ``step`` wrote, expecting the revisions this session wrote last."""
-    changes = [dict(c, expected_revision=history.revs.get(k[:3], k[3])) for c, k in zip(contents, step.keys)]
+def _rewrite(store: Store, clip_id: int, revs: dict, step: Step, contents: list[dict], author: str) -> list:
+    """Write ``contents`` over the keys ``step`` wrote, expecting the revisions this session wrote
+    last (``revs``, updated)."""
+    changes = [dict(c, expected_revision=revs.get(k[:3], k[3])) for c, k in zip(contents, step.keys)]
     keys = trackops.apply(store, clip_id, changes, author=author)
-    history.wrote(keys)
+    for f, t, p, r in keys:
+        revs[(f, t, p)] = r
     return keys
+
+
+def _rewrite_views(store: Store, history: EditHistory, step: Step, after: bool, author: str) -> list:
+    """Undo (``after`` False) or redo the other views' part of ``step``; returns their new steps."""
+    out = []
+    for clip_id, sub in step.views:
+        keys = _rewrite(store, clip_id, history.view_revs.setdefault(clip_id, {}), sub,
+                        sub.after if after else sub.before, author)
+        out.append((clip_id, Step(keys=keys, before=sub.before, after=sub.after, label=sub.label, frame=sub.frame)))
+    return out
 
 
 def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
@@ -174,25 +191,27 @@ def undo_step(store: Store, clip_id: int, history: EditHistory, author: str = ""
         for run in [*reversed(step.refined), step.run_id]:
             if run is not None:
                 store.undo_run(clip_id, run)
-        keys = _rewrite(store, clip_id, history, step, step.before, author) if step.keys else []
+        keys = _rewrite(store, clip_id, history.revs, step, step.before, author) if step.keys else []
+        views = _rewrite_views(store, history, step, False, author)
         for event_id, before, _after in step.events:
             _set_event(store, clip_id, history, event_id, before, author)
         history.undo.pop()
         history.touched(step.refill)
         history.redo.append(Step(keys=keys, before=step.before, after=step.after, label=step.label,
-                                 frame=step.frame, refill=step.refill, events=step.events))
+                                 frame=step.frame, refill=step.refill, events=step.events, views=views))
     return step
 
 
 def redo_step(store: Store, clip_id: int, history: EditHistory, author: str = "") -> Step:
     with history.lock:
         step = history.redo[-1]
-        keys = _rewrite(store, clip_id, history, step, step.after, author) if step.keys else []
+        keys = _rewrite(store, clip_id, history.revs, step, step.after, author) if step.keys else []
+        views = _rewrite_views(store, history, step, True, author)
         for event_id, _before, after in step.events:
             _set_event(store, clip_id, history, event_id, after, author)
         history.redo.pop()
         again = Step(keys=keys, before=step.before, after=step.after, label=step.label, frame=step.frame,
-                     refill=step.refill, events=step.events)
+                     refill=step.refill, events=step.events, views=views)
         if step.refill:
             again.run_id = _refill(store, clip_id, step.refill)
             again.fills = history.touched(step.refill)
@@ -284,8 +303,44 @@ def apply_event_edit(store: Store, clip_id: int, ev: dict, history: EditHistory,
     return step
 
 
-def _box_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author: str, fill: bool) -> Step:
-    """One box moved, resized, flagged or deleted in the editor, as a step."""
+#: ``follow(store, clip_id, frame, track_id, part, box) -> {clip_id: [change]}``: the changes that make
+#: the other views of a take agree with a corrected box (:func:`partlab.labelling.multiview.follow`)
+Follow = Callable[[Store, int, int, int, str, Box], dict[int, list[dict]]]
+
+
+def _follow_views(store: Store, clip_id: int, change: dict, history: EditHistory, follow: Follow,
+                  author: str) -> tuple[list[tuple[int, list[dict]]], list[str]]:
+    """The other views' changes for ``change`` (its own gets the point's ``camera`` and ``xyz``)."""
+    try:
+        by_clip = follow(store, clip_id, change["frame"], change["track_id"], change["part"], change["box"])
+    except (StoreError, ValueError) as exc:
+        return [], [f"The other views were not moved: {exc}"]
+    own = by_clip.pop(clip_id, [])
+    if own:
+        change.update(camera=own[0]["camera"], xyz=own[0]["xyz"])
+    return sorted(by_clip.items()), []
+
+
+def _write_views(store: Store, step: Step, history: EditHistory, others: list[tuple[int, list[dict]]],
+                 author: str) -> None:
+    """Write the other views' changes as parts of ``step`` (each view on its own: one refused
+    view does not stop the others)."""
+    for other, changes in others:
+        try:
+            keys, before, after = _write(store, other, changes, author)
+        except StoreError as exc:
+            step.view_errors.append(f"Not saved in another view (clip {other}): {exc}")
+            continue
+        revs = history.view_revs.setdefault(other, {})
+        for f, t, p, r in keys:
+            revs[(f, t, p)] = r
+        step.views.append((other, Step(keys=keys, before=before, after=after, label=step.label, frame=step.frame)))
+
+
+def _box_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author: str, fill: bool,
+              follow: Follow | None = None) -> Step:
+    """One box moved, resized, flagged or deleted in the editor, as a step; with ``follow``, the
+    same target's boxes in the other views of the take move with it (part of the same step)."""
     kind = ev["kind"]
     frame, tid, part = int(ev["frame"]), int(ev["track_id"]), str(ev["part"])
     expected = ev.get("revision")
@@ -294,16 +349,24 @@ def _box_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author
         expected = store.revision(clip_id, frame, tid, part)
     change = dict(frame=frame, track_id=tid, part=part, expected_revision=int(expected),
                   box=_box(ev["box"]) if kind == "edit" else None)
+    others, errors = [], []
     if kind == "edit":
         change.update(failure=_flag(ev.get("failure")), occluded=ev.get("occluded") or 0.0)
-    return record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
-                  author=author, fill=fill and kind == "edit")
+        if follow is not None:
+            others, errors = _follow_views(store, clip_id, change, history, follow, author)
+    with history.lock:
+        step = record(store, clip_id, [change], history, f"{kind} of {part} #{tid} at frame {frame}", frame,
+                      author=author, fill=fill and kind == "edit")
+        step.view_errors.extend(errors)
+        _write_views(store, step, history, others, author)
+    return step
 
 
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
-                 author: str = "", fill: bool = False) -> ApplyResult:
+                 author: str = "", fill: bool = False, follow: Follow | None = None) -> ApplyResult:
     """Write the editor's events to the store in order; see :mod:`partlab.app.box_editor` for
-    their shape. ``fill``: refill the in-between boxes of an edited track between its keyframes."""
+    their shape. ``fill``: refill the in-between boxes of an edited track between its keyframes;
+    ``follow``: move the other views' boxes of an edited target (a view of a calibrated take)."""
     res = ApplyResult()
     for ev in events:
         kind = ev.get("kind")
@@ -314,9 +377,10 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 store.set_occluders(clip_id, [_box(b) for b in ev.get("boxes", [])])
                 res.written += 1
             elif kind in ("edit", "delete"):
-                step = _box_edit(store, clip_id, ev, history, author, fill)
+                step = _box_edit(store, clip_id, ev, history, author, fill, follow)
                 if step.run_id is not None:
                     res.refills.append(step)
+                res.errors.extend(step.view_errors)
                 res.written += 1
             elif kind in ("event_add", "event_edit", "event_delete"):
                 apply_event_edit(store, clip_id, ev, history, author=author)

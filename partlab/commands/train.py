@@ -51,14 +51,11 @@ def run(args) -> int:
 
 
 def _train_clips(args) -> int:
-    import pandas as pd
     from tqdm import tqdm
 
     from partlab.labelling.video import VideoClip, VideoError
     from partlab.models.bundle import BundleError, save_bundle
-    from partlab.models.failure_svm import SVMReport, report_table
     from partlab.models.training import NothingLearnt, train_bundle, training_steps
-    from partlab.models.variance import comparison_table
     from partlab.tracking.tracks import TracksCSVError, read_tracks_csv
 
     if len(args.clip) != len(args.truth):
@@ -103,10 +100,29 @@ def _train_clips(args) -> int:
         save_bundle(bundle, out)
     except BundleError as exc:
         raise CommandError(str(exc)) from None
-    reports = {n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}
     print(f"wrote {out}  ({bundle.summary['samples']}); learnt: {', '.join(bundle.summary['learnt'])}")
-    print("\nfailure SVMs (5-fold cross-validation; negative = failure):")
-    print(report_table(reports))
+    _print_summary(bundle, args.start)
+    return 0
+
+
+def _print_summary(bundle, start: str) -> None:
+    """What training printed after writing the bundle: the SVMs, variances, extents, validation."""
+    import pandas as pd
+
+    from partlab.models.failure_svm import SVMReport, report_table
+    from partlab.models.variance import comparison_table
+
+    reports = {n: SVMReport.from_dict(d) for n, d in bundle.summary["svms"].items()}
+    if any(r.trained or r.n_positive or r.n_negative for r in reports.values()):
+        print("\nfailure SVMs (5-fold cross-validation; negative = failure):")
+        print(report_table(reports))
+    else:
+        print("\nfailure SVMs: none trained (no head, torso and hip-leg boxes in the corrections)")
+    if "person" in bundle.summary:
+        from partlab.models.person import person_table
+
+        print("\nfrom the person boxes (fitted vs start; each kept only if it lowers the edits on these clips):")
+        print(person_table(bundle.summary["person"]))
     print("\nvariance parameters (fitted vs default; '-' = default kept):")
     print(comparison_table(pd.DataFrame(bundle.summary["variances"])))
     if "output_extent" in bundle.summary:
@@ -121,10 +137,9 @@ def _train_clips(args) -> int:
     if "selection" in bundle.summary:
         from partlab.models.selection import selection_table
 
-        print(f"\nvalidation on the training clips, starting from {args.start!r} (tracking rate per part; noise "
+        print(f"\nvalidation on the training clips, starting from {start!r} (tracking rate per part; noise "
               "and extent are kept only if they raise the mean, the new detector unless it lowers it):")
         print(selection_table(bundle.summary["selection"]))
-    return 0
 
 
 def _train_takes(args) -> int:

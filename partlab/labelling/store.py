@@ -133,8 +133,10 @@ class TrackerBoxRow(Base):
 #: what a revision of a human edit is: ``box`` a box the user drew, moved or flagged (a
 #: keyframe, a corrected frame, training truth); ``restore`` hands the key back to the tracker
 #: (an undone first edit); ``track`` an identity operation (merge, split, change id, delete from
-#: a frame on) that moved or removed the tracker's box without checking its position.
-EDIT_KINDS: tuple[str, ...] = ("box", "restore", "track")
+#: a frame on) that moved or removed the tracker's box without checking its position; ``view`` a box
+#: of one view of a take moved to the reprojection of a 3D point corrected in another view
+#: (:mod:`partlab.labelling.multiview`; it follows a keyframe but is not one itself).
+EDIT_KINDS: tuple[str, ...] = ("box", "restore", "track", "view")
 
 
 class EditRow(Base):

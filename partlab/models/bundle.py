@@ -260,10 +260,23 @@ def _load_arrays(path: Path) -> dict[str, np.ndarray]:
 #: bundle to be retrained.
 LEARNED_BODY_FIELDS: tuple[str, ...] = ("dynamics.noise", "output.extent")
 LEARNED_LIMB_FIELDS: tuple[str, ...] = ("priors.sigma_v", "priors.sigma_d", "priors.sigma_s")
+#: What training may fit from person boxes (:mod:`partlab.models.person`): applied only where the
+#: bundle's summary lists them as learnt (``summary["person"]["fields"]``), so a bundle that did
+#: not learn them follows the installed defaults like every other hand-set tunable.
+PERSON_BODY_FIELDS: tuple[str, ...] = ("output.person", "detector.min_score", "detector.shrink",
+                                       "detector.steer", "detector.undetected_frames", "detection.leave_fraction")
 
 
-def learned_body_params(saved: BodyParams) -> BodyParams:
-    return BodyParams().updated({k: saved.get(k) for k in LEARNED_BODY_FIELDS})
+def learned_body_params(saved: BodyParams, person_fields=()) -> BodyParams:
+    fields = (*LEARNED_BODY_FIELDS, *(f for f in PERSON_BODY_FIELDS if f in set(person_fields)))
+    return BodyParams().updated({k: saved.get(k) for k in fields})
+
+
+def person_fields(summary) -> list[str]:
+    """The person-box fields a bundle's summary says training learnt (others are ignored)."""
+    person = summary.get("person") if isinstance(summary, dict) else None
+    listed = person.get("fields", []) if isinstance(person, dict) else []
+    return [f for f in PERSON_BODY_FIELDS if isinstance(listed, list) and f in listed]
 
 
 def learned_limb_params(saved: LimbParams) -> LimbParams:
@@ -284,7 +297,8 @@ def _read_params(manifest: dict) -> tuple[BodyParams, LimbParams, dict]:
     unknown = sorted(set(saved) - set(registry.PARAMETERS))
     if unknown:
         raise ValueError(f"parameters of unknown kind(s) {', '.join(unknown)} (a newer partlab's trackers?)")
-    body = learned_body_params(BodyParams.from_dict(saved["body"])) if "body" in saved else BodyParams()
+    learnt = person_fields(manifest.get("summary"))
+    body = learned_body_params(BodyParams.from_dict(saved["body"]), learnt) if "body" in saved else BodyParams()
     limb = learned_limb_params(LimbParams.from_dict(saved["limbs"])) if "limbs" in saved else LimbParams()
     more = {k: registry.params_class(k).from_dict(v) for k, v in saved.items() if k not in ("body", "limbs")}
     return body, limb, more

@@ -22,6 +22,13 @@ With the tracker, every fitted component (noise and ``lam``, output extent, SVM
 detector) is then validated on the training clips (:mod:`partlab.models.selection`) and kept
 only if it raises the tracking rate there; the summary's ``selection`` records the
 scores and decisions.
+
+Person boxes teach what part boxes are not needed for (:mod:`partlab.models.person`): the person
+box's extent around the parts, the people detector's threshold and window, when an undetected
+track ends, and the person's motion noise. With the tracker, and truth holding person rows, those
+are fitted and each kept only if it lowers the edits of the person boxes on the training clips
+(the summary's ``person``). Truth of person boxes alone (no part box: no SVM sample) therefore
+still trains a bundle, as long as one of those is kept.
 """
 
 from __future__ import annotations
@@ -103,7 +110,9 @@ def training_steps(n_clips: int, with_tracker: bool, with_sharpness: bool | None
     """Number of ``progress`` calls :func:`train_bundle` makes (for a progress bar's total)."""
     if with_sharpness is None:
         with_sharpness = sharpness_available()
-    return n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
+    person = (1 + n_clips + 5) * int(with_tracker)  # learning from person boxes: start, detections, validations
+    return (n_clips * (1 + int(with_tracker) + int(with_sharpness)) + len(SVM_NAMES) + 1 + 4 * int(with_tracker)
+            + person)
 
 
 def _apply_lam(body: BodyParams, table: pd.DataFrame,
@@ -137,13 +146,16 @@ class TrainingOptions:
     (None: when available) decodes each clip once more to fit ``lam``; ``validate`` (with a
     tracker): keep each fitted component only if it does not lower the tracking rate on the
     training clips (:func:`partlab.models.selection.select_components`; up to three more tracker
-    runs per clip); without it, everything fitted is used."""
+    runs per clip); without it, everything fitted is used. ``person`` (None: when the truth has
+    person rows and the tracker runs): learn from the person boxes too
+    (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip)."""
 
     seed: int = 0
     perturbed_per_person: int = 300
     dt: float = DEFAULT_DT
     fit_sharpness: bool | None = None
     validate: bool = True
+    person: bool | None = None
 
 
 @dataclass
@@ -187,9 +199,14 @@ def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
     names = list(names) if names is not None else [f"clip{i}" for i in range(len(clips))]
     if len(names) != len(clips):
         raise ValueError(f"{len(names)} names for {len(clips)} clips")
+    from partlab.models.person import has_person_rows, person_only
+
+    if all(person_only(normalise_tracks(t)) for _f, _fps, t in clips):
+        opts = replace(opts, fit_sharpness=False)  # lam is a part's: person boxes cannot give it
     if opts.fit_sharpness is None:
         opts = replace(opts, fit_sharpness=sharpness_available())
     check_span(clips, names, opts.dt)
+    clips = [(_until(factory, truth), fps, truth) for factory, fps, truth in clips]
     step = progress or (lambda _msg: None)
     rng = np.random.default_rng(opts.seed)
     got = _Samples()
@@ -197,16 +214,29 @@ def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
         _clip_samples(got, i, factory, fps, truth, name, opts, rng, step, tracker_runner, body)
     x_all = np.concatenate(got.xs, axis=0) if got.xs else np.zeros((0, 0))
     y_all = np.concatenate(got.ys, axis=0) if got.ys else np.zeros(0)
-    if len(x_all) == 0:
+    with_person = (opts.person is not False and bool(got.tracked_runs)
+                   and any(has_person_rows(t) for t in got.truths))
+    if len(x_all) == 0 and not with_person:
         raise NothingLearnt("no training samples: the truth has no person with head, torso and hip-leg boxes "
-                            "(person boxes alone teach the failure SVMs nothing)")
-    models, reports = train_failure_svms(x_all, y_all, seed=opts.seed, progress=lambda n: step(f"SVM {n}"))
+                            "(person boxes alone teach the failure SVMs nothing"
+                            + (", and what they teach the tracker needs it: train without --no-tracker)"
+                               if tracker_runner is None else ")"))
+    models, reports = ({}, {}) if len(x_all) == 0 else train_failure_svms(
+        x_all, y_all, seed=opts.seed, progress=lambda n: step(f"SVM {n}"))
     body_p, limb_p, table = _fit_parameters(got, body, limb, opts, step)
     detector = SVMFailureDetector(models, dt=opts.dt) if models else None
     selection = None
-    if got.tracked_runs and opts.validate:
+    parts = not all(person_only(t) for t in got.truths)
+    if got.tracked_runs and opts.validate and parts:
         body_p, detector, table, selection = _validate(clips, got, body, body_p, detector, table, opts, step,
                                                        tracker_runner, start, start_detector)
+    elif not parts:  # person boxes only: the parts' fits have nothing to go on, the start stays
+        body_p, detector = (body or BodyParams()), start_detector
+        body_rows = table["tracker"] == "body"
+        table.loc[body_rows, "applied"] = table.loc[body_rows, "default"]
+    person = None
+    if with_person:
+        body_p, person = _learn_from_people(clips, got, body_p, detector, table, opts, step, tracker_runner)
     summary = {
         "seed": opts.seed,
         "clips": got.clip_info,
@@ -220,9 +250,51 @@ def train_bundle(clips: list[Clip], options: TrainingOptions | None = None, *,
     }
     if selection is not None:
         summary["selection"] = selection
+    if person is not None:
+        summary["person"] = person
     new_detector = detector is not None and detector is not start_detector
     summary["learnt"], summary["nothing_learnt"] = learnt(summary, new_detector)
     return Bundle(body_p, limb_p, detector, summary)
+
+
+def _until(factory: FramesFactory, truth: pd.DataFrame) -> FramesFactory:
+    """``factory``'s frames up to the truth's last frame: frames nobody corrected teach nothing
+    (a user who corrected frames 0-200 of a long clip trains on those, not on the whole clip)."""
+    frames = normalise_tracks(truth)["frame"]
+    last = int(frames.max()) if len(frames) else -1
+
+    def frames_until():
+        for index, frame in factory():
+            if index > last:
+                return
+            yield index, frame
+    return frames_until
+
+
+def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table: pd.DataFrame,
+                       opts: TrainingOptions, step, tracker_runner) -> tuple[BodyParams, dict]:
+    """The person-box fits of :mod:`partlab.models.person` on top of ``body_p`` (what the parts
+    gave), each kept only where it lowers the person-box edits on the training clips:
+    ``(params, the summary's "person" record)``."""
+    from partlab.models.person import fit_person, select_person
+
+    inits = [first_boxes(g) for g in got.truths]
+
+    def run(i, params):
+        return tracker_runner(clips[i][0], clips[i][1], inits[i], opts.seed + i, params=params,
+                              failure_detector=detector)
+
+    step("tracking with the start")
+    base_tracks = [run(i, body_p) for i in range(len(clips))]
+    fit = fit_person(clips, got.truths, base_tracks, body_p, table, progress=step)
+    if not opts.validate:
+        chosen = body_p
+        for changes in fit.components.values():
+            chosen = chosen.updated(changes)
+        return chosen, {**fit.record, "fitted": sorted(fit.components), "kept": {c: True for c in fit.components},
+                        "fields": sorted(f for changes in fit.components.values() for f in changes)}
+    chosen, record = select_person(run, got.truths, body_p, fit, base_tracks=base_tracks, progress=step)
+    return chosen, {**fit.record, "fitted": sorted(fit.components), **record}
 
 
 def check_span(clips: list[Clip], names: list[str], dt: float) -> None:
@@ -246,6 +318,12 @@ def _differs(a, b) -> bool:
         return False
 
 
+#: how :func:`learnt` names the person-box components (:mod:`partlab.models.person`)
+PERSON_COMPONENTS = {"extent": "person box extent", "detector": "detector threshold and window",
+                     "steer": "detection steering gain",
+                     "ending": "undetected-track ending", "noise": "part noise from person motion"}
+
+
 class NothingLearnt(ValueError):
     """Training ran but the bundle would be its start again: nothing to save or make a default."""
 
@@ -255,6 +333,8 @@ def learnt(summary: dict, new_detector: bool) -> tuple[list[str], str]:
     why (in a sentence). Validation decides where it ran; without it, every fitted component
     (a trained SVM, a noise or ``lam`` other than its default) counts."""
     got = []
+    got += [f"{PERSON_COMPONENTS.get(c, c)} (validated, from person boxes)"
+            for c, kept in summary.get("person", {}).get("kept", {}).items() if kept]
     selection = summary.get("selection")
     if selection is not None:
         got += [f"{c} (validated)" for c, kept in selection.get("kept", {}).items() if kept and c != "detector"]
@@ -275,6 +355,12 @@ def learnt(summary: dict, new_detector: bool) -> tuple[list[str], str]:
         why.append(f"too few samples for the failure SVMs (right/failed: {counts}; 5 of each are needed)")
     if not any(r.get("n") for r in summary.get("variances", [])):
         why.append("too few corrected frames per track to fit the variances")
+    person = summary.get("person")
+    if person is not None:
+        why.append("nothing fitted from the person boxes (" + (", ".join(person.get("fitted", [])) or "none fitted")
+                   + ") lowered the edits on the training clips" if person.get("fitted") else
+                   "the person boxes gave nothing to fit (too few frames where the tracker or the detector "
+                   "was on a corrected person)")
     if selection is not None and not why:
         why.append("nothing fitted tracked the training clips better than the model it started from")
     if not why:
@@ -291,11 +377,15 @@ def _clip_samples(got: _Samples, i: int, factory: FramesFactory, fps: float, tru
     info = {"name": name, "fps": float(fps), "people": int(truth_clean["track_id"].nunique()),
             "frames": int(truth_clean["frame"].nunique())}
     tracked = None
+    from partlab.models.person import person_only
+
+    parts = not person_only(truth_clean)  # person boxes alone label no part: no SVM sample
     if tracker_runner is not None:
         step(f"tracking {name}")
         tracked = tracker_runner(factory, fps, first_boxes(truth_clean), opts.seed + i)
         got.tracked_runs.append((tracked, truth_clean))
-        x, y = tracker_samples(tracked, truth_clean, fps, opts.dt)
+        x, y = tracker_samples(tracked, truth_clean, fps, opts.dt) if parts else (np.zeros((0, 24)),
+                                                                                  np.zeros((0, 3), np.int8))
         got.xs.append(x)
         got.ys.append(y)
         got.counts["tracker"] += len(x)
@@ -312,7 +402,7 @@ def _clip_samples(got: _Samples, i: int, factory: FramesFactory, fps: float, tru
     got.ys.append(y)
     got.counts["human_flags"] += len(x)
     n_pert = 0
-    for x, y in _perturbed(truth_clean, tracked, fps, opts, rng):
+    for x, y in _perturbed(truth_clean, tracked, fps, opts, rng) if parts else ():
         got.xs.append(x)
         got.ys.append(y)
         n_pert += len(x)

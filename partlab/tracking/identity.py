@@ -47,11 +47,50 @@ def remap_ids(ids, mapping: dict[int, int], offset: int) -> np.ndarray:
 
 def merge_tracks(body: pd.DataFrame, limbs: pd.DataFrame, mapping: dict[int, int], offset: int) -> pd.DataFrame:
     """Body and limb rows in one table: matched limb people take their body person's id, the
-    others ``track_id + offset``; a limb head is dropped where the body tracker has that person's
+    others ``track_id + offset`` (rows :func:`relabel_on_people` gave a body id keep it); a limb head
+    is dropped where the body tracker has that person's
     head in the same frame (one head box per person and frame)."""
     limbs = limbs.copy()
-    limbs["track_id"] = remap_ids(limbs["track_id"], mapping, offset)
+    moved = limbs.pop("relabelled").to_numpy(bool) if "relabelled" in limbs else np.zeros(len(limbs), bool)
+    ids = limbs["track_id"].to_numpy(np.int64).copy()
+    ids[~moved] = remap_ids(ids[~moved], mapping, offset)  # relabelled rows carry their body id already
+    limbs["track_id"] = ids
     body_heads = body.loc[body["part"] == "head", ["frame", "track_id"]]
     key = pd.MultiIndex.from_frame(body_heads)
     dup = (limbs["part"] == "head") & pd.MultiIndex.from_frame(limbs[["frame", "track_id"]]).isin(key)
     return pd.concat([body, limbs[~dup]], ignore_index=True)
+
+
+def relabel_on_people(body: pd.DataFrame, limbs: pd.DataFrame, mapping: dict[int, int],
+                      head_top: float) -> tuple[pd.DataFrame, dict[int, int]]:
+    """Rows of limb people no body person was matched to (:func:`match_limb_people`), relabelled
+    frame by frame to the body person they are on: a head whose centre lies in the top ``head_top``
+    of one body ``person`` box of its frame, a hand inside one (the nearest box centre when several
+    hold it); rows on nobody are dropped. Where this gives a body person two rows of one part in a
+    frame, its own matched limb row (else the higher score) stays. Returns the limb rows (matched
+    ones keep their limb ids, relabelled ones carry the body id in ``track_id`` and ``relabelled``
+    True) and, per unmatched limb id, the body id it was given most often (for its events)."""
+    limbs = limbs.assign(relabelled=False)
+    free = ~limbs["track_id"].isin(list(mapping))
+    people = body[body["part"] == "person"][["frame", "track_id", "x", "y", "w", "h"]]
+    if not free.any() or people.empty:
+        return limbs[~free], {}
+    rows = limbs[free].reset_index(drop=True)
+    m = rows[["frame", "part", "x", "y", "w", "h"]].reset_index().merge(people, on="frame", suffixes=("", "_p"))
+    cx, cy = m["x"] + m["w"] / 2, m["y"] + m["h"] / 2
+    top = np.where(m["part"] == "head", head_top, 1.0)
+    m = m[(cx >= m["x_p"]) & (cx <= m["x_p"] + m["w_p"]) & (cy >= m["y_p"]) & (cy <= m["y_p"] + top * m["h_p"])].copy()
+    m["d"] = np.hypot(m["x"] + m["w"] / 2 - m["x_p"] - m["w_p"] / 2, m["y"] + m["h"] / 2 - m["y_p"] - m["h_p"] / 2)
+    best = m.sort_values("d", kind="stable").groupby("index").head(1).set_index("index")["track_id"]
+    moved = rows.loc[best.index].assign(track_id=best.to_numpy().astype(np.int64), relabelled=True,
+                                        _limb=rows.loc[best.index, "track_id"].to_numpy())
+    given = moved.groupby("_limb")["track_id"].agg(lambda ids: int(ids.mode().iloc[0])).to_dict()
+    own = limbs[~free].copy()
+    own["_own"] = own["track_id"].map(mapping)
+    both = pd.concat([own.assign(_key=own["_own"], _rank=0), moved.assign(_key=moved["track_id"], _rank=1)],
+                     ignore_index=True)
+    score = both["score"] if "score" in both else pd.Series(0.0, index=both.index)
+    both = both.assign(_s=-score.fillna(0.0)).sort_values(["_rank", "_s"], kind="stable")
+    both = both.drop_duplicates(["frame", "_key", "part"]).sort_index()
+    out = both.drop(columns=["_own", "_key", "_rank", "_s", "_limb"], errors="ignore")
+    return out, {int(k): v for k, v in given.items()}

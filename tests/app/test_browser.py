@@ -646,3 +646,98 @@ def _move_a_keyframe(page, store, clip):
     _editor(page, f"(e.sentFrame = -1, e.show({back}, true))")
     page.wait_for_function(f"() => window.partlabEditor.sentFrame === {back}")
     page.locator('[data-testid="stStatusWidget"]').wait_for(state="detached", timeout=60_000)
+
+
+# ----------------------------------------------------------------------------- a take of several views
+@pytest.fixture
+def take3(store, tmp_path):
+    """A 3-camera synthetic take (standing, 320x240, 6 frames) in the store, its exact head and
+    hand boxes of every view stored as the 3D tracker's run of each view (camera, X, Y, Z)."""
+    from partlab.labelling.multiview import store_take_tracks
+    from partlab.labelling.synth.multiview import render_take
+    from partlab.tracking.tracks import read_tracks_csv
+
+    out = render_take("standing", tmp_path / "take", 3, seed=1, n_frames=6, width=320, height=240, chessboard=False)
+    truth = read_tracks_csv(out / "truth.csv")
+    truth = truth[truth.part.isin(["head", "left_hand", "right_hand"])].drop(columns=["source"])
+    project = store.create_project("take")  # before the app's first run: the session opens it
+    take = store.import_take(project.id, out)
+    store_take_tracks(store, take.id, truth)
+    return take, truth
+
+
+def test_a_hand_corrected_in_one_view_of_a_3_camera_take_moves_the_other_views(server, page, store, take3):
+    """The Done-when of the multi-camera issue: in the Correct page of a 3-camera take, drag a hand
+    in view cam0; its 3D point moves along cam0's new line of sight (where cam1's and cam2's boxes
+    agree best) and cam1's and cam2's hand boxes move to that point's reprojection."""
+    import numpy as np
+
+    from partlab.tracking.camera import Camera
+
+    url, _ = server
+    take, truth = take3
+    clips = {st.name: st.clip_id for st in take.streams}
+    cams = {st.name: Camera.from_dict(st.calibration, st.name) for st in take.streams}
+    f0 = truth[(truth.frame == 0) & (truth.occluded < 0.5)]
+    # the hand to correct: one every view sees at frame 0, the largest in cam0
+    seen = f0[f0.part != "head"].groupby("part").camera.nunique()
+    hand = f0[(f0.camera == "cam0") & f0.part.isin(seen[seen == 3].index)].sort_values("w").iloc[-1].part
+
+    def box(name):
+        df = store.frame_boxes(clips[name], 0)
+        return df[(df.part == hand) & (df.track_id == 1)].iloc[0]
+
+    def centre(row):
+        return np.array([row.x + row.w / 2, row.y + row.h / 2])
+
+    before = {n: box(n) for n in cams}
+    page.goto(url + "/correct")
+    page.get_by_text("cam1 at frame 0").wait_for(timeout=90_000)  # the other views beside the editor
+    page.get_by_text("cam2 at frame 0").wait_for()
+    page.wait_for_function("() => window.partlabEditor && window.partlabEditor.ready(0)", timeout=90_000)
+    _settled(page)
+    target = page.locator(f'rect.pl-box[data-part="{hand}"][data-track="1"]')
+    scale = 320 / page.locator(".pl-overlay").bounding_box()["width"]  # image px per screen px
+    _drag(page, target, 16 / scale, -10 / scale)  # 16 px right and 10 px up in the image
+
+    def followed():
+        now = {n: box(n) for n in cams}
+        return [now] if now["cam0"].source == "human" and all(
+            abs(now[n].x - before[n].x) > 1e-6 for n in ("cam1", "cam2")) else None
+
+    [now] = _wait_for(followed, timeout=60, what="the other views' boxes in the store")
+    assert now["cam0"].x - before["cam0"].x == pytest.approx(16, abs=1.5)
+    assert now["cam0"].y - before["cam0"].y == pytest.approx(-10, abs=1.5)
+    X = np.array([now["cam0"].X, now["cam0"].Y, now["cam0"].Z])
+    np.testing.assert_allclose(cams["cam0"].project(X[None])[0], centre(now["cam0"]), atol=0.01)  # on cam0's line
+    for n in ("cam1", "cam2"):
+        assert now[n].source == "tracker" and now[n].camera == n  # followed the correction, not a keyframe
+        np.testing.assert_allclose([now[n].X, now[n].Y, now[n].Z], X)
+        np.testing.assert_allclose(centre(now[n]), cams[n].project(X[None])[0], atol=0.5)  # the reprojection
+        assert np.linalg.norm(centre(now[n]) - centre(before[n])) > 2.0, n  # and it moved
+        assert (now[n].w, now[n].h) == (before[n].w, before[n].h)
+    # the other views beside the editor are drawn again; cam1 in the editor shows its moved box
+    page.get_by_text("cam2 at frame 0").wait_for()
+
+    def shown_x():  # the image x of the hand's box in the editor on screen (None while it redraws)
+        try:
+            overlay = page.locator(".pl-overlay").bounding_box(timeout=2000)
+            bb = target.bounding_box(timeout=2000)
+        except playwright.Error:  # none, or two editors while the page swaps them
+            return None
+        return (bb["x"] - overlay["x"]) * 320 / overlay["width"] if bb and overlay else None
+
+    def editor_at(x):
+        return lambda: (lambda v: v is not None and abs(v - x) < 1.0)(shown_x())
+
+    _settled(page)
+    page.get_by_test_id("stRadio").get_by_text("cam1", exact=True).click()
+    _wait_for(editor_at(now["cam1"].x), timeout=60, what="cam1's moved hand in the editor")
+    page.get_by_text("cam0 at frame 0").wait_for()
+    # one undo in cam0 takes back the move in every view
+    _settled(page)
+    page.get_by_test_id("stRadio").get_by_text("cam0", exact=True).click()
+    _wait_for(editor_at(now["cam0"].x), timeout=60, what="cam0's corrected hand in the editor")
+    _settled(page)
+    page.locator('button[data-act="undo"]').click()
+    _wait_for(lambda: all(box(n).x == before[n].x for n in cams), what="the undo in every view")

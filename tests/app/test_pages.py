@@ -219,3 +219,35 @@ def test_pages_without_a_project_say_what_to_do_first():
         at = page(name)
         assert not at.exception, name
         assert any("No project yet" in i for i in texts(at, "info")), name
+
+
+def test_projects_page_adds_a_take_folder_with_its_tracks_in_every_view(store, tmp_path):
+    import numpy as np
+
+    from partlab.labelling.calibration import write_calibration
+    from partlab.labelling.synth.multiview import look_at
+    from partlab.labelling.video import write_video
+
+    take = tmp_path / "take"
+    take.mkdir()
+    cams = [look_at("cam0", (3000, 0, 1500), (0, 0, 1200), 300.0, (160, 120)),
+            look_at("cam1", (0, 3000, 1800), (0, 0, 1200), 260.0, (160, 120))]
+    for k, c in enumerate(cams):
+        write_video(take / f"{c.name}.mp4", [np.full((120, 160, 3), 50 + 40 * k, np.uint8)] * 3, fps=10)
+    write_calibration(cams, take / "calibration.json")
+    pd.DataFrame([dict(frame=f, track_id=1, part="head", x=70 + k, y=40, w=12, h=12, camera=c.name, X=0.0, Y=0.0,
+                       Z=1600.0) for f in range(3) for k, c in enumerate(cams)]).to_csv(tmp_path / "t.csv", index=False)
+    pd.DataFrame([dict(frame=0, track_id=1, part="head", x=1, y=1, w=5, h=5)]).to_csv(tmp_path / "bad.csv", index=False)
+    project = store.create_project("p")
+    at = page("projects")
+    at.text_input(key=f"take_path:{project.id}").input(str(take))
+    at.text_input(key=f"take_tracks:{project.id}").input(str(tmp_path / "bad.csv"))
+    at.button(key=f"take_add:{project.id}").click().run()
+    assert any("no camera column" in e for e in texts(at, "error")) and store.takes(project.id) == []
+    at.text_input(key=f"take_tracks:{project.id}").input(str(tmp_path / "t.csv"))
+    at.button(key=f"take_add:{project.id}").click().run()
+    assert any("Added take 'take': views cam0, cam1" in m for m in texts(at, "success")), texts(at, "error")
+    [rec] = store.takes(project.id)
+    for k, st_ in enumerate(rec.streams):
+        df = store.tracks(st_.clip_id)
+        assert len(df) == 3 and set(df.camera) == {st_.name} and df.x.tolist() == [70.0 + k] * 3

@@ -323,4 +323,48 @@ def test_random_appearances_cover_any_number_and_vary_proportions():
     assert len(apps) == 12
     girth = [a.girth for a in apps]
     assert max(girth) - min(girth) > 0.2 and all(0.8 <= g <= 1.3 for g in girth)
+    legs = [a.legs for a in apps]
+    assert max(legs) - min(legs) > 0.06 and all(0.92 <= v <= 1.08 for v in legs)
     assert len({a.shirt for a in apps}) == 12
+
+
+def test_random_camera_tilts_verticals_converge_and_rolls():
+    from partlab.labelling.synth.camera import Camera
+
+    rolls = []
+    for seed in range(8):
+        cam = Camera.random(np.random.default_rng(seed), 640, 480)
+        canvas, warp = cam.drawing()
+        assert warp is not None and canvas.width > 640 and canvas.height > 480
+        rolls.append(cam.roll)
+        # a person-high vertical at the left and at the right of the frame, 8 m away
+        z, s = 8.0, float(canvas.scale(8.0))
+        lean = []
+        for xr in (-0.8, 0.8):
+            x = float(cam.x_from_fraction(xr, z))
+            fx, fy = canvas.floor_point(x, z)
+            pts = np.array([[fx, fy, 1.0], [fx, fy - 1.8 * s, 1.0]]).T
+            q = warp @ pts
+            qx, qy = q[0] / q[2], q[1] / q[2]
+            lean.append((qx[1] - qx[0]) / (qy[0] - qy[1]))  # image x per row going up
+        if cam.horizon < 0.5 * cam.height:  # looking down: the tops lean apart (verticals meet below)
+            assert lean[1] - lean[0] > 0.05
+    assert max(rolls) - min(rolls) > np.radians(2) and max(np.abs(rolls)) <= np.radians(4) + 1e-9
+
+
+def test_tilted_random_scene_truth_boxes_follow_the_warped_pixels():
+    from partlab.labelling.synth.scene import make_scene
+
+    scene = make_scene("random", seed=3, n_frames=2, width=480, height=360, owners=True)
+    person = scene.truth[(scene.truth["frame"] == 1) & (scene.truth["part"] == "person")
+                         & (scene.truth["occluded"] == 0)]
+    checked = 0
+    for r in person.itertuples():
+        ys, xs = np.nonzero(scene.owners[1] == r.track_id)
+        if len(xs) < 200:
+            continue
+        got = np.array([xs.min(), ys.min(), xs.max() + 1, ys.max() + 1])
+        want = np.array([r.x, r.y, r.x + r.w, r.y + r.h])
+        assert np.abs(got - want).max() <= 2, (r.track_id, got, want)
+        checked += 1
+    assert checked >= 1

@@ -134,11 +134,16 @@ def _inner_rect_runner(truths):
     """A deterministic 'tracker' for :func:`partlab.models.training.train_bundle`: its inner rectangle is the
     true box moved right by 0.3 of its width, reported through ``params.output.extent``; with the
     built-in extent the boxes are too large and off-centre (under half of them on the part)."""
-    truth_of = {id(f): g for f, g in truths}
+    from partlab.models.training import first_boxes
+
+    def key(init):  # which clip: by the boxes it starts from (training hands the runner its own frames)
+        return tuple(init.sort_values(["track_id", "part"])["x"].round(3))
+
+    truth_of = {key(first_boxes(g)): g for _f, g in truths}
 
     def run(frames, fps, init, seed, params=None, failure_detector=None):
         params = params or BodyParams()
-        t = truth_of[id(frames)].copy()
+        t = truth_of[key(init)].copy()
         for part, (sw, sh, dx, dy) in params.output.extent.items():
             m = t.part == part
             w, h = t.loc[m, "w"], t.loc[m, "h"]

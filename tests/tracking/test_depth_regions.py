@@ -8,7 +8,7 @@ from partlab.tracking.camera import Camera
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthCue, Posture
 from partlab.tracking.depth.posture import elbow, elbow_circle
-from partlab.tracking.depth.regions import depth_foreground, face_depth, hand_regions
+from partlab.tracking.depth.regions import depth_foreground, face_depth, hand_regions, support_surfaces
 from partlab.tracking.depth.sampling import icondensation_correction, importance_density, prior_density
 
 
@@ -54,6 +54,55 @@ def test_components_of_improper_size_are_not_hands():
     face_box = (70, 8, 20, 22)
     fd = face_depth(d, face_box, fx=160.0)
     assert hand_regions(d, fd, face_box, 160.0, DepthCue()) == []
+
+
+def _desk_scene(h=120, w=160, f=160.0):
+    """The room, a desk top (a horizontal plane 250 mm below the camera, from 900 mm to the person
+    at 1500 mm) and a hand resting on it at its far edge, joined to it in the depth map."""
+    d = _room(h, w)
+    yy, xx = np.mgrid[:h, :w].astype(float)
+    cy = h / 2
+    with np.errstate(divide="ignore"):
+        z_desk = 250.0 * f / (yy - cy)  # a ray through row v meets y = 250 mm at z = 250 f / (v - cy)
+    desk = (yy > cy) & (z_desk >= 900) & (z_desk <= 1500)
+    d[desk] = z_desk[desk]
+    # a hand (radius 45 mm, 6 px) resting on it 1230 mm away: its centre 205 mm below the camera
+    _blob(d, 40, 87, 6, 1230.0)
+    return d, desk
+
+
+def test_a_desk_top_is_a_support_surface_and_a_hand_on_it_stays_a_hand():
+    d, desk = _desk_scene()
+    K = np.array([[160.0, 0, 80], [0, 160.0, 60], [0, 0, 1]])
+    face_box = (70, 8, 20, 22)
+    fd = face_depth(d, face_box, fx=160.0)
+    p = DepthCue()
+    near = d < fd.mean - p.hand_gap * fd.width_mm
+    # without the surface the hand's component is joined to the desk and rejected with it (too large)
+    assert hand_regions(d, fd, face_box, 160.0, p) == []
+    surf = support_surfaces(d, near, K, fd, 20 * 22, p, np.random.default_rng(0))
+    assert surf is not None
+    assert surf[desk & near].mean() > 0.95  # the desk top's pixels in front of the face
+    yy, xx = np.mgrid[: d.shape[0], : d.shape[1]]
+    upper = ((xx - 40) ** 2 + (yy - 87) ** 2 <= 36) & (yy <= 87)
+    assert not surf[upper].any()  # the hand is not flat: only its rim next to the desk is within reach of it
+    regions = hand_regions(d, fd, face_box, 160.0, p, surfaces=surf)
+    assert len(regions) == 1 and abs(regions[0].xc - 40) < 4
+    # nothing large and flat in front of the face: no surface (the room of the test above)
+    d2 = _room()
+    _blob(d2, 40, 70, 9, 1150.0)
+    fd2 = face_depth(d2, face_box, fx=160.0)
+    assert support_surfaces(d2, d2 < fd2.mean - 40, K, fd2, 20 * 22, p, np.random.default_rng(0)) is None
+
+
+def test_a_long_streak_in_front_of_the_face_is_not_a_hand():
+    d = _room()
+    d[100:104, 20:140] = 1200.0  # 120 x 4 px: the size of a hand's component, six face widths long
+    _blob(d, 40, 60, 7, 1150.0)
+    face_box = (70, 8, 20, 22)
+    fd = face_depth(d, face_box, fx=160.0)
+    regions = hand_regions(d, fd, face_box, 160.0, DepthCue())
+    assert [(round(r.xc), round(r.yc)) for r in regions] == [(40, 60)]
 
 
 def test_importance_weight_is_f_over_g():
@@ -156,7 +205,7 @@ def test_arm_lengths_are_fitted_to_the_depth_of_a_shorter_arm():
 
 
 
-def test_hands_bins_other_behind_the_hand_plane_and_where_depth_is_missing():
+def test_hands_bins_other_behind_the_hand_plane_or_on_a_surface_and_colour_decides_where_depth_is_missing():
     from partlab.tracking.depth.params import DepthParams
     from partlab.tracking.depth.regions import FaceDepth
     from partlab.tracking.depth.tracker import DepthTracker
@@ -165,6 +214,8 @@ def test_hands_bins_other_behind_the_hand_plane_and_where_depth_is_missing():
     nb = DepthParams().appearance.hue_bins
     bins = np.array([[3, 3, 3, -1]], np.int16)
     depth = np.array([[900.0, 1500.0, np.nan, 900.0]], np.float32)  # near, at the face, unmeasured, near
-    got = tracker._hand_bins(bins, depth, FaceDepth(1500.0, 5.0, 160.0))
-    assert got.tolist() == [[3, nb, nb, nb]]
-    assert tracker._hand_bins(bins, depth, None).tolist() == [[3, 3, 3, nb]]  # colour alone: only hue counts
+    got = tracker._hand_bins(bins, depth, FaceDepth(1500.0, 5.0, 160.0), None)
+    assert got.tolist() == [[3, nb, 3, nb]]  # unmeasured depth is no evidence: its hue counts
+    surface = np.array([[True, False, False, False]])
+    assert tracker._hand_bins(bins, depth, FaceDepth(1500.0, 5.0, 160.0), surface).tolist() == [[nb, nb, 3, nb]]
+    assert tracker._hand_bins(bins, depth, None, None).tolist() == [[3, 3, 3, nb]]  # colour alone: only hue counts

@@ -123,3 +123,33 @@ def test_tracker_follows_head_and_hands_of_a_standing_person():
         cx, cy = d.loc[cam, "x"] + d.loc[cam, "w"] / 2, d.loc[cam, "y"] + d.loc[cam, "h"] / 2
         r = t.loc[cam]
         assert r.x <= cx <= r.x + r.w and r.y <= cy <= r.y + r.h
+
+
+def test_single_view_candidates_lie_on_the_blob_line_nearest_the_prediction_and_respect_others():
+    a, b = _two_cameras()
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(0), {"cam0": a, "cam1": b})
+    pred = np.array([100.0, 50.0, 1200.0])
+    seen = pred + [0.0, 40.0, -30.0]  # where the hand really is: 50 mm off the prediction
+    blob = a.project(seen[None])[0]
+    far = a.project((pred + [0.0, 400.0, 0.0])[None])[0]  # 400 mm off: beyond the 100 mm gate
+    [point] = tr._single_view(pred, [np.array([blob, far]), np.zeros((0, 2))], np.zeros((0, 3)))
+    v = a.rays(blob[None])[0]
+    np.testing.assert_allclose(np.cross(point - a.centre, v), 0, atol=1e-6)  # on the blob's line of sight
+    assert abs((point - pred) @ v) < 1e-6  # the line's point nearest the prediction
+    assert np.linalg.norm(point - seen) < 60  # the depth stays the prediction's: ~ the offset across the line
+    # a blob nearer another target's projection is that target's; nothing beyond the gate is taken
+    assert len(tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], seen[None] + [0.0, 5.0, 0.0])) == 0
+    assert len(tr._single_view(pred, [np.array([far]), np.zeros((0, 2))], np.zeros((0, 3)))) == 0
+
+
+def test_a_hand_uses_only_candidates_within_reach_of_its_own_head():
+    a, b = _two_cameras()
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(0), {"cam0": a, "cam1": b})
+    from partlab.tracking.limbs3d.tracker import _Target
+
+    head = np.array([0.0, 0.0, 1600.0])
+    points = np.array([[300.0, 0.0, 900.0], [1200.0, 0.0, 1000.0]])  # 760 mm and 1340 mm from the head
+    hand, face = _Target(1, "left_hand"), _Target(1, "head")
+    assert tr._usable(hand, points, None, None, head).tolist() == [True, False]
+    assert tr._usable(face, points, None, None, head).tolist() == [True, True]  # a head has no reach limit
+    assert tr._usable(hand, points, None, None, None).tolist() == [True, True]  # no head estimate: no limit

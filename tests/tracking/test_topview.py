@@ -10,7 +10,14 @@ from partlab.tracking.frame import FrameSet
 from partlab.tracking.protocol import TrackContext
 from partlab.tracking.run import build_tracker
 from partlab.tracking.topview.filter import PersonFilter
-from partlab.tracking.topview.likelihood import bhattacharyya, free_space, nearest, weigh
+from partlab.tracking.topview.likelihood import (
+    bhattacharyya,
+    free_space,
+    nearest,
+    nearest_primitive,
+    self_intersection,
+    weigh,
+)
 from partlab.tracking.topview.model import (
     JOINTS,
     KINDS,
@@ -23,7 +30,7 @@ from partlab.tracking.topview.model import (
     neutral_state,
     primitives,
 )
-from partlab.tracking.topview.params import ResamplingParams, TopViewParams
+from partlab.tracking.topview.params import DynamicsParams, ExclusionParams, ResamplingParams, TopViewParams
 from partlab.tracking.topview.tracker import Geometry, TopViewTracker
 
 
@@ -119,6 +126,41 @@ def test_free_space_charges_an_arm_over_the_floor_only(s1):
     assert pen[1, left] > 40.0 and pen[1, WEIGHT_PARTS.index("head")] == pytest.approx(pen[0, 0])
 
 
+def test_self_intersection_charges_a_forearm_folded_into_the_torso_only():
+    b = Body()
+    hanging = neutral_state(0.0, 0.0, b)
+    folded = hanging.copy()
+    folded[9], folded[10] = 1.2, 1.0  # right upper arm twisted in, elbow bent: the forearm crosses the belly
+    pen = self_intersection(primitives(np.stack([hanging, folded]), b), 100.0)
+    right, left = WEIGHT_PARTS.index("right_arm"), WEIGHT_PARTS.index("left_arm")
+    assert pen[0].max() == 0.0
+    assert pen[1, right] > 20.0 and pen[1, left] == 0.0 and pen[1, :3].max() == 0.0
+    assert self_intersection(primitives(folded[None], b), 10.0)[0, right] <= 10.0  # capped
+
+
+def test_a_hidden_forearm_random_walks_slower_and_speeds_up_when_seen_again(s1):
+    p = TopViewParams(dynamics=DynamicsParams(hidden_scale=0.25, hidden_points=8.0))
+    person = s1.people[0]
+    f = PersonFilter(p, np.random.default_rng(0), person.body, person.states[0])
+    full = f.step_scales()
+    f.seen[:] = (0.0, 4.0)  # right forearm not seen, the left half seen
+    slow = f.step_scales()
+    assert slow[[9, 10, 11]] == pytest.approx(0.25 * full[[9, 10, 11]])
+    assert slow[[14, 15, 16]] == pytest.approx(0.625 * full[[14, 15, 16]])
+    assert slow[[7, 8, 12, 13]] == pytest.approx(full[[7, 8, 12, 13]])  # the upper arms: seen from above
+    # the true pose's points: at least those on each forearm and hand are counted
+    pts = Geometry(s1.camera).points(s1.depth[0], np.flatnonzero((s1.person[0] == 1).ravel()
+                                                                  & np.isfinite(s1.depth[0]).ravel()))
+    f.estimate = person.states[0].copy()
+    f.observe_forearms(pts)
+    _, prim = nearest_primitive(pts, primitives(person.states[0][None], person.body)[0])
+    on = [np.isin(prim, (4, 5)).sum(), np.isin(prim, (7, 8)).sum()]
+    assert min(on) > 0 and np.all(f.seen >= 0.9 * np.array(on)) and f.seen.sum() < 0.5 * len(pts)
+    f.estimate[0] += 2000.0  # the model 2 m away: every point unexplained, each on one side
+    f.observe_forearms(pts)
+    assert f.seen.sum() == len(pts)
+
+
 def test_part_based_resampling_recombines_parts_and_measures_survival():
     p = TopViewParams(resampling=ResamplingParams(n_particles=8))
     f = PersonFilter(p, np.random.default_rng(0), Body(), neutral_state(0, 0, Body()))
@@ -180,6 +222,15 @@ def test_exclusion_assigns_pixels_to_the_right_person_and_auto_start_finds_both(
         roi = tr.assignment > 0
         rates.append(np.mean(tr.assignment[roi] == s3.person[f][roi]))
     assert np.mean(rates) > 0.98
+    # the second pass (nearest fitted model) against eq. 5 alone on the same frames and seeds
+    alone = TopViewParams(resampling=ResamplingParams(n_particles=60), exclusion=ExclusionParams(second_pass=False))
+    tr1 = TopViewTracker(alone, np.random.default_rng(1), init=s3.init, cameras={"cam0": s3.camera})
+    first = []
+    for f in range(len(s3.depth)):
+        tr1.step(FrameSet.single(f, s3.color[f], s3.depth[f], camera=s3.camera))
+        roi = tr1.assignment > 0
+        first.append(np.mean(tr1.assignment[roi] == s3.person[f][roi]))
+    assert np.mean(rates) >= np.mean(first) - 0.002
     auto = TopViewTracker(few, np.random.default_rng(1), cameras={"cam0": s3.camera})
     auto.step(FrameSet.single(0, s3.color[0], s3.depth[0], camera=s3.camera))
     assert len(auto.targets) == 2

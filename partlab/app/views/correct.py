@@ -2,6 +2,11 @@
 track mode; the track list with delete / merge / split / change id; a review pass; re-track
 between keyframes.
 
+A clip that is one view of a calibrated take (several cameras) shows a view selector and the take's
+other views at the same frame beside the editor; moving a head or hand box in one view moves that
+target's 3D point and its boxes in the other views (:mod:`partlab.labelling.multiview`), in the same
+step of undo.
+
 Edits are written to the store as they are made (a refused stale edit says so), each
 action one step of undo; the frames are the decoder's frames by index, the same the
 tracker used. The page only glues: the operations are in :mod:`partlab.labelling.trackops`
@@ -19,7 +24,7 @@ from partlab.app.box_editor import box_editor, encode_image, pack_boxes, pending
 from partlab.app.editing import Step, apply_events, record, refine_step
 from partlab.app.runs import start_tracking
 from partlab.app.views.common import job_panel, pick_clip, plain, require_project
-from partlab.labelling import trackops
+from partlab.labelling import multiview, trackops
 from partlab.labelling.events import KINDS
 from partlab.labelling.formats.events import KIND_COLOURS
 from partlab.labelling.store import Store, StoreError
@@ -40,6 +45,7 @@ occluder_mode = top[2].toggle("Edit occluder regions", key=f"occluders:{clip.id}
 editor_key = state.editor_key(clip.id, "occluders" if occluder_mode else "boxes")
 jkey = f"jump:{clip.id}"
 st.session_state.setdefault(jkey, dict(seq=0, frame=st.session_state[fkey]))
+views = multiview.take_views(s, clip.id)
 
 
 def jump(frame: int) -> None:
@@ -106,6 +112,42 @@ def clip_boxes(url: str, clip_id: int, version) -> dict:
                 parts=[p for p in BOX_PARTS if p in set(df.part)] or list(BOX_PARTS), ids=[t["id"] for t in tracks])
 
 
+def switch_view(key: str, clip_ids: dict[str, int], frame: int) -> None:
+    """Open the chosen view's clip at ``frame`` (run by the view choice before the page reruns)."""
+    other = clip_ids[st.session_state[key]]
+    state.set_frame(other, frame)
+    old = st.session_state.get(f"jump:{other}", dict(seq=0))
+    st.session_state[f"jump:{other}"] = dict(seq=int(old["seq"]) + 1, frame=frame)
+    st.session_state[state.CLIP] = other
+
+
+def pick_view() -> None:
+    """The take's views as a choice; another view opens its clip at the frame shown."""
+    key = f"view_pick:{views[0].clip_id}"  # one widget per take (a rerun does not draw a second one)
+    st.session_state[key] = next(v.name for v in views if v.clip_id == clip.id)
+    st.radio("View", [v.name for v in views], horizontal=True, key=key, on_change=switch_view,
+             args=(key, {v.name: v.clip_id for v in views}, st.session_state[fkey]),
+             help="the streams of this take; a head or hand box moved in one view moves the same target in the "
+                  "others (its 3D point is re-triangulated)")
+
+
+def other_views(frame: int) -> None:
+    """The take's other views at ``frame`` with their boxes, side by side."""
+    others = [v for v in views if v.clip_id != clip.id]
+    for col, v in zip(st.columns(len(others)), others):
+        other = s.clip(v.clip_id)
+        try:
+            cache = frame_cache(str(other.path))
+            with cache.lock:
+                image = cache.clip.read(min(frame, other.frame_count - 1))
+        except (VideoError, IndexError, ValueError) as exc:
+            col.caption(plain(f"{v.name}: cannot show frame {frame}: {exc}"))
+            continue
+        boxes = s.frame_boxes(v.clip_id, frame)
+        drawn = multiview.draw_view(image, boxes, {int(t): track_colour(int(t)) for t in set(boxes.track_id)})
+        col.image(drawn[:, :, ::-1], caption=f"{v.name} at frame {frame}", width="stretch")
+
+
 def timeline_events() -> list[dict]:
     """The clip's events as the editor's timeline draws them (newest revision of each, not deleted)."""
     return [dict(id=int(r.event_id), revision=int(r.revision), start=int(r.start_frame), end=int(r.end_frame),
@@ -116,7 +158,8 @@ def timeline_events() -> list[dict]:
 def apply(events: list[dict]) -> None:
     """Write the editor's events; the messages show above the editor on this run."""
     fill = any(e.get("fill") for e in events if e.get("kind") == "edit")
-    result = apply_events(s, clip.id, events, history, author=state.author(), fill=fill)
+    result = apply_events(s, clip.id, events, history, author=state.author(), fill=fill,
+                          follow=multiview.follow if views else None)
     refine(result.refills)
     st.session_state.setdefault("correct_messages", []).extend(result.errors + result.notes)
     if result.frame is not None and any(e.get("kind") in ("undo", "redo") for e in events):
@@ -189,11 +232,15 @@ def editor_panel() -> None:
     if late:  # events the early read did not see (not expected; kept so none is ever dropped)
         apply(late)
         st.rerun()
+    if views:
+        other_views(frame)
     if any(e.get("kind") not in ("frame",) for e in events):
         st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
 
 warm_tracker()
+if views:
+    pick_view()
 editor_panel()
 job_panel("refine", limit=1, clip_id=clip.id)
 frame = current_frame()

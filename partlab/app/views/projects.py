@@ -12,6 +12,7 @@ from partlab.app.upload_notice import show_refusals
 from partlab.app.uploads import UPLOAD_EXTENSIONS, UploadRefused, max_upload_mb, save_upload
 from partlab.app.views.common import plain, require_project
 from partlab.labelling import access
+from partlab.labelling.multiview import import_take_folder
 from partlab.labelling.store import StoreError
 from partlab.labelling.video import VideoClip, VideoError
 
@@ -54,6 +55,23 @@ if access.may(s, project.id, "annotator"):  # a viewer gets no uploader (the sto
     uploaded = st.file_uploader(f"Upload clips ({', '.join(UPLOAD_EXTENSIONS)}; up to {limit} MB each)",
                                 type=list(UPLOAD_EXTENSIONS), accept_multiple_files=True, key=f"upload:{project.id}")
     show_refusals()  # a file over the limit, refused by the browser: its sentence shown, not just an icon
+if access.may(s, project.id, "annotator"):
+    with st.expander("Add a take folder (several calibrated cameras)"):
+        st.caption("A folder on this server with one video per camera and calibration.json (docs/formats.md, "
+                   "\"Takes\"), e.g. written by `partlab synth TAKE --scenario handshake --cameras 3`. Each camera "
+                   "becomes a clip; with a tracks CSV of the take (`partlab track TAKE --tracker limbs3d -o "
+                   "TAKE/tracks.csv`, one box per view in its camera column) its boxes are stored in every view. "
+                   "On the Correct page the views show side by side and a hand or head moved in one view moves "
+                   "in the others.")
+        take_path = st.text_input("Take folder", key=f"take_path:{project.id}")
+        tracks_path = st.text_input("Tracks CSV of the take (optional)", key=f"take_tracks:{project.id}")
+        if st.button("Add the take", key=f"take_add:{project.id}"):
+            try:
+                take = import_take_folder(s, project.id, take_path.strip(), tracks_path.strip() or None)
+                st.session_state[state.CLIP] = take.streams[0].clip_id
+                st.success(plain(f"Added take {take.name!r}: views {', '.join(st_.name for st_ in take.streams)}."))
+            except (StoreError, OSError, ValueError) as exc:
+                st.error(plain(f"Not added: {exc}"))
 seen = st.session_state.setdefault("uploads_done", {})
 for f in uploaded or []:
     if f.file_id in seen:

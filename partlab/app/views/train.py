@@ -54,6 +54,8 @@ def show_summary(summary: dict, key: str) -> None:
     samples = summary.get("samples") or {}
     if samples:
         st.caption("Training samples: " + ", ".join(f"{k} {v}" for k, v in samples.items()))
+    if summary.get("learnt"):
+        st.caption("Learnt: " + ", ".join(summary["learnt"]))
     svms = summary.get("svms") or {}
     if svms:
         table = pd.DataFrame([dict(svm=k, trained=v.get("trained"), kernel=v.get("kernel"), C=v.get("C"),
@@ -70,6 +72,11 @@ def show_summary(summary: dict, key: str) -> None:
             fig.update_layout(title=k, height=230, margin=dict(l=10, r=10, t=40, b=10))
             fig.update_yaxes(autorange="reversed")
             col.plotly_chart(fig, key=f"cm:{key}:{k}")
+    if summary.get("person"):
+        from partlab.models.person import person_rows
+
+        st.caption("From the person boxes (each kept only if it lowered the edits on the training clips):")
+        st.dataframe(pd.DataFrame(person_rows(summary["person"])), hide_index=True)
     variances = pd.DataFrame(summary.get("variances") or [])
     if len(variances):
         v = variances.dropna(subset=["fitted"])

@@ -67,6 +67,7 @@ class Appearance:
     long_hair: bool = False
     girth: float = 1.0  # body width against the built-in adult proportions (lateral scale)
     head_scale: float = 1.0  # head size against the built-in proportions
+    legs: float = 1.0  # leg length (waist height) against the built-in proportions
 
 
 def _jitter(rng: np.random.Generator, colour, amount: int = 8) -> tuple[int, int, int]:
@@ -122,7 +123,8 @@ def _random_colour(rng: np.random.Generator) -> tuple[int, int, int]:
 def random_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
     """``n`` people of any look (any number; colours may repeat, as in real crowds): clothes of any
     colour, skin anywhere between the palette's darkest and lightest tones, heights 1.50-1.95 m,
-    body width 0.8-1.3 and head size 0.85-1.15 of the built-in proportions."""
+    body width 0.8-1.3, head size 0.85-1.15 and leg length 0.92-1.08 of the built-in proportions
+    (waist at 0.49-0.57 of the height: adults' sitting-height ratios span about that)."""
     skins = np.asarray(SKINS, float)
     dark, light = skins[np.argmin(skins.sum(1))], skins[np.argmax(skins.sum(1))]
     out = []
@@ -136,5 +138,6 @@ def random_appearances(rng: np.random.Generator, n: int) -> list[Appearance]:
             height_m=float(rng.uniform(1.50, 1.95)),
             short_sleeves=bool(rng.random() < 0.4), long_hair=bool(rng.random() < 0.35),
             girth=float(rng.uniform(0.8, 1.3)), head_scale=float(rng.uniform(0.85, 1.15)),
+            legs=float(rng.uniform(0.92, 1.08)),
         ))
     return out

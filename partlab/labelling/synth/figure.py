@@ -232,11 +232,22 @@ def _arm_solids(pose: FigurePose, shoulders: np.ndarray, project, depth, scale: 
     return out
 
 
+def _leg_heights(u: np.ndarray, height_m: float, legs: float) -> np.ndarray:
+    """Heights ``u`` (metres) with the waist moved to ``legs`` x its built-in height, the feet and
+    the crown kept: the legs stretched by ``legs``, the body above shortened to match."""
+    if legs == 1.0:
+        return u
+    waist = WAIST_U * height_m
+    return np.where(u <= waist, u * legs, waist * legs + (u - waist) * (height_m - waist * legs) / (height_m - waist))
+
+
 def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_sleeves: bool = False,
                   long_hair: bool = False, anchors: dict | None = None, girth: float = 1.0,
-                  head_scale: float = 1.0) -> list[_Solid]:
+                  head_scale: float = 1.0, legs: float = 1.0) -> list[_Solid]:
     """The solids of the figure in image coordinates, sorted far to near; ``girth`` scales the body
-    across (lateral offsets), ``head_scale`` the head's radii.
+    across (lateral offsets), ``head_scale`` the head's radii, ``legs`` the waist's height (leg
+    length against the built-in proportions; the body above is shortened or stretched to keep the
+    person's height).
 
     ``anchors``, when given, receives the floor offsets and height ``(dx, dz, u)`` (metres, the
     view's floor frame) of the head's centre and of each hand's centre, keyed by part name: the
@@ -245,12 +256,17 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
     F = np.array([np.cos(pose.facing), np.sin(pose.facing)])  # forward on the floor (X, Z)
     L = np.array([-F[1], F[0]])  # the person's left
 
+    leg_scale = float(legs)  # (``legs`` below are the leg joints)
+
+    def up(u):
+        return _leg_heights(u, H, leg_scale)
+
     def to_world(p: np.ndarray):
         p = np.atleast_2d(p)
         lat = p[:, 0] * girth
         dx = lat * L[0] + p[:, 1] * F[0]
         dz = lat * L[1] + p[:, 1] * F[1]
-        return dx, dz, p[:, 2]
+        return dx, dz, up(p[:, 2])
 
     def project(p):
         dx, dz, u = to_world(p)
@@ -297,7 +313,7 @@ def figure_solids(pose: FigurePose, height_m: float, view: LocalView, short_slee
         c = head_c[0] + np.array([0.0, 0.0, offset_u * H])
         dx = c[0] * L[0] + c[1] * F[0] + offset_f * H * Fh[0]
         dz = c[0] * L[1] + c[1] * F[1] + offset_f * H * Fh[1]
-        centre = view.project(np.array([dx]), np.array([dz]), np.array([c[2]]))[0]
+        centre = view.project(np.array([dx]), np.array([dz]), up(np.array([c[2]])))[0]
         ax = view.s * H * np.hypot(rl * Lh[0], rf * Fh[0])
         ay = view.s * H * np.hypot(ru, view.k * 0.3 * np.hypot(rl * Lh[1], rf * Fh[1]))
         return centre, (ax, ay), dz
@@ -390,7 +406,7 @@ def _extent(solid: _Solid) -> np.ndarray:
 def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView, anchors: dict | None = None) -> Figure:
     """Draw one person: the label image and the part masks over its bounding region."""
     solids = figure_solids(pose, appearance.height_m, view, appearance.short_sleeves, appearance.long_hair,
-                           anchors, appearance.girth, appearance.head_scale)
+                           anchors, appearance.girth, appearance.head_scale, appearance.legs)
     ext = np.array([_extent(s) for s in solids])
     x1, y1 = np.floor(ext[:, :2].min(0)).astype(int) - 2
     x2, y2 = np.ceil(ext[:, 2:].max(0)).astype(int) + 2

@@ -12,6 +12,12 @@ and ``occluded`` is the fraction of them where another person or an occluder is
 visible instead. Hidden parts keep their rows; parts entirely outside the frame have
 none. ``person`` is the extent of the whole drawn figure (head, torso, hip-leg, arms
 and hands).
+
+A tilted camera (the randomized scenes, :meth:`Camera.drawing`) is drawn on a larger canvas
+seen through a vertical image plane, then every frame is warped into the tilted camera's frame
+by one homography; a truth box is then the extent of its pixels' corners carried by the same
+homography, clipped to the frame (a homography keeps a set's convex hull, so the corners of each
+row's first and last pixel give the exact extent).
 """
 
 from __future__ import annotations
@@ -21,6 +27,7 @@ from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
@@ -133,9 +140,40 @@ def random_size(seed: int) -> tuple[int, int]:
     """The frame size the randomized suite renders scene ``seed`` at (one of :data:`RANDOM_SIZES`)."""
     return RANDOM_SIZES[int(np.random.default_rng([seed, 99]).integers(len(RANDOM_SIZES)))]
 
-def _truth_rows(i: int, drawn: list, owner: np.ndarray) -> list[tuple]:
+def _warped_extent(mask: np.ndarray, x0: int, y0: int, warp: np.ndarray, width: int,
+                   height: int) -> tuple[int, int, int, int] | None:
+    """``(x, y, w, h)`` of the pixels of ``mask`` (placed at ``(x0, y0)`` on the canvas) carried
+    into the frame by the homography ``warp``, those inside it only; None when none land inside.
+    Wholly inside: the corners of each row's first and last pixel; cut by the frame's edge: the
+    centre of every pixel (the parts inside a slanted cut are not a box's corners)."""
+    def carried(xs, ys):
+        p = warp @ np.stack([xs + x0, ys + y0, np.ones_like(xs)])
+        return p[0] / p[2], p[1] / p[2]
+
+    rws = np.flatnonzero(mask.any(axis=1))
+    first = mask[rws].argmax(axis=1)
+    last = mask.shape[1] - 1 - mask[rws, ::-1].argmax(axis=1)
+    px, py = carried(np.concatenate([first, last + 1, first, last + 1]).astype(np.float64),
+                     np.concatenate([rws, rws, rws + 1, rws + 1]).astype(np.float64))
+    if px.min() < 0 or py.min() < 0 or px.max() > width or py.max() > height:
+        ys, xs = np.nonzero(mask)
+        px, py = carried(xs + 0.5, ys + 0.5)
+        inside = (px >= 0) & (py >= 0) & (px < width) & (py < height)
+        if not inside.any():
+            return None
+        px, py = px[inside], py[inside]
+    x1, y1 = max(int(np.floor(px.min())), 0), max(int(np.floor(py.min())), 0)
+    x2, y2 = min(int(np.ceil(px.max())), width), min(int(np.ceil(py.max())), height)
+    if x2 <= x1 or y2 <= y1:
+        return None
+    return x1, y1, x2 - x1, y2 - y1
+
+
+def _truth_rows(i: int, drawn: list, owner: np.ndarray, warp: np.ndarray | None = None,
+                size: tuple[int, int] = (0, 0)) -> list[tuple]:
     """Truth rows of frame ``i``: every drawn person's box and each part's box (its visible
-    pixels, or all of it when hidden), with the occluded fraction from the owner map."""
+    pixels, or all of it when hidden), with the occluded fraction from the owner map; ``warp``
+    (a tilted camera): boxes carried into the ``size (W, H)`` frame by that homography."""
     rows = []
     for a, fig, crop, (cx1, cy1, cx2, cy2) in drawn:
         own = owner[cy1:cy2, cx1:cx2]
@@ -150,12 +188,36 @@ def _truth_rows(i: int, drawn: list, owner: np.ndarray) -> list[tuple]:
             total = int(mask.sum())
             if total == 0:
                 continue
+            visible = int(np.count_nonzero(own[mask] == a + 1))
+            if warp is not None:
+                box = _warped_extent(mask, cx1, cy1, warp, *size)
+                if box is None:
+                    continue
+                rows.append((i, a + 1, part, *box, round(1.0 - visible / total, 4)))
+                continue
             cols = np.flatnonzero(mask.any(axis=0))
             rws = np.flatnonzero(mask.any(axis=1))
-            visible = int(np.count_nonzero(own[mask] == a + 1))
             rows.append((i, a + 1, part, cx1 + cols[0], cy1 + rws[0], cols[-1] - cols[0] + 1,
                          rws[-1] - rws[0] + 1, round(1.0 - visible / total, 4)))
     return rows
+
+
+def _canvas(name: str, camera: Camera, script: Script) -> tuple[Camera, np.ndarray | None]:
+    """Where the scene is drawn and the homography into the frame (:meth:`Camera.drawing`): a
+    tilted camera's scene (the randomized ones) is drawn on a larger canvas, then warped."""
+    canvas, warp = camera.drawing()
+    if warp is not None and (script.props or script.occluders or script.objects):
+        raise ValueError(f"scenario {name!r}: props, occluders and objects are placed in the frame, "
+                         "not on a tilted camera's canvas")
+    return canvas, warp
+
+
+def _warped(image: np.ndarray, warp: np.ndarray | None, width: int, height: int,
+            interpolation: int = cv2.INTER_LINEAR) -> np.ndarray:
+    """``image`` drawn on the canvas as the ``width x height`` frame sees it (as it is: no warp)."""
+    if warp is None:
+        return image
+    return cv2.warpPerspective(image, warp, (width, height), flags=interpolation)
 
 
 def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, height: int = 480,
@@ -170,15 +232,17 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     rng = np.random.default_rng([seed, SCENARIOS.index(name)])  # scenarios differ at the same seed
     camera = Camera.random(rng, width, height) if name == "random" else Camera.for_frame(width, height)
     script: Script = {**BUILDERS, **ACTIVITY_BUILDERS}[name](rng, camera, n_frames, FPS)
-    background = draw_props(room(rng, camera), script.props)
+    canvas, warp = _canvas(name, camera, script)
+    cw, ch = canvas.width, canvas.height
+    background = draw_props(room(rng, canvas), script.props)
     effects = None if clean else CameraEffects.make(rng, n_frames, width, height, FPS)
     occ_tex = [_pillar_texture(rng, o.box, o.colour) for o in script.occluders]
     luts = [colour_table(a.appearance) for a in script.actors]
     # cloth folds and lighting: a gain field per person that moves with them (none when clean)
-    folds = [None if clean else 0.045 * smooth_noise(rng, height + 64, width + 64, max(3, height // 40))
+    folds = [None if clean else 0.045 * smooth_noise(rng, ch + 64, cw + 64, max(3, height // 40))
              for _ in script.actors]
     frames = np.empty((n_frames, height, width, 3), np.uint8)
-    owner = np.zeros((height, width), np.uint8)
+    owner = np.zeros((ch, cw), np.uint8)
     owner_maps = np.zeros((n_frames, height, width), np.uint8) if owners else None
     rows: list[tuple] = []
     for i in tqdm(range(n_frames), desc=f"synth {name}", unit="frame", disable=not progress):
@@ -186,17 +250,17 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
         owner[:] = 0
         for actor in script.actors:
             if actor.view is None:
-                _shadow(frame, camera, float(actor.motion.x[i]), float(actor.motion.z[i]), actor.appearance.height_m)
+                _shadow(frame, canvas, float(actor.motion.x[i]), float(actor.motion.z[i]), actor.appearance.height_m)
         order = sorted(range(len(script.actors)), key=lambda a: -script.actors[a].motion.z[i])
         drawn = []
         for a in order:
             actor = script.actors[a]
             m = actor.motion
-            view = actor.view or camera.local_view(float(m.x[i]), float(m.z[i]))
+            view = actor.view or canvas.local_view(float(m.x[i]), float(m.z[i]))
             fig = draw_figure(_pose(actor, i, FPS), actor.appearance, view)
             x0, y0 = fig.origin
             fh, fw = fig.labels.shape
-            cx1, cy1, cx2, cy2 = max(x0, 0), max(y0, 0), min(x0 + fw, width), min(y0 + fh, height)
+            cx1, cy1, cx2, cy2 = max(x0, 0), max(y0, 0), min(x0 + fw, cw), min(y0 + fh, ch)
             if cx1 >= cx2 or cy1 >= cy2:
                 continue
             crop = (slice(cy1 - y0, cy2 - y0), slice(cx1 - x0, cx2 - x0))
@@ -219,12 +283,13 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
             owner[y:y + h, x:x + w] = OCCLUDER_ID
-        rows.extend(_truth_rows(i, drawn, owner))
+        rows.extend(_truth_rows(i, drawn, owner, warp, (width, height)))
+        frame = _warped(frame, warp, width, height)
         if script.lighting is not None:
             frame = np.clip(frame * script.lighting, 0, 255).astype(np.uint8)
         frames[i] = frame if effects is None else effects.apply(frame, i)
         if owner_maps is not None:
-            owner_maps[i] = owner
+            owner_maps[i] = _warped(owner, warp, width, height, cv2.INTER_NEAREST)
     truth = pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h", "occluded"])
     truth["source"] = "truth"
     order = {p: k for k, p in enumerate(PART_NAMES)}
@@ -245,6 +310,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
         events = pd.DataFrame([(e.kind, e.start_frame, e.end_frame, e.track_id_a, e.part_a, e.track_id_b, e.part_b,
                                 "" if e.colour is None else "#{:02x}{:02x}{:02x}".format(*reversed(e.colour)))
                                for e in script.events], columns=list(EVENT_TRUTH_COLUMNS))
+    background = _warped(background, warp, width, height)
     return Scene(frames, truth, init, [o.box for o in script.occluders], FPS,
                  tuple(a.appearance for a in script.actors), background, owner_maps, events)
 

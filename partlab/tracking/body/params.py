@@ -1,7 +1,8 @@
 """Every tunable number of the body-part tracker (Zhao & Lee), grouped by what it tunes.
 
 ``BodyParams`` is what ``partlab track`` uses, what retraining fits (the fields marked
-**fitted**: ``dynamics.noise`` and ``output.extent``, by :mod:`partlab.models`) and what a model
+**fitted**: ``dynamics.noise``, ``output.extent`` and, from person boxes alone, ``output.person`` and
+the detector's and track ending's thresholds, by :mod:`partlab.models`) and what a model
 bundle stores under the key ``"body"``. The tracker reads numbers only from here. Groups, in the
 paper's order:
 
@@ -372,11 +373,21 @@ class BodyOutput:
     # tracked size. Only the output changes; the filters keep tracking the inner rectangles.
     # (1, 1, 0, 0) reports them as they are, as the paper does; a part not listed likewise.
     extent: dict[str, tuple[float, float, float, float]] = mapping(_default_output_extent, rule=Rule(), n=4)
+    # The person box written with the part boxes (sec. 5.3: the minimum bounding rectangle of the
+    # three parts) is that rectangle scaled and shifted by (scale_w, scale_h, shift_x, shift_y), in
+    # fractions of its size: the box people draw around a whole person need not be the union of
+    # the part boxes (a walker's swinging arms and feet reach beyond them; far-away people are
+    # cut into parts that leave gaps). (1, 1, 0, 0), the MBR itself, is the paper's. Fitted from
+    # corrected person boxes, which need no part boxes (partlab.models.person). Only the output
+    # changes, as for ``extent``: automatic starts and the detection cue go on with the MBR.
+    person: tuple[float, float, float, float] = pair((1.0, 1.0, 0.0, 0.0), rule=Rule(), n=4)
 
     def check(self, path: str) -> None:
         for part, (sw, sh, _dx, _dy) in self.extent.items():
             if sw <= 0 or sh <= 0:
                 raise ValueError(f"{path}.extent.{part}: scales must be > 0, got {(sw, sh)}")
+        if self.person[0] <= 0 or self.person[1] <= 0:
+            raise ValueError(f"{path}.person: scales must be > 0, got {self.person[:2]}")
 
 
 @dataclass(frozen=True)
@@ -397,7 +408,7 @@ class BodyParams(Parameters):
     output: BodyOutput = group_field(BodyOutput)
 
     #: fields added after partlab 0.2 (no flat name)
-    ADDED: ClassVar[tuple[str, ...]] = tuple(f"detector.{f.name}" for f in fields(BodyDetector))
+    ADDED: ClassVar[tuple[str, ...]] = (*(f"detector.{f.name}" for f in fields(BodyDetector)), "output.person")
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {

@@ -264,8 +264,22 @@ class BodyTracker:
         self.candidates = fresh
 
     def _reported_person_box(self, person: Person) -> Box:
-        """The person box as written: the MBR of its parts' reported boxes."""
+        """The person box the tracker reasons with (starts, the detection cue): the MBR of its
+        parts' reported boxes (``output.person`` only changes what is written)."""
         return minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.filters.items())
+
+    def report_person(self, mbr: Box) -> Box:
+        """The person box written for the MBR of the reported part boxes: scaled and shifted by
+        ``BodyParams.output.person`` (fitted from corrected person boxes), clipped to the frame.
+        Only the output changes: the tracker itself (the detection cue's matching and steering,
+        automatic starts) goes on with the MBR, so a refit of it cannot change how people are
+        tracked, only how their boxes are written."""
+        sw, sh, dx, dy = self.params.output.person
+        if self.whole or (sw, sh, dx, dy) == (1.0, 1.0, 0.0, 0.0):
+            return mbr
+        out = mbr.transformed(sw, sh, dx, dy)
+        size = getattr(self, "frame_size", None)
+        return out.clip(*size) if size else out
 
     # -- one frame ----------------------------------------------------------------------
     def step(self, index: int, frame: np.ndarray, foreground: np.ndarray | None) -> list[TrackRecord]:
@@ -597,8 +611,8 @@ class BodyTracker:
             scores = [person.scores.get(n, 1.0) for n in person.filters]
             boxes = {name: self.report_box(name, f.box) for name, f in person.filters.items()}
             if not self.whole:
-                out.append(TrackRecord(index, tid, "person", minimum_bounding_rectangle(boxes.values()),
-                                       float(np.mean(scores)),
+                whole_box = self.report_person(minimum_bounding_rectangle(boxes.values()))
+                out.append(TrackRecord(index, tid, "person", whole_box, float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
             for name in person.filters:

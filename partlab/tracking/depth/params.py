@@ -16,7 +16,9 @@ from partlab.tracking.core.params import FRACTION, POSITIVE_COUNT, Parameters, f
 class Appearance:
     """Sec. 3, eq. 1-2: hue histograms of the H channel of HSV."""
 
-    hue_bins: int = number(16, POSITIVE_COUNT)
+    # 32 bins of OpenCV's 0-180 hue (5.6 each): with 16, skin (hue ~10) and a red shirt (0-2) fell
+    # in one bin and the hands slid up red sleeves in front of the face (unseen desk seed 14)
+    hue_bins: int = number(32, POSITIVE_COUNT)
     # hue is undefined for grey or dark pixels: only pixels with S and V at least these count
     min_saturation: int = number(30, POSITIVE_COUNT)
     min_value: int = number(40, POSITIVE_COUNT)
@@ -70,12 +72,27 @@ class DepthCue:
     # its forearm up to about 2.5; a desk top in front of the person is far larger)
     min_area: float = number(0.08)
     max_area: float = number(3.0)
+    # ... and, after step 4, no longer than this in face widths either way (a hand with its
+    # forearm pointing sideways is about 2; a stereo pair's streak of noise along a desk's edge, 4)
+    max_extent: float = number(2.5)
     # Table 1 step 4 c): epsilon and epsilon' in pixels
     eps: float = number(0.5)
     eps_size: float = number(4.0)
     max_iterations: int = number(20, POSITIVE_COUNT)
     # eq. 3's covariance is diag((w/2)^2, (h/2)^2); never narrower than this, in hand widths
     min_sigma: float = number(0.25)
+    # support surfaces (regions.support_surfaces, our addition): a plane among the pixels in front
+    # of the face covering this many face areas (a desk top; a hand is ~0.3 and not flat) is not a
+    # hand; its points lie within surface_tol face widths of it (~20 mm: the stereo pair's error on
+    # the desk top is ~7 mm median, a resting hand's centre lies a hand radius, ~45 mm, above it)
+    surfaces: bool = flag(True)
+    surface_area: float = number(3.0)
+    surface_tol: float = number(0.12)
+    # RANSAC: planes tried per search, up to surface_planes planes (a desk's top and its front),
+    # fitted on every surface_step-th pixel each way (1/16 of the pixels at 4: a few ms a frame)
+    surface_hypotheses: int = number(48, POSITIVE_COUNT)
+    surface_planes: int = number(2, POSITIVE_COUNT)
+    surface_step: int = number(4, POSITIVE_COUNT)
     # sec. 4: weights for importance and standard sampling are q and 1 - q (Fig. 4: q = 0.5)
     q: float = number(0.5, FRACTION)
     # ICONDENSATION's three kinds of sample: of the q drawn from g, this share are its

@@ -7,6 +7,14 @@ than the face) and step 4 a) weights the centroid by ``d`` (pulling it to the ne
 millimetres both flip: step 2 keeps ``d < d_f - lambda sd_f`` and step 4 weights each kept pixel by
 how far it lies in front of the threshold, ``ds_thre - d`` (0 at the threshold, largest at the
 fingertips), which is what the disparity weight does up to an offset.
+
+*Our addition*, :func:`support_surfaces`: a desk top (or any large flat surface) in front of the
+person passes step 2's test like a hand. Step 3 rejects its component by size, but a hand resting on
+it (or joined to it by a stereo pair's blurred edges) is then rejected with it, and the hands'
+observation (which keeps every pixel in front of the face, sec. 4) lets a skin-hued desk pull the
+hands onto its front edge. Large planes among the pixels in front of the face are found by RANSAC
+(Fischler & Bolles) in 3D and their pixels taken out of both; a hand is not flat over several face
+areas, so it stays.
 """
 
 from __future__ import annotations
@@ -63,21 +71,83 @@ class HandRegion:
     coarse: tuple[int, int, int, int]  # step 3's bounding rectangle x, y, w, h
 
 
+def support_surfaces(depth: np.ndarray, near: np.ndarray, K: np.ndarray, face: FaceDepth, face_px: float,
+                     p: DepthCue, rng: np.random.Generator) -> np.ndarray | None:
+    """``(H, W) bool``: the pixels of ``near`` (in front of the face, depth measured) that lie on a
+    plane covering at least ``p.surface_area`` face areas (up to ``p.surface_planes`` planes, each
+    within ``p.surface_tol`` face widths); None when there is none.
+
+    RANSAC, vectorised: ``p.surface_hypotheses`` planes through 3 random points of a grid subsample
+    (every ``p.surface_step``-th pixel each way) are scored at once by their inliers; the best is
+    refitted to its inliers by least squares (the smallest singular vector) and tested on every pixel."""
+    step = p.surface_step
+    need = p.surface_area * face_px / step ** 2  # grid points a large enough plane holds
+    sub = near[::step, ::step]
+    if sub.sum() < need:
+        return None
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    hgt, wid = depth.shape
+    vv, uu = np.mgrid[0:hgt:step, 0:wid:step]
+    z = depth[::step, ::step][sub].astype(np.float64)
+    pts = np.stack([(uu[sub] - cx) * z / fx, (vv[sub] - cy) * z / fy, z], 1)
+    tol = p.surface_tol * face.width_mm
+    out = np.zeros_like(near)
+    left = np.ones(len(pts), bool)
+    for _ in range(p.surface_planes):
+        cand = np.flatnonzero(left)
+        if len(cand) < need:
+            break
+        tri = pts[cand[rng.integers(0, len(cand), (p.surface_hypotheses, 3))]]  # (M, 3, 3)
+        normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        norm = np.linalg.norm(normal, axis=1)
+        good = norm > 1e-9
+        if not good.any():
+            break
+        normal = normal[good] / norm[good, None]
+        offset = np.einsum("mk,mk->m", normal, tri[good, 0])
+        inl = np.abs(pts[cand] @ normal.T - offset) < tol  # (n, M)
+        best = int(np.argmax(inl.sum(0)))
+        if inl[:, best].sum() < need:
+            break
+        # least squares on the inliers: the plane through their mean, normal = least spread
+        q = pts[cand[inl[:, best]]]
+        centre = q.mean(0)
+        normal = np.linalg.svd(q - centre, full_matrices=False)[2][-1]
+        on = np.abs((pts - centre) @ normal) < tol
+        left &= ~on
+        out |= _on_plane(depth, near, K, centre, normal, tol)
+    return out if out.any() else None
+
+
+def _on_plane(depth, near, K, centre, normal, tol) -> np.ndarray:
+    """Every pixel of ``near`` whose 3D point lies within ``tol`` of the plane (centre, normal)."""
+    hgt, wid = depth.shape
+    vv, uu = np.nonzero(near)
+    z = depth[vv, uu].astype(np.float64)
+    pts = np.stack([(uu - K[0, 2]) * z / K[0, 0], (vv - K[1, 2]) * z / K[1, 1], z], 1)
+    out = np.zeros((hgt, wid), bool)
+    out[vv, uu] = np.abs((pts - centre) @ normal) < tol
+    return out
+
+
 def hand_regions(depth: np.ndarray, face: FaceDepth, face_box, fx: float, p: DepthCue,
-                 max_regions: int = 2) -> list[HandRegion]:
-    """Table 1 steps 2-4: up to ``max_regions`` hand candidate regions, largest first."""
+                 max_regions: int = 2, surfaces: np.ndarray | None = None) -> list[HandRegion]:
+    """Table 1 steps 2-4: up to ``max_regions`` hand candidate regions, largest first (pixels on
+    ``surfaces``, :func:`support_surfaces`, are not hands)."""
     # step 2 (in mm; see the module docstring): nearer than the face by lambda sd_f
     gap = max(p.lam * face.sd, p.min_gap * face.width_mm)
     thre = face.mean - gap
     with np.errstate(invalid="ignore"):
         keep = depth < thre
+    if surfaces is not None:
+        keep &= ~surfaces
     weight = np.where(keep, thre - depth, 0.0).astype(np.float32)
     # step 3: connected components of proper size (in face areas)
     face_px = max(float(face_box[2]) * float(face_box[3]), 1.0)
     n, _, stats, _ = cv2.connectedComponentsWithStats(keep.view(np.uint8), connectivity=8)
     area = stats[1:, cv2.CC_STAT_AREA].astype(float)
     ok = np.flatnonzero((area >= p.min_area * face_px) & (area <= p.max_area * face_px)) + 1
-    ok = ok[np.argsort(-stats[ok, cv2.CC_STAT_AREA])][:max_regions]
+    ok = ok[np.argsort(-stats[ok, cv2.CC_STAT_AREA])]
     if not len(ok):
         return []
     # step 4: integral images of d', x d', y d' make each iteration's centroid four lookups
@@ -87,12 +157,16 @@ def hand_regions(depth: np.ndarray, face: FaceDepth, face_box, fx: float, p: Dep
     w64 = weight.astype(np.float64)
     integ = [cv2.integral(a) for a in (w64, w64 * xs, w64 * ys)]
     out = []
+    longest = p.max_extent * float(face_box[2])
     for k in ok:
         x, y, w, h = (int(v) for v in stats[k, :4])
         box = _refine(integ, float(x), float(y), float(x + w - 1), float(y + h - 1), p)
         xl, yl, xu, yu = box
-        out.append(HandRegion((xl + xu) / 2, (yl + yu) / 2, max(xu - xl + 1, 1.0), max(yu - yl + 1, 1.0),
-                              (x, y, w, h)))
+        region = HandRegion((xl + xu) / 2, (yl + yu) / 2, max(xu - xl + 1, 1.0), max(yu - yl + 1, 1.0), (x, y, w, h))
+        if max(region.w, region.h) <= longest:  # not a long streak (a stereo pair's noise on a desk's edge)
+            out.append(region)
+        if len(out) == max_regions:
+            break
     return out
 
 

@@ -39,7 +39,7 @@ from partlab.tracking.core.hue_histogram import (
 from partlab.tracking.depth.filter import HueFilter
 from partlab.tracking.depth.params import DepthParams
 from partlab.tracking.depth.posture import ArmFit, head_width, recover
-from partlab.tracking.depth.regions import HandRegion, depth_foreground, face_depth, hand_regions
+from partlab.tracking.depth.regions import HandRegion, depth_foreground, face_depth, hand_regions, support_surfaces
 from partlab.tracking.depth.sampling import draw_importance, icondensation_correction
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
@@ -181,23 +181,32 @@ class DepthTracker:
         inner = (x + w * (1 - iw) / 2, y + h * (1 - ih), w * iw, h * ih)  # lower middle: skin, no hair
         return hand_reference(bins, inner, self.params.appearance.hue_bins, self.params.appearance.hand_fill)
 
-    def _hand_bins(self, bins, depth, fd) -> np.ndarray:
+    def _hand_bins(self, bins, depth, fd, surfaces, face_box=None) -> np.ndarray:
         """The hands' bin image: hue bins, and one *other* bin (index ``hue_bins``) for pixels with
-        no hue and, with depth, for pixels not in front of the face's plane (sec. 4 constraint 1).
+        no hue and, with depth, for pixels measured not in front of the face's plane (sec. 4
+        constraint 1) or on a support surface (:func:`~.regions.support_surfaces`).
 
         Leaving such pixels out of the histogram (as eq. 1-2 do for grey pixels) makes every window
         that holds the hand score alike, however large: the scale alpha then drifts freely and the
         box outgrows the hand (Zhao & Lee's box rule fails with the centre on the hand). Counted in a
         bin the reference (the face's skin) hardly has, they lower the confidence of a window by the
-        share of it that is not hand, as background of another hue does in colour alone."""
+        share of it that is not hand, as background of another hue does in colour alone.
+
+        Unmeasured depth (NaN) is no evidence either way: the pixel's colour decides, as without
+        depth (counted as *not in front*, a hand in the band along a stereo pair's left edge that
+        the right camera does not see vanished there), except inside the face's box, where
+        unmeasured skin is the face's (a hand there slid onto the face's unmatched pixels)."""
         nb = self.params.appearance.hue_bins
         keep = bins >= 0
         if fd is not None and self.params.depth.depth_foreground:
-            # unmeasured depth counts as not in front (letting the colour alone decide there was
-            # tried: on stereo depth the hands then slid onto unmatched skin-hued pixels, seeds 1
-            # and 2 fell from 1.00 to 0.43 and 0.11 of frames, for seed 6's 0.59 -> 0.84)
             with np.errstate(invalid="ignore"):
-                keep &= depth < fd.mean - self.params.depth.hand_gap * fd.width_mm
+                keep &= ~(depth >= fd.mean - self.params.depth.hand_gap * fd.width_mm)  # NaN stays
+            if surfaces is not None:
+                keep &= ~surfaces
+            if face_box is not None:
+                x, y, w, h = (int(round(v)) for v in face_box)
+                ys, xs = slice(max(y, 0), max(y + h, 0)), slice(max(x, 0), max(x + w, 0))
+                keep[ys, xs] &= np.isfinite(depth[ys, xs])
         return np.where(keep, bins, nb).astype(bins.dtype)
 
     def _assign(self, regions: list[HandRegion]) -> None:
@@ -313,14 +322,14 @@ class DepthTracker:
         else:
             h.low = 0
 
-    def _hands(self, bins, depth, fd, fbox) -> None:
+    def _hands(self, bins, depth, fd, fbox, surfaces) -> None:
         """Sec. 4 for both hands: start (or restart) the uninitialised ones, track the others."""
         p = self.params
         ref = self._hand_reference(bins)
         if ref is None:
             return
         nb = p.appearance.hue_bins
-        hand_bins = self._hand_bins(bins, depth, fd)
+        hand_bins = self._hand_bins(bins, depth, fd, surfaces, fbox)
         hand_integral = integral_histogram(hand_bins, nb + 1)
         backproj = None
         if p.refinement.mean_shift:
@@ -415,11 +424,12 @@ class DepthTracker:
         # 2. depth foreground and hand candidate regions (Table 1)
         fg = depth_foreground(depth, fd, p.depth) if (fd is not None and p.depth.depth_foreground) else None
         self._fg = fg
-        regions = (hand_regions(depth, fd, fbox, float(camera.K[0, 0]), p.depth)
+        surfaces = self._surfaces(depth, fd, fbox, camera)
+        regions = (hand_regions(depth, fd, fbox, float(camera.K[0, 0]), p.depth, surfaces=surfaces)
                    if fd is not None and p.depth.importance_sampling else [])
         self._assign(regions)
         # 3. the hands, observed in front of the face's plane (sec. 4 constraint 1) when depth is used
-        self._hands(bins, depth, fd, fbox)
+        self._hands(bins, depth, fd, fbox, surfaces)
         # 4. posture and rows
         hand_boxes = [self.hands[n].filter.box() if self.hands[n].initialised else None for n in HANDS]
         if self.head_mm is None:
@@ -427,6 +437,16 @@ class DepthTracker:
         pose = recover(camera, depth, fbox, [self._seen(n, b, camera) for n, b in zip(HANDS, hand_boxes)],
                        p.posture, self.head_mm, self.arms)
         return self._rows(index, view.stream, camera, fbox, hand_boxes, pose)
+
+    def _surfaces(self, depth, fd, fbox, camera) -> np.ndarray | None:
+        """Large planes in front of the face (a desk top): not hands (:func:`~.regions.support_surfaces`)."""
+        p = self.params.depth
+        if fd is None or not p.surfaces or not (p.depth_foreground or p.importance_sampling):
+            return None
+        with np.errstate(invalid="ignore"):
+            near = depth < fd.mean - p.hand_gap * fd.width_mm
+        return support_surfaces(depth, near, np.asarray(camera.K, float), fd, float(fbox[2]) * float(fbox[3]),
+                                p, self.rng)
 
     def _seen(self, name: str, box, camera) -> tuple | None:
         """The hand's box for the posture when the hand is seen now: tracked with confidence (not

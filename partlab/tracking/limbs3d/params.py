@@ -114,6 +114,21 @@ class Limbs3DDynamics:
     candidate_gate: float = number(250.0, POSITIVE)
     # a candidate nearer another target's prediction (by this factor) is left to that target
     exclusive_ratio: float = number(1.0, POSITIVE)
+    # a hand uses only candidates within this distance (mm) of its own person's head estimate, 0 =
+    # no limit (our addition, not the paper's): shoulder to head ~250 mm plus an arm ~650-700 mm,
+    # and a hand hanging at the side of a 1.9 m person is ~880 mm from the head. Two people who
+    # shake hands stand ~1 m apart, so when the hands part, the other person's hand going back to
+    # its side (~1.2-1.4 m from this head) cannot carry this hand away with it
+    hand_reach: float = number(1000.0)
+    # single-view candidates (our addition, the "next step" of docs/trackers/limbs3d.md): a normal
+    # target with no candidate from a pair of views within candidate_gate of its prediction (a hand
+    # hidden by a body in all views but one, or a camera that went dark) takes, in each view, the
+    # blob nearest its predicted projection within single_view_gate mm (projected at its depth) that
+    # no other target's projection is nearer to, at the point of that blob's line of sight nearest
+    # the prediction. Their prior is below states.recover_likelihood, so they keep a tracked target
+    # tracked but never bring a lost one back (one view cannot tell its depth). 0 = off
+    single_view_prior: float = number(0.2, FRACTION)
+    single_view_gate: float = number(100.0, POSITIVE)
     # a combined filter spreads its particles this much wider so it sees both modes
     combined_noise_scale: float = number(1.3, POSITIVE)
     # a lost target's particles spread this wide (mm) around where it is looked for

@@ -40,24 +40,10 @@ from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
 LIMB_PARTS = ("head", "left_hand", "right_hand")
-
-
-def triangulate(cameras: list[Camera], pixels: list[np.ndarray]) -> np.ndarray:
-    """A world point (mm) from its pixels in two or more views: ``cv2.triangulatePoints`` on each
-    pair of views (undistorted pixels), averaged."""
-    pts = []
-    for i in range(len(cameras)):
-        for j in range(i + 1, len(cameras)):
-            a = cv2.undistortPoints(np.asarray(pixels[i], float).reshape(1, 1, 2), cameras[i].K, cameras[i].dist,
-                                    P=cameras[i].K).reshape(2, 1)
-            b = cv2.undistortPoints(np.asarray(pixels[j], float).reshape(1, 1, 2), cameras[j].K, cameras[j].dist,
-                                    P=cameras[j].K).reshape(2, 1)
-            h = cv2.triangulatePoints(cameras[i].P, cameras[j].P, a, b).ravel()
-            pts.append(h[:3] / h[3])
-    return np.mean(pts, axis=0)
 
 
 @dataclass
@@ -247,14 +233,19 @@ class Limbs3DTracker:
         if len(points) and len(active):
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
         observations: dict[int, Observation] = {}
+        heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
         for a, k in enumerate(active):
             t = self.targets[k]
-            if len(points) and len(active) > 1:
-                others = np.delete(dist, a, axis=1).min(axis=1)
-                mine = dist[:, a] <= p.dynamics.exclusive_ratio * others
-            else:
-                mine = np.ones(len(points), bool)
-            est = t.filter.update(points[mine], weights[mine])
+            mine = self._usable(t, points, dist[:, a] if len(points) and len(active) > 1 else None,
+                                np.delete(dist, a, axis=1) if len(points) and len(active) > 1 else None,
+                                heads.get(t.track_id))
+            use, use_w = points[mine], weights[mine]
+            if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
+                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < p.dynamics.candidate_gate).any()):
+                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0))
+                use = np.vstack([use.reshape(-1, 3), single])
+                use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
+            est = t.filter.update(use, use_w)
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
             else:
@@ -280,6 +271,39 @@ class Limbs3DTracker:
             elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
                 pass  # the leader's filter tracks both
         return self._records(index)
+
+    def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray) -> np.ndarray:
+        """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
+        ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
+        within ``single_view_gate`` mm that is nearer to it than to every other target's projection
+        (``others (M, 3)``), at the point of the blob's line of sight nearest ``pred``."""
+        out = []
+        for cam, cen in zip(self.cameras, centres):
+            cen = np.asarray(cen, float).reshape(-1, 2)
+            depth = cam.to_camera(pred[None])[0, 2]
+            if not len(cen) or depth <= 0:
+                continue
+            uv = cam.project(pred[None])[0]
+            d = np.linalg.norm(cen - uv, axis=1)
+            if len(others):
+                d_other = np.linalg.norm(cen[:, None] - cam.project(others)[None], axis=-1).min(axis=1)
+                d = np.where(d < d_other, d, np.inf)
+            j = int(np.argmin(d))
+            if d[j] > cam.K[0, 0] * self.params.dynamics.single_view_gate / depth:
+                continue
+            v = cam.rays(cen[j:j + 1])[0]
+            out.append(cam.centre + v * float(v @ (pred - cam.centre)))
+        return np.array(out).reshape(-1, 3)
+
+    def _usable(self, t: _Target, points: np.ndarray, mine, others, head) -> np.ndarray:
+        """The candidates target ``t`` may use: those no other target's prediction is nearer to
+        (``mine``/``others``: distances to its and the other active targets' predictions, None with
+        one target) and, for a hand, within ``hand_reach`` of its person's head estimate ``head``."""
+        d = self.params.dynamics
+        use = (mine <= d.exclusive_ratio * others.min(axis=1)) if mine is not None else np.ones(len(points), bool)
+        if d.hand_reach > 0 and t.part != "head" and head is not None and len(points):
+            use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        return use
 
     def _modes(self, est, points, weights) -> tuple:
         """The combined posterior's two strongest modes: the strongest candidate near the filter,

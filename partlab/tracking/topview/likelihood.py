@@ -82,10 +82,10 @@ def _weigh(points, bins, prims, kinds, part_of, n_parts, n_bins):
 
 
 @_jit(fastmath=True)
-def _nearest(points, prims, kinds, part_of):
+def _nearest(points, prims, kinds):
     m, n_k = points.shape[0], prims.shape[0]
     dist = np.empty(m, np.float32)
-    part = np.empty(m, np.int64)
+    prim = np.empty(m, np.int64)
     for j in range(m):
         best = 1e30
         bp = 0
@@ -93,10 +93,10 @@ def _nearest(points, prims, kinds, part_of):
             d = _distance(points[j, 0], points[j, 1], points[j, 2], prims[k], kinds[k])
             if d < best:
                 best = d
-                bp = part_of[k]
+                bp = k
         dist[j] = best
-        part[j] = bp
-    return dist, part
+        prim[j] = bp
+    return dist, prim
 
 
 def weigh(points: np.ndarray, prims: np.ndarray, bins: np.ndarray | None = None, n_bins: int = 0):
@@ -115,8 +115,15 @@ def weigh(points: np.ndarray, prims: np.ndarray, bins: np.ndarray | None = None,
 def nearest(points: np.ndarray, prims: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """For one model (``prims (K, 16)``): each point's distance to it ``(M,)`` mm and its nearest
     weighting part ``(M,)``."""
+    dist, prim = nearest_primitive(points, prims)
+    return dist, PART_OF[prim]
+
+
+def nearest_primitive(points: np.ndarray, prims: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """As :func:`nearest`, with each point's nearest primitive ``(M,)`` (index into
+    :data:`partlab.tracking.topview.model.PRIMITIVES`) instead of its part."""
     pts = np.ascontiguousarray(points, np.float32).reshape(-1, 3)
-    return _nearest(pts, np.ascontiguousarray(prims, np.float32).reshape(-1, 16), KINDS, PART_OF)
+    return _nearest(pts, np.ascontiguousarray(prims, np.float32).reshape(-1, 16), KINDS)
 
 
 def bhattacharyya(hist: np.ndarray, reference: np.ndarray) -> np.ndarray:
@@ -189,3 +196,41 @@ def free_space(prims: np.ndarray, depth: np.ndarray, camera, cap_mm: float) -> n
     out = np.zeros((n_p, N_PARTS))
     np.add.at(out.T, part, pen.T)
     return out / np.maximum(np.bincount(part, minlength=N_PARTS), 1)
+
+
+# -- partlab's addition: the body's own volume -----------------------------------------------
+#
+# Seen from above, a forearm or hand under the person's own torso or head is hidden: eq. 1 finds
+# its surface near the torso's points and the free-space check sees the sensor *nearer* than the
+# model, so neither charges a hand pushed *into* the torso, where it explains the torso's points
+# at almost no distance. A body cannot pass through itself: the axis points of each forearm and
+# hand are checked against the torso's elliptic cylinder and the head's sphere, and how deep the
+# segment's surface goes into them (capped) is charged to the arm's part.
+
+_ARM_SAMPLES = ((4, 0.0), (4, 0.5), (4, 1.0), (5, 0.0), (7, 0.0), (7, 0.5), (7, 1.0), (8, 0.0))
+
+
+def self_intersection(prims: np.ndarray, cap_mm: float) -> np.ndarray:
+    """``(P, 5)`` mean depth (mm, capped at ``cap_mm``) by which the forearms and hands of ``(P, K,
+    16)`` primitives go into their own torso or head, in the arms' columns (0 elsewhere)."""
+    torso, slab, head = prims[:, 2], prims[:, 1], prims[:, 0]
+    O, e1, e2, e3 = torso[:, None, 0:3], torso[:, None, 3:6], torso[:, None, 6:9], torso[:, None, 9:12]
+    a, b = torso[:, None, 12], torso[:, None, 13]
+    length = torso[:, None, 14] + slab[:, None, 14]
+    k = np.array([s[0] for s in _ARM_SAMPLES])
+    f = np.array([s[1] for s in _ARM_SAMPLES], np.float32)
+    seg = prims[:, k]
+    pts = seg[..., 0:3] + (f * seg[..., 14])[..., None] * seg[..., 9:12]  # (P, S, 3) on the axes
+    radius = np.where(k % 3 == 2, 0.5 * seg[..., 12], seg[..., 12])  # a hand: half its half-width
+    q = pts - O
+    q1, q2, q3 = (q * e1).sum(-1), (q * e2).sum(-1), (q * e3).sum(-1)
+    rn = np.sqrt((q1 / a) ** 2 + (q2 / b) ** 2)
+    along = np.minimum(q3, length - q3)  # how far inside the cylinder's length the point is
+    into_torso = np.minimum(radius - (rn - 1.0) * np.minimum(a, b), radius + along)
+    into_head = radius + head[:, None, 12] - np.linalg.norm(pts - head[:, None, 0:3], axis=-1)
+    pen = np.clip(np.maximum(into_torso, into_head), 0.0, cap_mm)
+    out = np.zeros((len(prims), N_PARTS))
+    half = len(_ARM_SAMPLES) // 2
+    out[:, PART_OF[4]] = pen[:, :half].mean(1)
+    out[:, PART_OF[7]] = pen[:, half:].mean(1)
+    return out

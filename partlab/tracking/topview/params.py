@@ -49,6 +49,17 @@ class DynamicsParams:
     neck: float = number(0.06)
     shoulder: tuple[float, float, float] = pair((0.10, 0.08, 0.10), n=3)  # flexion, abduction, twist
     elbow: tuple[float, float] = pair((0.12, 0.10))               # flexion, twist
+    #: partlab's: a forearm and hand the camera above does not see (under the upper arm, the
+    #: head or a bent torso) are held by nothing in eq. 1, so the degrees of freedom only they
+    #: show (the shoulder's twist, the elbow's flexion and twist) random-walk at full speed and
+    #: carry the hidden hand 100-300 mm off in 10-20 frames. Their noise is scaled down to
+    #: ``hidden_scale`` while fewer than ``hidden_points`` of the person's points (of the
+    #: ``roi.max_points`` drawn) lie on the estimate's forearm and hand or are left unexplained
+    #: (farther than ``unexplained_mm`` from the model) beside that arm, and back up as they show
+    #: again (re-acquisition): 1 = the paper's plain random walk
+    hidden_scale: float = number(0.25, FRACTION)
+    hidden_points: float = number(8.0, POSITIVE)
+    unexplained_mm: float = number(40.0, POSITIVE)
 
 
 @dataclass(frozen=True)
@@ -72,6 +83,12 @@ class LikelihoodParams:
     #: (a misplaced arm over the floor costs ``cap`` at most, as much as a point 100 mm off)
     free_space_weight: float = number(0.5)
     free_space_cap_mm: float = number(100.0)
+    #: partlab's self-intersection check (:func:`partlab.tracking.topview.likelihood.self_intersection`):
+    #: the weight of how deep a forearm or hand goes into its own torso or head (mean over the
+    #: segments' axis points, capped), in the arm's cost; 0 = off. A hand pushed 30 mm into the
+    #: torso then costs as much as its points lying 15 mm off at the weight 0.5
+    self_weight: float = number(0.5)
+    self_cap_mm: float = number(100.0, POSITIVE)
     #: colour histogram: levels per BGR channel (4 -> 64 bins: enough for clothes vs skin vs hair)
     colour_levels: int = number(4, POSITIVE_COUNT)
 
@@ -102,6 +119,12 @@ class ExclusionParams:
     #: prediction (the last estimate); 1, constant velocity, keeps a forearm that moves 30-50 mm a
     #: frame on its own pixels where two people's forearms cross
     velocity: float = number(1.0)
+    #: partlab's second pass: after every person's filter has run, each point goes again to the
+    #: nearest *fitted* model, and a person whose points changed by at least
+    #: ``second_pass_points`` is weighed again with the new ones (only with two people or more;
+    #: :meth:`partlab.tracking.topview.tracker.TopViewTracker.step`)
+    second_pass: bool = flag(True)
+    second_pass_points: int = number(20, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)

@@ -201,14 +201,15 @@ class TopViewTracker:
         return RoiPoints(mask.reshape(d.shape), index, pts, bins)
 
     # -- the exclusion principle (eq. 5) -----------------------------------------------------
-    def assign(self, roi: RoiPoints) -> np.ndarray:
+    def assign(self, roi: RoiPoints, fitted: bool = False) -> np.ndarray:
         """``(M,)`` index into :attr:`targets` of each ROI point's nearest predicted model (-1: none
-        within ``max_assign_mm``)."""
+        within ``max_assign_mm``); ``fitted``: nearest this frame's estimated model instead."""
         if not self.targets or not len(roi.points):
             return np.full(len(roi.points), -1, np.int64)
         v = self.params.exclusion.velocity
-        dist = np.stack([nearest(roi.points, primitives(t.filter.predicted(v)[None], t.filter.body)[0])[0]
-                         for t in self.targets])
+        states = [t.filter.estimate if fitted else t.filter.predicted(v) for t in self.targets]
+        dist = np.stack([nearest(roi.points, primitives(s[None], t.filter.body)[0])[0]
+                         for s, t in zip(states, self.targets)])
         owner = np.argmin(dist, 0)
         owner[dist.min(0) > self.params.exclusion.max_assign_mm] = -1
         return owner
@@ -225,13 +226,8 @@ class TopViewTracker:
             self._start_from_roi(roi, owner, view.depth.shape)
             if len(self.targets) > before:
                 owner = self.assign(roi)
-        assignment = np.zeros(view.depth.size, np.int32)
-        ids = np.array([t.track_id for t in self.targets] + [0])
-        assignment[roi.index] = ids[owner]
-        self.assignment = assignment.reshape(view.depth.shape)
-        lk = self.params.likelihood
-        n_bins = lk.colour_levels ** 3
-        out, keep = [], []
+        cam = view.camera or self.cameras.get(view.stream)
+        keep, used = [], {}
         for k, t in enumerate(self.targets):
             mine = np.flatnonzero(owner == k)
             if len(mine) < self.params.start.min_points:
@@ -241,15 +237,49 @@ class TopViewTracker:
                 continue
             t.missing = 0
             keep.append(t)
-            if len(mine) > self.params.roi.max_points:
-                mine = self.rng.choice(mine, self.params.roi.max_points, replace=False)
-            bins = roi.bins[mine] if roi.bins is not None else None
-            if bins is not None and t.filter.reference is None:
-                t.filter.update_reference(roi.points[mine], bins, n_bins)
-            t.filter.step(roi.points[mine], bins, n_bins, view.depth, view.camera or self.cameras.get(view.stream))
-            out.extend(self._rows(frames.index, view, t, roi.points[mine]))
+            used[t.track_id] = self._measure(t, roi, mine, view.depth, cam, first=True)
         self.targets = keep
-        return out
+        if len(used) > 1 and self.params.exclusion.second_pass:
+            owner = self._second_pass(roi, owner, used, view.depth, cam)
+        assignment = np.zeros(view.depth.size, np.int32)
+        ids = np.array([t.track_id for t in self.targets] + [0])
+        assignment[roi.index] = ids[owner]
+        self.assignment = assignment.reshape(view.depth.shape)
+        return [row for t in self.targets if t.track_id in used
+                for row in self._rows(frames.index, view, t, roi.points[used[t.track_id]])]
+
+    def _measure(self, t: Target, roi: RoiPoints, mine: np.ndarray, depth: np.ndarray, cam, first: bool) -> np.ndarray:
+        """Run ``t``'s filter on its ROI points ``mine`` (at most ``roi.max_points`` of them, drawn
+        at random); ``first`` = False weighs this frame's particles again (the second pass).
+        Returns the points used."""
+        if len(mine) > self.params.roi.max_points:
+            mine = self.rng.choice(mine, self.params.roi.max_points, replace=False)
+        n_bins = self.params.likelihood.colour_levels ** 3
+        bins = roi.bins[mine] if roi.bins is not None else None
+        if bins is not None and t.filter.reference is None:
+            t.filter.update_reference(roi.points[mine], bins, n_bins)
+        if first:
+            t.filter.step(roi.points[mine], bins, n_bins, depth, cam)
+        else:
+            t.filter.measure(roi.points[mine], bins, n_bins, depth, cam, again=True)
+        return mine
+
+    def _second_pass(self, roi: RoiPoints, owner: np.ndarray, used: dict[int, np.ndarray], depth: np.ndarray,
+                     cam) -> np.ndarray:
+        """Eq. 5 again with this frame's fitted models instead of the predicted ones (partlab's):
+        where two people touch, a forearm that moved against its prediction took the other
+        person's points; the people whose points changed are weighed again with their new ones
+        (the same particles: no second resampling or propagation). Returns the new owners."""
+        fitted = self.assign(roi, fitted=True)
+        for k, t in enumerate(self.targets):
+            if t.track_id not in used:
+                fitted[fitted == k] = -1
+                continue
+            mine = np.flatnonzero(fitted == k)
+            changed = np.count_nonzero((owner == k) != (fitted == k))
+            if changed >= self.params.exclusion.second_pass_points and len(mine) >= self.params.start.min_points:
+                used[t.track_id] = self._measure(t, roi, mine, depth, cam, first=False)
+        return fitted
 
     def _rows(self, index: int, view: Frame, t: Target, points: np.ndarray) -> list[TrackRecord]:
         f = t.filter

@@ -1,0 +1,447 @@
+"""What corrected person boxes teach the body tracker, without a single part box.
+
+Many teams label whole people only (PETS09-S2L1's truth, the MOT benchmarks). Such boxes say
+nothing of head, torso or hip-leg, so they give the failure SVMs (Zhao & Lee sec. 4.2) no sample;
+but measured against what the tracker and its people detector do on the same frames they say:
+
+1. **the person box around the parts** (``output.person``): the box a person draws around a whole
+   person against the tracker's person box (the minimum bounding rectangle of the reported parts,
+   sec. 5.3), as the median ratio of sizes and offset of centres, on frames where the tracker is on
+   the person (its centre inside the corrected box) -- the same rule as the part extent of
+   :mod:`partlab.models.extent`;
+2. **the detector's threshold and window** (``detector.min_score``, ``detector.shrink``): the HOG
+   detector is run on the corrected frames exactly where the detection cue would run it (foreground
+   blobs and the tracks' boxes, every ``detector.every`` frames) with no threshold; a detection on a
+   corrected box (IoU >= 0.5) is true, any other false. The threshold is the one that maximises F1
+   over the corrected boxes of those frames (a false window starts a ghost track or drags a track
+   off its person, a missed one leaves a box unsteered); the window's share of the body is the
+   median ratio of corrected box to detector window over the true detections;
+3. **when tracks end** (``detector.undetected_frames``, ``detection.leave_fraction``): how long the
+   detector goes without finding people who *are* there (the longest run of scans without a
+   detection on each corrected track); a track undetected for much longer than the people on the
+   corrected frames ever were is a ghost. Where the detector misses people for over
+   :data:`MAX_UNDETECTED_S` seconds, this cannot tell ghosts from people and stays off. And how
+   much of a person is in view where the corrected tracks begin and end at the frame's sides
+   (:func:`fit_leave_fraction`): a track goes on no longer than the annotator would label it;
+4. **the dynamics**: a person's parts move with the person, so the person boxes' constant-velocity
+   noise (:func:`partlab.models.variance.fit_body_noise` on the ``person`` rows) widens each part's
+   position and velocity noise where it is larger (the fits only ever widen, as for parts).
+
+Each is a handful of numbers from medians, a quantile and one threshold, nothing tied to where or
+when the corrected people were; validation on the training clips (:func:`select_person`: the
+detector, then the extent refitted with it, then ending and noise) keeps each only if it lowers
+the annotator's edits there (:func:`partlab.labelling.evaluation.count_edits`, the measure the
+issue judges the tracker by), so a fit that does not help is not used.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import pandas as pd
+from scipy.optimize import linear_sum_assignment
+
+from partlab.tracking.core.box import iou_xywh
+from partlab.tracking.params import BodyParams
+from partlab.tracking.parts import BODY_PARTS
+
+#: corrected/tracked (or corrected/detected) pairs needed before a value is refitted
+MIN_PAIRS = 20
+#: false detections needed before the threshold is refitted (with fewer, F1 only says "lower it")
+MIN_FALSE = 5
+#: a detector that misses people on the corrected frames for longer than this cannot end ghosts
+MAX_UNDETECTED_S = 4.0
+#: the IoU at which a detection is on a corrected box (the MOT rule, and the edits')
+TRUE_IOU = 0.5
+XYWH = ["x", "y", "w", "h"]
+
+
+def has_person_rows(truth: pd.DataFrame) -> bool:
+    return bool((truth["part"] == "person").any())
+
+
+def person_only(truth: pd.DataFrame) -> bool:
+    """Person boxes and no body-part box: what the failure SVMs cannot learn from."""
+    return has_person_rows(truth) and not truth["part"].isin(BODY_PARTS).any()
+
+
+# -- 1. the person box around the parts ---------------------------------------------------------
+
+def fit_person_extent(tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
+                      current: tuple[float, float, float, float]) -> tuple[float, float, float, float] | None:
+    """New ``output.person`` from the tracker's person rows (written with ``current``) and the
+    corrected person boxes of the same clips and tracks; None with fewer than :data:`MIN_PAIRS`
+    frames where the tracker is on the person. A track's first frame (its drawn box) and boxes
+    touching the frame's edge (clipped) are left out."""
+    pairs = []
+    for t, g in zip(tracked, truths):
+        t = t[t["part"] == "person"]
+        t = t[t["frame"] > t.groupby("track_id")["frame"].transform("min")]
+        g = g[g["part"] == "person"]
+        pairs.append(t[["frame", "track_id", *XYWH]].merge(g[["frame", "track_id", *XYWH]],
+                                                           on=["frame", "track_id"], suffixes=("", "_t")))
+    m = pd.concat(pairs, ignore_index=True) if pairs else pd.DataFrame()
+    if m.empty:
+        return None
+    m = m[(m.w > 1) & (m.h > 1) & (m.w_t > 0) & (m.h_t > 0) & (m.x > 0.5) & (m.y > 0.5)]
+    cx, cy = m.x + m.w / 2, m.y + m.h / 2
+    m = m[(cx >= m.x_t) & (cx <= m.x_t + m.w_t) & (cy >= m.y_t) & (cy <= m.y_t + m.h_t)]
+    if len(m) < MIN_PAIRS:
+        return None
+    sw, sh, dx, dy = current
+    mbr_w, mbr_h = m.w / sw, m.h / sh
+    return (round(sw * float(np.median(m.w_t / m.w)), 3), round(sh * float(np.median(m.h_t / m.h)), 3),
+            round(dx + float(np.median((m.x_t + m.w_t / 2 - m.x - m.w / 2) / mbr_w)), 3),
+            round(dy + float(np.median((m.y_t + m.h_t / 2 - m.y - m.h / 2) / mbr_h)), 3))
+
+
+# -- 2. the detector's threshold and window ----------------------------------------------------
+
+def detection_samples(frames, truth: pd.DataFrame, params: BodyParams,
+                      tracked: pd.DataFrame | None = None) -> pd.DataFrame:
+    """Every window the detection cue's scan finds on the corrected frames, with no threshold:
+    one row per detection ``frame, x, y, w, h, score, iou, truth`` (``iou`` with the corrected box
+    the Hungarian assignment gives it, ``truth`` that box's track id or -1), plus one row per
+    corrected box of a scanned frame (``score`` NaN) so that misses are counted. ``frames``: a
+    frames factory (``() -> iterator of (index, BGR frame)``); regions are the foreground blobs
+    and the tracks' person boxes (``tracked``'s, else the corrected ones), as in
+    :class:`partlab.tracking.body.cue.DetectionCue`."""
+    from partlab.tracking.body.cue import _blob_regions
+    from partlab.tracking.core.background import BackgroundModel
+    from partlab.tracking.core.box import Box
+    from partlab.tracking.core.people import PeopleDetector
+
+    p = params.detector
+    detector = PeopleDetector(replace(p.scan(), min_score=0.0))
+    truth = truth[truth["part"] == "person"]
+    boxes = tracked[tracked["part"] == "person"] if tracked is not None else truth
+    t_by = {f: g for f, g in truth.groupby("frame")}
+    b_by = {f: g[XYWH].to_numpy(float) for f, g in boxes.groupby("frame")}
+    last = int(truth["frame"].max()) if len(truth) else -1
+    background = BackgroundModel(params)
+    rows = []
+    for index, frame in frames():
+        if index > last:
+            break
+        mask = background.apply(frame)
+        if index % p.every or index not in t_by:
+            continue
+        regions = _blob_regions(mask, p.min_region_height) + [Box(*b) for b in b_by.get(index, [])]
+        dets = detector.detect(frame, regions)
+        rows.extend(_label_scan(index, dets, t_by[index]))
+    return pd.DataFrame(rows, columns=["frame", *XYWH, "score", "iou", "truth"])
+
+
+def _label_scan(index: int, dets: np.ndarray, truth: pd.DataFrame) -> list[tuple]:
+    gt = truth[XYWH].to_numpy(float)
+    ids = truth["track_id"].to_numpy()
+    iou = iou_xywh(dets[:, :4], gt) if len(dets) and len(gt) else np.zeros((len(dets), len(gt)))
+    got = np.zeros(len(dets)), np.full(len(dets), -1)
+    if iou.size:
+        r, c = linear_sum_assignment(iou, maximize=True)
+        ok = iou[r, c] > 0
+        got[0][r[ok]], got[1][r[ok]] = iou[r[ok], c[ok]], ids[c[ok]]
+    out = [(index, *d[:4], d[4], got[0][k], int(got[1][k])) for k, d in enumerate(dets)]
+    out += [(index, *g, np.nan, np.nan, int(i)) for g, i in zip(gt, ids)]
+    return out
+
+
+def fit_min_score(samples: pd.DataFrame, current: float) -> tuple[float | None, dict]:
+    """The detector threshold of highest F1 on the corrected boxes of the scanned frames (ties:
+    the one nearest ``current``), and a record (counts, F1 at ``current`` and at the fit); None
+    with fewer than :data:`MIN_PAIRS` true or :data:`MIN_FALSE` false detections."""
+    det = samples[samples["score"].notna()]
+    n_truth = int(samples["score"].isna().sum())
+    true = det["iou"].to_numpy() >= TRUE_IOU
+    scores = det["score"].to_numpy()
+    record = {"detections": int(len(det)), "true": int(true.sum()), "false": int((~true).sum()), "boxes": n_truth}
+
+    def f1(t: float) -> float:
+        tp, fp = int((true & (scores >= t)).sum()), int((~true & (scores >= t)).sum())
+        return 2 * tp / max(2 * tp + fp + (n_truth - tp), 1)
+
+    record["f1_current"] = round(f1(current), 4)
+    if true.sum() < MIN_PAIRS or (~true).sum() < MIN_FALSE:
+        return None, record
+    grid = np.round(np.arange(0.0, max(float(scores.max()), current) + 0.05, 0.05), 2)
+    values = np.array([f1(t) for t in grid])
+    best = grid[np.isclose(values, values.max())]
+    fitted = float(best[np.argmin(np.abs(best - current))])
+    record["f1_fitted"] = round(f1(fitted), 4)
+    return fitted, record
+
+
+def fit_shrink(samples: pd.DataFrame, current: tuple[float, float], min_score: float) -> tuple[float, float] | None:
+    """The body's share of the detector window: median corrected size over window size (the
+    detections were shrunk by ``current``) of the true detections at ``min_score``; None with
+    fewer than :data:`MIN_PAIRS`."""
+    det = samples[samples["score"].notna() & (samples["iou"] >= TRUE_IOU) & (samples["score"] >= min_score)]
+    truth = samples[samples["score"].isna()][["frame", "truth", "w", "h"]]
+    m = det.merge(truth, on=["frame", "truth"], suffixes=("", "_t"))
+    if len(m) < MIN_PAIRS:
+        return None
+    sw = current[0] * float(np.median(m.w_t / m.w))
+    sh = current[1] * float(np.median(m.h_t / m.h))
+    return (round(min(sw, 1.0), 3), round(min(sh, 1.0), 3))
+
+
+def _box_errors(a: pd.DataFrame, suffix: str = "_t") -> np.ndarray:
+    """Squared error of boxes against corrected ones, in the corrected box's height (centre) and
+    in log size, averaged over the four terms: how far off a person-box estimate is."""
+    h = a["h" + suffix]
+    dcx = (a.x + a.w / 2 - a["x" + suffix] - a["w" + suffix] / 2) / h
+    dcy = (a.y + a.h / 2 - a["y" + suffix] - h / 2) / h
+    return ((dcx ** 2 + dcy ** 2 + np.log(a.w / a["w" + suffix]) ** 2 + np.log(a.h / h) ** 2) / 4).to_numpy()
+
+
+def fit_steer(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
+              min_score: float) -> tuple[float | None, dict]:
+    """``detector.steer``, the share of the way a matched detection moves a track's person box,
+    as the blend of two noisy estimates of one box that errs least (the Kalman gain of a scalar
+    state): ``e_t / (e_t + e_d)``, with ``e_t`` the tracker's and ``e_d`` the detector's median
+    squared error (:func:`_box_errors`) against the corrected boxes: the tracker's person boxes
+    on frames where it is on the person, the detections at ``min_score`` matched to a corrected
+    box at IoU >= 0.3 (what the cue matches). To 0.05 in [0.1, 1]; None with fewer than
+    :data:`MIN_PAIRS` of either."""
+    det = samples[samples["score"].notna() & (samples["iou"] >= 0.3) & (samples["score"] >= min_score)]
+    truth_rows = samples[samples["score"].isna()][["frame", "truth", *XYWH]]
+    d = det.merge(truth_rows, on=["frame", "truth"], suffixes=("", "_t"))
+    pairs = []
+    for t, g in zip(tracked, truths):
+        t = t[t["part"] == "person"]
+        t = t[t["frame"] > t.groupby("track_id")["frame"].transform("min")]
+        g = g[g["part"] == "person"]
+        pairs.append(t[["frame", "track_id", *XYWH]].merge(g[["frame", "track_id", *XYWH]],
+                                                           on=["frame", "track_id"], suffixes=("", "_t")))
+    m = pd.concat(pairs, ignore_index=True) if pairs else pd.DataFrame(columns=["x", "x_t"])
+    if len(m):
+        cx, cy = m.x + m.w / 2, m.y + m.h / 2
+        m = m[(m.w > 0) & (m.h > 0) & (cx >= m.x_t) & (cx <= m.x_t + m.w_t) & (cy >= m.y_t) & (cy <= m.y_t + m.h_t)]
+    record = {"tracker_pairs": int(len(m)), "detector_pairs": int(len(d))}
+    if len(m) < MIN_PAIRS or len(d) < MIN_PAIRS:
+        return None, record
+    e_t, e_d = float(np.median(_box_errors(m))), float(np.median(_box_errors(d)))
+    record.update(tracker_error=round(e_t, 5), detector_error=round(e_d, 5))
+    gain = e_t / max(e_t + e_d, 1e-12)
+    return float(np.clip(round(gain * 20) / 20, 0.1, 1.0)), record
+
+
+# -- 3. when an undetected track ends -------------------------------------------------------------
+
+def fit_undetected_frames(samples: pd.DataFrame, min_score: float, every: int, fps: float) -> int | None:
+    """``detector.undetected_frames`` from how long corrected people went undetected: 1.5 times
+    the longest run of scans without a true detection (at ``min_score``) of 90 % of the corrected
+    tracks, plus one scan; None (leave it) with fewer than 3 tracks seen in 5 scans or more, or
+    when that is over :data:`MAX_UNDETECTED_S`."""
+    det = samples[samples["score"].notna() & (samples["iou"] >= TRUE_IOU) & (samples["score"] >= min_score)]
+    hit = set(zip(det["frame"], det["truth"]))
+    gaps = []
+    for tid, g in samples[samples["score"].isna()].groupby("truth"):
+        frames = np.sort(g["frame"].to_numpy())
+        if len(frames) < 5:
+            continue
+        run = longest = 0
+        for f in frames:
+            run = 0 if (f, tid) in hit else run + 1
+            longest = max(longest, run)
+        gaps.append(longest * every)
+    if len(gaps) < 3:
+        return None
+    value = int(np.ceil(1.5 * np.quantile(gaps, 0.9))) + every
+    return value if value <= MAX_UNDETECTED_S * fps else None
+
+
+def fit_leave_fraction(truths: list[pd.DataFrame], sizes: list[tuple[int, int]]) -> float | None:
+    """``detection.leave_fraction`` from where the corrected tracks begin and end at the frame's
+    sides: for each track whose first or last box lies within half its width (height) of a side
+    (top or bottom), that box's width (height) over the track's median, at most 1 (a person's box
+    cut by the frame is narrower); the median over those, to 0.05. None with fewer than 3 such
+    ends. Annotators who draw people only once wholly in view give about 1 (end a track as its
+    person starts to leave); those who draw the visible part of a person half out give less."""
+    shares = []
+    for truth, (W, H) in zip(truths, sizes):
+        t = truth[truth["part"] == "person"]
+        for _tid, g in t.groupby("track_id"):
+            if len(g) < 5:
+                continue
+            g = g.sort_values("frame")
+            mw, mh = float(g["w"].median()), float(g["h"].median())
+            for r in (g.iloc[0], g.iloc[-1]):
+                if min(r.x, W - r.x - r.w) <= 0.5 * r.w:
+                    shares.append(min(r.w / mw, 1.0))
+                elif min(r.y, H - r.y - r.h) <= 0.5 * r.h:
+                    shares.append(min(r.h / mh, 1.0))
+    if len(shares) < 3:
+        return None
+    return float(np.clip(round(np.median(shares) * 20) / 20, 0.05, 1.0))
+
+
+# -- 4. the dynamics ------------------------------------------------------------------------------
+
+def part_noise_from_person(noise: dict, person_rows: pd.DataFrame) -> dict:
+    """Each body part's position and velocity noise widened to the person box's fitted values
+    (rows of :func:`partlab.models.variance.fit_body_noise`'s table for part ``person``)."""
+    fitted = {r.parameter: r.fitted for r in person_rows.itertuples() if np.isfinite(r.fitted)}
+    out = dict(noise)
+    for part in BODY_PARTS:
+        if part in out:
+            out[part] = replace(out[part], **{k: max(getattr(out[part], k), float(v))
+                                              for k, v in fitted.items() if k in ("x", "y", "vx", "vy")})
+    return out
+
+
+# -- fitting and validation -----------------------------------------------------------------------
+
+@dataclass
+class PersonFit:
+    """What person boxes gave: candidate parameter changes by component, and the record."""
+
+    components: dict[str, dict] = field(default_factory=dict)
+    record: dict = field(default_factory=dict)
+
+
+def fit_person(clips, truths: list[pd.DataFrame], tracked: list[pd.DataFrame], base: BodyParams,
+               noise_table: pd.DataFrame | None = None, progress: Callable[[str], None] | None = None) -> PersonFit:
+    """Every fit above on the clips' person rows: ``components`` maps ``extent``, ``detector``,
+    ``ending`` and ``noise`` to the :meth:`BodyParams.updated` changes each would make (absent:
+    nothing fitted or the same as ``base``). ``tracked``: the tracker's runs with ``base``."""
+    step = progress or (lambda _msg: None)
+    out = PersonFit()
+    ext = fit_person_extent(tracked, truths, base.output.person)
+    out.record["person_extent"] = list(ext) if ext else None
+    if ext and ext != base.output.person:
+        out.components["extent"] = {"output.person": ext}
+    if base.detector.enabled:
+        samples = []
+        for (factory, _fps, _truth), truth, t in zip(clips, truths, tracked):
+            step("detections on the corrected frames")
+            samples.append(detection_samples(factory, truth, base, t))
+        s = pd.concat(samples, ignore_index=True)
+        det = base.detector
+        score, rec = fit_min_score(s, det.min_score)
+        shrink = fit_shrink(s, det.shrink, det.min_score if score is None else score)
+        out.record["detector"] = {**rec, "min_score": score, "shrink": list(shrink) if shrink else None}
+        changes = {}
+        if score is not None and score != det.min_score:
+            changes["detector.min_score"] = score
+        if shrink and shrink != det.shrink:
+            changes["detector.shrink"] = shrink
+        if changes:
+            out.components["detector"] = changes
+        steer, rec = fit_steer(s, tracked, truths, det.min_score if score is None else score)
+        out.record["steer"] = {**rec, "steer": steer}
+        if steer is not None and steer != det.steer:
+            out.components["steer"] = {"detector.steer": steer}
+        fps = float(clips[0][1])
+        undetected = fit_undetected_frames(s, det.min_score if score is None else score, det.every, fps)
+        out.record["undetected_frames"] = undetected
+        if undetected is not None and undetected != det.undetected_frames:
+            out.components.setdefault("ending", {})["detector.undetected_frames"] = undetected
+    sizes = [_frame_size(factory) for factory, _fps, _t in clips]
+    leave = fit_leave_fraction(truths, sizes)
+    out.record["leave_fraction"] = leave
+    if leave is not None and leave != base.detection.leave_fraction:
+        out.components.setdefault("ending", {})["detection.leave_fraction"] = leave
+    if noise_table is not None:
+        rows = noise_table[(noise_table["tracker"] == "body") & (noise_table["part"] == "person")]
+        noise = part_noise_from_person(base.dynamics.noise, rows)
+        if noise != base.dynamics.noise:
+            out.components["noise"] = {"dynamics.noise": noise}
+    return out
+
+
+def _frame_size(factory) -> tuple[int, int]:
+    for _index, frame in factory():
+        return frame.shape[1], frame.shape[0]
+    return 0, 0
+
+
+def person_edits(tracks: list[pd.DataFrame], truths: list[pd.DataFrame]) -> float:
+    """Edits per 100 corrected person boxes over all clips (:func:`~partlab.labelling.evaluation.count_edits`)."""
+    from partlab.labelling.evaluation import count_edits
+
+    edits = boxes = 0
+    for t, g in zip(tracks, truths):
+        e = count_edits(g, t, "person")
+        edits, boxes = edits + e.edits, boxes + e.truth_boxes
+    return 100.0 * edits / max(boxes, 1)
+
+
+def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[pd.DataFrame], base: BodyParams,
+                  fit: PersonFit, base_tracks: list[pd.DataFrame] | None = None,
+                  progress: Callable[[str], None] | None = None) -> tuple[BodyParams, dict]:
+    """Add the fitted components to ``base`` one at a time (detector, steer, extent, ending, noise),
+    keeping each only if the person-box edits on the training clips fall strictly below the best
+    so far (a tie keeps the simpler model): ``(params, record)``.
+
+    The detector goes first and the person extent is then refitted from the runs of the best
+    model so far: the detection cue steers each track's person box towards its detection, so
+    the extent that fits depends on the detector's window (fitted on the old window, both would
+    correct the same width twice)."""
+    step = progress or (lambda _msg: None)
+
+    def score(params, name):
+        step(f"validating {name}")
+        tracks = [run(i, params) for i in range(len(truths))]
+        return person_edits(tracks, truths), tracks
+
+    if base_tracks is None:
+        base_tracks = score(base, "start")[1]
+    scores = {"start": person_edits(base_tracks, truths)}
+    best, params, tracks, kept, used = scores["start"], base, base_tracks, {}, {}
+    for comp in ("detector", "steer", "extent", "ending", "noise"):
+        changes = fit.components.get(comp)
+        if comp == "extent" and (changes is not None or "detector" in kept):
+            ext = fit_person_extent(tracks, truths, params.output.person)
+            changes = {"output.person": ext} if ext and ext != params.output.person else None
+            fit.record["person_extent"] = list(ext) if ext else None
+        if changes is None:
+            continue
+        trial = params.updated(changes)
+        s, trial_tracks = score(trial, comp)
+        scores[f"+{comp}"] = s
+        kept[comp] = bool(s < best)
+        if kept[comp]:
+            best, params, tracks, used[comp] = s, trial, trial_tracks, changes
+    fields = sorted(f for changes in used.values() for f in changes)
+    return params, {"scores": {k: round(v, 3) for k, v in scores.items()}, "kept": kept, "fields": fields,
+                    "rule": "each fitted component is kept only if the edits per 100 corrected person boxes on "
+                            "the training clips fall strictly below the best so far"}
+
+
+def person_rows(record: dict) -> list[dict]:
+    """The summary's ``person`` record as rows ``component, edits/100, decision, fitted``: what was
+    fitted, the edits each component gave on the training clips and whether it was kept."""
+    det = record.get("detector") or {}
+    shrink = tuple(det["shrink"]) if det.get("shrink") else "-"
+    fitted = {
+        "detector": (f"min_score = {det.get('min_score')}, shrink = {shrink} ({det.get('true', 0)} true / "
+                     f"{det.get('false', 0)} false detections on {det.get('boxes', 0)} corrected boxes)")
+        if det else "-",
+        "steer": f"steer = {(record.get('steer') or {}).get('steer')} (median squared error: tracker "
+                 f"{(record.get('steer') or {}).get('tracker_error')}, detector "
+                 f"{(record.get('steer') or {}).get('detector_error')})",
+        "extent": f"output.person = {tuple(record['person_extent'])}" if record.get("person_extent") else "-",
+        "ending": f"undetected_frames = {record.get('undetected_frames')}, "
+                  f"leave_fraction = {record.get('leave_fraction')}",
+        "noise": "parts' position/velocity noise widened to the person's" if "noise" in record.get("fitted", [])
+        else "the person moves no faster than the parts' defaults",
+    }
+    scores, kept = record.get("scores", {}), record.get("kept", {})
+    rows = [dict(component="start", **{"edits/100": scores.get("start")}, decision="baseline", fitted="")]
+    for comp, text in fitted.items():
+        decision = ("kept" if kept.get(comp) else "dropped") if comp in kept else "not tried"
+        rows.append(dict(component=comp, **{"edits/100": scores.get(f"+{comp}")}, decision=decision, fitted=text))
+    return rows
+
+
+def person_table(record: dict) -> str:
+    """:func:`person_rows` as aligned text (``partlab train``)."""
+    lines = [f"{'component':9} {'edits/100':>9}  {'decision':10} fitted"]
+    for r in person_rows(record):
+        e = r["edits/100"]
+        lines.append(f"{r['component']:9} {e if e is not None else float('nan'):9.2f}  {r['decision']:10} "
+                     f"{r['fitted']}")
+    return "\n".join(lines)

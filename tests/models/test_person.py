@@ -1,0 +1,184 @@
+"""What person boxes alone teach the body tracker (partlab.models.person)."""
+
+import numpy as np
+import pandas as pd
+import pytest
+from walkers import walking_truth
+
+from partlab.models import person as P
+from partlab.tracking.params import BodyParams
+from partlab.tracking.tracks import normalise_tracks
+
+
+def _people(truth):
+    return truth[truth.part == "person"].reset_index(drop=True)
+
+
+def _scaled(df, sw, sh, dx=0.0, dy=0.0):
+    """``df``'s boxes scaled about their centres and shifted by fractions of the new size."""
+    out = df.copy()
+    cx, cy = df.x + df.w / 2 + dx * df.w * sw, df.y + df.h / 2 + dy * df.h * sh
+    out["w"], out["h"] = df.w * sw, df.h * sh
+    out["x"], out["y"] = cx - out.w / 2, cy - out.h / 2
+    return out
+
+
+def test_person_extent_maps_the_trackers_person_box_onto_the_drawn_one():
+    truth = _people(walking_truth(2, 30, seed=3))
+    # the tracker's person box: 0.8 x 0.9 of the drawn one, its centre 0.05 of its height too high
+    tracked = _scaled(truth, 0.8, 0.9, 0.0, -0.05)
+    ext = P.fit_person_extent([tracked], [truth], (1.0, 1.0, 0.0, 0.0))
+    assert ext == pytest.approx((1.25, 1 / 0.9, 0.0, 0.05), abs=2e-3)
+    # written with that extent, the tracker's box is the drawn one: the refit changes nothing
+    again = _scaled(tracked, ext[0], ext[1], ext[2] / ext[0], ext[3] / ext[1])
+    assert P.fit_person_extent([again], [truth], ext) == pytest.approx(ext, abs=2e-3)
+    # boxes whose centre is off the person are not evidence; too few pairs: nothing fitted
+    off = tracked.assign(x=tracked.x + 2 * tracked.w)
+    assert P.fit_person_extent([off], [truth], (1.0, 1.0, 0.0, 0.0)) is None
+
+
+def _samples(rng, n_true=60, n_false=30):
+    """Detections of 3 people on 40 scanned frames: true ones (on a corrected box) score about
+    1.0, false ones about 0.2; one person goes undetected for 8 scans running."""
+    rows = []
+    for f in range(0, 120, 3):
+        for tid in (1, 2, 3):
+            rows.append((f, 100.0 * tid, 50.0, 30.0, 80.0, np.nan, np.nan, tid))
+    truth = pd.DataFrame(rows, columns=["frame", "x", "y", "w", "h", "score", "iou", "truth"])
+    det = []
+    frames = truth.frame.unique()
+    for k in range(n_true):
+        f, tid = frames[k % len(frames)], 1 + k % 3
+        if tid == 3 and 30 <= f < 54:
+            continue  # person 3 undetected on 8 scans
+        det.append((f, 100.0 * tid + 1, 52.0, 27.0, 72.0, rng.normal(1.0, 0.2), 0.8, tid))
+    for k in range(n_false):
+        det.append((frames[k % len(frames)], 600.0, 40.0, 30.0, 80.0, abs(rng.normal(0.2, 0.1)), 0.0, -1))
+    return pd.concat([truth, pd.DataFrame(det, columns=truth.columns)], ignore_index=True)
+
+
+def test_detector_threshold_separates_true_from_false_detections_and_window_fits_the_body():
+    s = _samples(np.random.default_rng(0))
+    score, rec = P.fit_min_score(s, 0.0)
+    assert 0.35 <= score <= 0.75, score  # between the false (~0.2) and true (~1.0) scores
+    assert rec["f1_fitted"] > rec["f1_current"] and rec["false"] == 30
+    # the corrected boxes are 30 x 80, the detections (shrunk by 0.6 x 0.75) 27 x 72
+    assert P.fit_shrink(s, (0.6, 0.75), score) == pytest.approx((0.6 * 30 / 27, 0.75 * 80 / 72), abs=1e-3)
+    # too few false detections: the threshold is not refitted
+    assert P.fit_min_score(_samples(np.random.default_rng(0), n_false=3), 0.3)[0] is None
+
+
+def test_undetected_tracks_end_after_longer_than_corrected_people_went_undetected():
+    s = _samples(np.random.default_rng(1), n_true=120)
+    # persons 1 and 2 are found on every scan, person 3 missed 8 scans (24 frames) running
+    value = P.fit_undetected_frames(s, 0.0, every=3, fps=25.0)
+    assert value == int(np.ceil(1.5 * np.quantile([0, 0, 24], 0.9))) + 3
+    # a detector that misses people for many seconds cannot tell a ghost: left off
+    assert P.fit_undetected_frames(s, 0.0, every=3, fps=2.0) is None
+
+
+def test_part_noise_widens_to_the_person_boxes_motion_only():
+    noise = BodyParams().dynamics.noise
+    rows = pd.DataFrame([dict(parameter=k, fitted=v) for k, v in
+                         (("x", 6.0), ("y", 1.0), ("vx", 2.0), ("vy", np.nan), ("w", 9.0))])
+    out = P.part_noise_from_person(noise, rows)
+    for part in ("head", "torso", "hipleg"):
+        assert out[part].x == 6.0 and out[part].vx == 2.0  # wider than every default
+        assert out[part].y == noise[part].y and out[part].vy == noise[part].vy  # never narrowed, NaN ignored
+        assert out[part].w == noise[part].w  # sizes are the parts' own
+    assert out["person"] == noise["person"]
+
+
+def test_selection_keeps_only_what_lowers_the_edits():
+    truth = normalise_tracks(_people(walking_truth(2, 20, seed=5)))
+    calls = []
+
+    def run(_i, params):  # the 'tracker' reports the drawn box scaled by 0.6 unless output.person undoes it
+        calls.append(params)
+        sw, sh, _, _ = params.output.person
+        return _scaled(truth, 0.6 * sw, 0.6 * sh)
+
+    fit = P.PersonFit(components={"extent": {"output.person": (9.0, 9.0, 0.0, 0.0)},  # refitted from the runs
+                                  "ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(run, [truth], BodyParams(), fit)
+    assert rec["kept"] == {"extent": True, "ending": False}  # the ending changed nothing: a tie keeps the simpler
+    assert rec["scores"]["start"] == pytest.approx(100.0) and rec["scores"]["+extent"] == 0.0
+    assert params.output.person == pytest.approx((1 / 0.6, 1 / 0.6, 0.0, 0.0), abs=2e-3)
+    assert params.detector.undetected_frames == 0 and rec["fields"] == ["output.person"]
+    assert len(calls) == 3  # start, +extent, +ending
+
+
+def test_training_from_person_boxes_alone_recalibrates_a_wrong_person_box(tmp_path, capsys):
+    """A bundle whose person boxes are written at 0.6 of the parts' bounding box (a miscalibrated
+    start): training from the truth's person rows alone learns ``output.person`` back, validation
+    keeps it, ``partlab train`` says so; the same truth without the tracker is refused."""
+    from partlab.cli import main
+    from partlab.labelling.synth import make_scene
+    from partlab.labelling.video import write_video
+    from partlab.models.bundle import Bundle, load_bundle, save_bundle
+    from partlab.tracking.tracks import write_tracks_csv
+
+    scene = make_scene("single", seed=3, n_frames=40, width=320, height=240)
+    truth = scene.truth[scene.truth.part == "person"]
+    video = write_video(tmp_path / "walk.mp4", iter(scene.frames), scene.fps)
+    write_tracks_csv(truth, tmp_path / "people.csv")
+    start = BodyParams().updated({"output.person": (0.6, 0.6, 0.0, 0.0)})
+    save_bundle(Bundle(body_params=start, summary={"person": {"fields": ["output.person"]}}), tmp_path / "start")
+    args = ["train", "--clip", str(video), "--truth", str(tmp_path / "people.csv"), "--from", str(tmp_path / "start")]
+    assert main([*args, "-o", str(tmp_path / "b")]) == 0
+    text = capsys.readouterr().out
+    assert "person box extent (validated, from person boxes)" in text and "failure SVMs: none trained" in text
+    b = load_bundle(tmp_path / "b")
+    rec = b.summary["person"]
+    assert rec["kept"]["extent"] and rec["scores"]["+extent"] < rec["scores"]["start"] - 20, rec
+    # (the detection cue steers the parts so that the reported person box meets the detector's,
+    # so with the start's 0.6 the parts had grown: the refit is not simply 1 / 0.6)
+    sw, sh, _, _ = b.body_params.output.person
+    assert sw > 0.7 and sh > 0.7, (sw, sh)
+    assert b.failure_detector is None and b.summary["samples"]["total"] == 0
+    assert main([*args, "-o", str(tmp_path / "c"), "--no-tracker"]) == 2
+    assert "train without --no-tracker" in capsys.readouterr().err and not (tmp_path / "c").exists()
+
+
+def test_leave_fraction_is_how_much_of_a_person_is_in_view_where_corrections_begin_and_end():
+    rows = []
+    for tid in range(1, 5):  # walkers entering at the left side, cut by it, leaving at the right
+        for f in range(30):
+            x = -12.0 + 10 * f
+            visible = x + 30.0 - max(x, 0.0)  # the annotator draws the part in view
+            rows.append(dict(frame=f, track_id=tid, part="person", x=max(x, 0.0), y=50.0 + tid, w=visible, h=80.0))
+    truth = pd.DataFrame(rows)
+    # each first box shows 18 of 30 px: 0.6; each last one (x = 278, 12 px from the right side) is whole: 1.0
+    assert P.fit_leave_fraction([truth], [(320, 240)]) == pytest.approx(0.8)
+    whole = truth[truth.frame >= 2]  # drawn only once wholly in view, until they leave
+    assert P.fit_leave_fraction([whole], [(320, 240)]) == 1.0
+    assert P.fit_leave_fraction([whole[whole.track_id == 1]], [(320, 240)]) is None  # 2 ends: too few
+
+
+def test_steering_gain_blends_tracker_and_detector_by_their_errors():
+    truth = _people(walking_truth(3, 30, seed=7))
+    rng = np.random.default_rng(2)
+    # the tracker's person boxes err twice as far (in centre, per box height) as the detections
+    tracked = truth.assign(x=truth.x + rng.choice([-1, 1], len(truth)) * 0.10 * truth.h)
+    rows = [(r.frame, r.x + 0.05 * r.h * rng.choice([-1, 1]), r.y, r.w, r.h, 1.0, 0.8, r.track_id)
+            for r in truth.itertuples()]
+    rows += [(r.frame, r.x, r.y, r.w, r.h, np.nan, np.nan, r.track_id) for r in truth.itertuples()]
+    samples = pd.DataFrame(rows, columns=["frame", "x", "y", "w", "h", "score", "iou", "truth"])
+    gain, rec = P.fit_steer(samples, [tracked], [truth], 0.3)
+    # squared errors 0.01 / 4 and 0.0025 / 4: gain 0.01 / 0.0125 = 0.8
+    assert gain == pytest.approx(0.8) and rec["tracker_error"] == pytest.approx(0.0025, rel=1e-3)
+    assert P.fit_steer(samples[samples.score.isna()], [tracked], [truth], 0.3)[0] is None  # no detections
+
+
+def test_a_bundle_applies_the_person_box_fields_its_summary_lists_and_no_others(tmp_path):
+    from partlab.models.bundle import Bundle, load_bundle, save_bundle
+
+    body = BodyParams().updated({"output.person": (0.9, 1.1, 0.0, -0.02), "detector.steer": 0.7,
+                                 "detection.leave_fraction": 1.0})
+    save_bundle(Bundle(body_params=body, summary={"person": {"fields": ["output.person", "detector.steer"]}}),
+                tmp_path / "b")
+    loaded = load_bundle(tmp_path / "b").body_params
+    assert loaded.output.person == (0.9, 1.1, 0.0, -0.02) and loaded.detector.steer == 0.7
+    assert loaded.detection.leave_fraction == BodyParams().detection.leave_fraction  # not learnt: the default
+    save_bundle(Bundle(body_params=body), tmp_path / "c")  # a bundle that learnt none of them
+    assert load_bundle(tmp_path / "c").body_params.output.person == (1.0, 1.0, 0.0, 0.0)
