@@ -69,12 +69,9 @@ def person_only(truth: pd.DataFrame) -> bool:
 
 # -- 1. the person box around the parts ---------------------------------------------------------
 
-def fit_person_extent(tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
-                      current: tuple[float, float, float, float]) -> tuple[float, float, float, float] | None:
-    """New ``output.person`` from the tracker's person rows (written with ``current``) and the
-    corrected person boxes of the same clips and tracks; None with fewer than :data:`MIN_PAIRS`
-    frames where the tracker is on the person. A track's first frame (its drawn box) and boxes
-    touching the frame's edge (clipped) are left out."""
+def _person_pairs(tracked: list[pd.DataFrame], truths: list[pd.DataFrame], empty: pd.DataFrame) -> pd.DataFrame:
+    """The tracker's person boxes beside the corrected ones of the same frame and track (``x`` ..
+    and ``x_t`` ..), each track's first frame (its drawn box) left out; ``empty`` when no clip."""
     pairs = []
     for t, g in zip(tracked, truths):
         t = t[t["part"] == "person"]
@@ -82,7 +79,16 @@ def fit_person_extent(tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
         g = g[g["part"] == "person"]
         pairs.append(t[["frame", "track_id", *XYWH]].merge(g[["frame", "track_id", *XYWH]],
                                                            on=["frame", "track_id"], suffixes=("", "_t")))
-    m = pd.concat(pairs, ignore_index=True) if pairs else pd.DataFrame()
+    return pd.concat(pairs, ignore_index=True) if pairs else empty
+
+
+def fit_person_extent(tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
+                      current: tuple[float, float, float, float]) -> tuple[float, float, float, float] | None:
+    """New ``output.person`` from the tracker's person rows (written with ``current``) and the
+    corrected person boxes of the same clips and tracks; None with fewer than :data:`MIN_PAIRS`
+    frames where the tracker is on the person. A track's first frame (its drawn box) and boxes
+    touching the frame's edge (clipped) are left out."""
+    m = _person_pairs(tracked, truths, pd.DataFrame())
     if m.empty:
         return None
     m = m[(m.w > 1) & (m.h > 1) & (m.w_t > 0) & (m.h_t > 0) & (m.x > 0.5) & (m.y > 0.5)]
@@ -208,14 +214,7 @@ def fit_steer(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[p
     det = samples[samples["score"].notna() & (samples["iou"] >= 0.3) & (samples["score"] >= min_score)]
     truth_rows = samples[samples["score"].isna()][["frame", "truth", *XYWH]]
     d = det.merge(truth_rows, on=["frame", "truth"], suffixes=("", "_t"))
-    pairs = []
-    for t, g in zip(tracked, truths):
-        t = t[t["part"] == "person"]
-        t = t[t["frame"] > t.groupby("track_id")["frame"].transform("min")]
-        g = g[g["part"] == "person"]
-        pairs.append(t[["frame", "track_id", *XYWH]].merge(g[["frame", "track_id", *XYWH]],
-                                                           on=["frame", "track_id"], suffixes=("", "_t")))
-    m = pd.concat(pairs, ignore_index=True) if pairs else pd.DataFrame(columns=["x", "x_t"])
+    m = _person_pairs(tracked, truths, pd.DataFrame(columns=["x", "x_t"]))
     if len(m):
         cx, cy = m.x + m.w / 2, m.y + m.h / 2
         m = m[(m.w > 0) & (m.h > 0) & (cx >= m.x_t) & (cx <= m.x_t + m.w_t) & (cy >= m.y_t) & (cy <= m.y_t + m.h_t)]
