@@ -43,17 +43,19 @@ def no_interrupt() -> None:
 
 
 def _set_up_workers(c, local: bool) -> None:
-    """On every worker, now and on workers that join later: :func:`one_core`, and for a local
-    cluster :func:`no_interrupt`."""
+    """On every worker, now and on workers that join later: a local cluster's worker leaves Ctrl-C
+    to us (:func:`no_interrupt`; its threads are set by :data:`ONE_CORE_ENV` before it starts),
+    a worker started elsewhere is kept to one OpenCV thread (:func:`one_core`)."""
     from distributed.diagnostics.plugin import WorkerPlugin
 
     class PartlabWorker(WorkerPlugin):
         name = "partlab-worker"
 
         def setup(self, worker) -> None:
-            one_core()
             if local:
                 no_interrupt()
+            else:
+                one_core()
 
     c.register_plugin(PartlabWorker())
 
