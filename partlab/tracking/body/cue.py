@@ -55,6 +55,28 @@ def _target(part: Box, person: Box, det: Box) -> Box:
     return Box(dcx + (cx - pcx) * sx - w / 2, dcy + (cy - pcy) * sy - h / 2, w, h)
 
 
+def _layout(parts: dict[str, Box], person: Box) -> dict[str, tuple]:
+    """Each part box's centre offset from ``person``'s centre and its size, in the person box's
+    width and height."""
+    (pcx, pcy), pw, ph = person.centre, max(person.w, 1e-6), max(person.h, 1e-6)
+    return {n: ((b.centre[0] - pcx) / pw, (b.centre[1] - pcy) / ph, b.w / pw, b.h / ph) for n, b in parts.items()}
+
+
+def _placed(layout: tuple, det: Box) -> Box:
+    """A part box at its place ``layout`` (centre offset and size relative to the person box) in ``det``."""
+    rx, ry, rw, rh = layout
+    w, h = rw * det.w, rh * det.h
+    cx, cy = det.centre
+    return Box(cx + rx * det.w - w / 2, cy + ry * det.h - h / 2, w, h)
+
+
+def _blend(a: Box, b: Box, share: float) -> Box:
+    """``share`` of the way from box ``a`` to box ``b`` (centre and size)."""
+    (ax, ay), (bx, by) = a.centre, b.centre
+    w, h = a.w + share * (b.w - a.w), a.h + share * (b.h - a.h)
+    return Box(ax + share * (bx - ax) - w / 2, ay + share * (by - ay) - h / 2, w, h)
+
+
 class DetectionCue:
     """The detector, the unconfirmed detections and, per track, the frame a detection last
     matched it."""
@@ -167,9 +189,15 @@ class DetectionCue:
             # box never narrows while the head is not steered); down, the whole person
             across = minimum_bounding_rectangle(self.tracker.report_box(n, person.filters[n].box) for n in steered)
             reported = Box(across.x, reported.y, across.w, reported.h)
+        layout = self.p.steer_layout
+        if layout > 0 and not person.layout:  # the first detection of the track: its layout now
+            person.layout = _layout({n: person.filters[n].box for n in steered}, reported)
         for name in steered:
             f = person.filters[name]
-            f.steer(_target(f.box, reported, det), gain)
+            target = _target(f.box, reported, det)
+            if layout > 0 and name in person.layout:
+                target = _blend(target, _placed(person.layout[name], det), layout)
+            f.steer(target, gain)
         if follows:  # the head moves with the torso's correction, keeping its size and place on it
             person.filters["head"].shift(torso.state[0:2] - before)
 
