@@ -135,10 +135,10 @@ def test_a_person_smaller_than_the_track_region_is_found_at_their_size(monkeypat
     assert (x + w / 2, y + h / 2) == pytest.approx((115, 112), abs=1.5)
 
 
-def test_steering_places_the_parts_as_they_lay_in_the_person_at_its_first_detection():
-    """A hip-leg box grown below the feet (over a dark road) is put back where the body's layout
-    at the track's first detection says when a later detection steers the track; steered by the
-    current layout it keeps most of its grown height."""
+def test_steering_keeps_the_parts_near_their_proportions_at_the_first_detection():
+    """A hip-leg box grown below the feet (over a dark road) is brought back within
+    ``layout_tolerance`` of its share of the person at the track's first detection when a later
+    detection steers the track; without the tolerance it keeps most of its grown height."""
     import cv2
 
     from partlab.tracking.core.box import Box
@@ -147,17 +147,23 @@ def test_steering_places_the_parts_as_they_lay_in_the_person_at_its_first_detect
     frame[60:160, 140:170] = (40, 60, 200)
     frame = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
     start = {"head": Box(148, 60, 14, 14), "torso": Box(142, 75, 26, 35), "hipleg": Box(143, 110, 24, 50)}
-    hip_h = {}
-    for layout in (0.0, 1.0):
-        params = BodyParams().updated({"detector.steer_layout": layout})
+    grown = {}
+    for tolerance in (0.0, 1.25):
+        params = BodyParams().updated({"detector.layout_tolerance": tolerance})
         t = BodyTracker(params, np.random.default_rng(0))
         person = t.start_track(1, dict(start), frame, None, 0)
         hip = person.filters["hipleg"]
         first, det = hip.box, t._reported_person_box(person)  # the detector sees the person as at the start
         t.cue._steer(person, det, det, 1.0)  # the first detection: nothing moves
         assert hip.box.as_tuple() == pytest.approx(first.as_tuple())
-        hip.steer(Box(first.x, first.y, first.w, first.h * 1.6), 1.0)  # drifted below the feet
+        hip.steer(Box(first.x, first.y, first.w, first.h * 2.0), 1.0)  # drifted below the feet
         t.cue._steer(person, t._reported_person_box(person), det, 1.0)
-        hip_h[layout] = hip.box.h / first.h
-    assert hip_h[0.0] > 1.2  # shrunk only by the person's height ratio (1.6 -> 1.27)
-    assert hip_h[1.0] == pytest.approx(1.0, abs=0.01)
+        grown[tolerance] = (hip.box.w / first.w, hip.box.h / first.h)
+    assert grown[0.0][1] > 1.4  # shrunk only by the person's height ratio
+    assert grown[1.25][1] == pytest.approx(1.25, abs=0.01)
+    assert grown[1.25][0] == pytest.approx(grown[0.0][0])  # the width had not drifted
+
+
+def test_layout_tolerance_is_checked():
+    with pytest.raises(ValueError, match="detector.layout_tolerance"):
+        BodyParams().updated({"detector.layout_tolerance": 0.8})

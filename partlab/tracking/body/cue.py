@@ -70,11 +70,13 @@ def _placed(layout: tuple, det: Box) -> Box:
     return Box(cx + rx * det.w - w / 2, cy + ry * det.h - h / 2, w, h)
 
 
-def _blend(a: Box, b: Box, share: float) -> Box:
-    """``share`` of the way from box ``a`` to box ``b`` (centre and size)."""
-    (ax, ay), (bx, by) = a.centre, b.centre
-    w, h = a.w + share * (b.w - a.w), a.h + share * (b.h - a.h)
-    return Box(ax + share * (bx - ax) - w / 2, ay + share * (by - ay) - h / 2, w, h)
+def _within(box: Box, layout: Box, tolerance: float) -> Box:
+    """``box`` with its width and height brought within ``tolerance`` times those of ``layout``
+    (same centre)."""
+    w = min(max(box.w, layout.w / tolerance), layout.w * tolerance)
+    h = min(max(box.h, layout.h / tolerance), layout.h * tolerance)
+    cx, cy = box.centre
+    return Box(cx - w / 2, cy - h / 2, w, h)
 
 
 class DetectionCue:
@@ -189,14 +191,14 @@ class DetectionCue:
             # box never narrows while the head is not steered); down, the whole person
             across = minimum_bounding_rectangle(self.tracker.report_box(n, person.filters[n].box) for n in steered)
             reported = Box(across.x, reported.y, across.w, reported.h)
-        layout = self.p.steer_layout
-        if layout > 0 and not person.layout:  # the first detection of the track: its layout now
+        tolerance = self.p.layout_tolerance
+        if tolerance > 0 and not person.layout:  # the first detection of the track: its layout now
             person.layout = _layout({n: person.filters[n].box for n in steered}, reported)
         for name in steered:
             f = person.filters[name]
             target = _target(f.box, reported, det)
-            if layout > 0 and name in person.layout:
-                target = _blend(target, _placed(person.layout[name], det), layout)
+            if tolerance > 0 and name in person.layout:
+                target = _within(target, _placed(person.layout[name], det), tolerance)
             f.steer(target, gain)
         if follows:  # the head moves with the torso's correction, keeping its size and place on it
             person.filters["head"].shift(torso.state[0:2] - before)
