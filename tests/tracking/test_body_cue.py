@@ -85,3 +85,85 @@ def test_detector_parameters_are_checked():
         BodyParams().updated({"detector.confirm_hits": 4, "detector.confirm_window": 3})
     with pytest.raises(ValueError, match="detector.scale_step"):
         BodyParams().updated({"detector.scale_step": 1.0})
+
+
+class _OnePersonHOG:
+    """Stands in for OpenCV's HOG on a frame holding one person ``height`` px tall centred at
+    ``centre``: like ``detectMultiScale`` it only tries windows of 128 px and up in the image it
+    gets (a pyramid from scale 1), and answers with the smallest window that holds the person's
+    body (three quarters of the window's height), scored higher the better it fits. ``crops``:
+    (x0, y0, f) of each call, recorded by the test."""
+
+    def __init__(self, centre, height, crops):
+        self.centre, self.height, self.crops = np.asarray(centre, float), height, crops
+
+    def detectMultiScale(self, img, winStride, padding, scale):
+        x0, y0, f = self.crops[-1]
+        body = self.height * f  # the person's height in the resized crop
+        win_h = max(128.0, body / 0.75)
+        cx, cy = (self.centre - (x0, y0)) * f
+        return np.array([[cx - win_h / 4, cy - win_h / 2, win_h / 2, win_h]]), np.array([[2 * body / 0.75 / win_h]])
+
+
+def test_a_person_smaller_than_the_track_region_is_found_at_their_size(monkeypatch):
+    """A walker going away inside a track's box grown with them: the region scan's smallest window
+    is larger than the person; the finer scan around it finds the window that fits."""
+    from partlab.tracking.core.box import Box
+    from partlab.tracking.core.people import PeopleDetector
+
+    frame = np.zeros((240, 360, 3), np.uint8)
+    region = Box(100, 80, 30, 64)  # the track's box; the person is 40 px tall inside it
+    found = {}
+    for finer in (1.0, 0.7):
+        det = PeopleDetector(BodyParams().updated({"detector.finer": finer}).detector.scan())
+        crops = []
+        real_scan = det._scan
+
+        def scan(frame, crop, f, real_scan=real_scan, crops=crops):
+            crops.append((int(crop.x), int(crop.y), f))
+            return real_scan(frame, crop, f)
+
+        monkeypatch.setattr(det, "_scan", scan)
+        det.hog = _OnePersonHOG((115, 112), 40.0, crops)
+        found[finer] = det.detect(frame, [region])
+        assert len(found[finer]) == 1
+        assert len(crops) == (1 if finer == 1 else 2)
+    # region 64 px tall: at fill 1.2 the smallest window holds a body of 64 / 1.2 = 53 px
+    assert found[1.0][0, 3] == pytest.approx(64 / 1.2, rel=0.02)
+    x, y, w, h, _ = found[0.7][0]
+    assert h == pytest.approx(40, rel=0.02)
+    assert (x + w / 2, y + h / 2) == pytest.approx((115, 112), abs=1.5)
+
+
+def test_steering_keeps_the_parts_near_their_proportions_at_the_first_detection():
+    """A hip-leg box grown below the feet (over a dark road) is brought back within
+    ``layout_tolerance`` of its share of the person at the track's first detection when a later
+    detection steers the track; without the tolerance it keeps most of its grown height."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    frame = np.full((240, 320, 3), 90, np.uint8)
+    frame[60:160, 140:170] = (40, 60, 200)
+    frame = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    start = {"head": Box(148, 60, 14, 14), "torso": Box(142, 75, 26, 35), "hipleg": Box(143, 110, 24, 50)}
+    grown = {}
+    for tolerance in (0.0, 1.25):
+        params = BodyParams().updated({"detector.layout_tolerance": tolerance})
+        t = BodyTracker(params, np.random.default_rng(0))
+        person = t.start_track(1, dict(start), frame, None, 0)
+        hip = person.filters["hipleg"]
+        first, det = hip.box, t._reported_person_box(person)  # the detector sees the person as at the start
+        t.cue._steer(person, det, det, 1.0)  # the first detection: nothing moves
+        assert hip.box.as_tuple() == pytest.approx(first.as_tuple())
+        hip.steer(Box(first.x, first.y, first.w, first.h * 2.0), 1.0)  # drifted below the feet
+        t.cue._steer(person, t._reported_person_box(person), det, 1.0)
+        grown[tolerance] = (hip.box.w / first.w, hip.box.h / first.h)
+    assert grown[0.0][1] > 1.4  # shrunk only by the person's height ratio
+    assert grown[1.25][1] == pytest.approx(1.25, abs=0.01)
+    assert grown[1.25][0] == pytest.approx(grown[0.0][0])  # the width had not drifted
+
+
+def test_layout_tolerance_is_checked():
+    with pytest.raises(ValueError, match="detector.layout_tolerance"):
+        BodyParams().updated({"detector.layout_tolerance": 0.8})

@@ -55,6 +55,30 @@ def _target(part: Box, person: Box, det: Box) -> Box:
     return Box(dcx + (cx - pcx) * sx - w / 2, dcy + (cy - pcy) * sy - h / 2, w, h)
 
 
+def _layout(parts: dict[str, Box], person: Box) -> dict[str, tuple]:
+    """Each part box's centre offset from ``person``'s centre and its size, in the person box's
+    width and height."""
+    (pcx, pcy), pw, ph = person.centre, max(person.w, 1e-6), max(person.h, 1e-6)
+    return {n: ((b.centre[0] - pcx) / pw, (b.centre[1] - pcy) / ph, b.w / pw, b.h / ph) for n, b in parts.items()}
+
+
+def _placed(layout: tuple, det: Box) -> Box:
+    """A part box at its place ``layout`` (centre offset and size relative to the person box) in ``det``."""
+    rx, ry, rw, rh = layout
+    w, h = rw * det.w, rh * det.h
+    cx, cy = det.centre
+    return Box(cx + rx * det.w - w / 2, cy + ry * det.h - h / 2, w, h)
+
+
+def _within(box: Box, layout: Box, tolerance: float) -> Box:
+    """``box`` with its width and height brought within ``tolerance`` times those of ``layout``
+    (same centre)."""
+    w = min(max(box.w, layout.w / tolerance), layout.w * tolerance)
+    h = min(max(box.h, layout.h / tolerance), layout.h * tolerance)
+    cx, cy = box.centre
+    return Box(cx - w / 2, cy - h / 2, w, h)
+
+
 class DetectionCue:
     """The detector, the unconfirmed detections and, per track, the frame a detection last
     matched it."""
@@ -167,9 +191,15 @@ class DetectionCue:
             # box never narrows while the head is not steered); down, the whole person
             across = minimum_bounding_rectangle(self.tracker.report_box(n, person.filters[n].box) for n in steered)
             reported = Box(across.x, reported.y, across.w, reported.h)
+        tolerance = self.p.layout_tolerance
+        if tolerance > 0 and not person.layout:  # the first detection of the track: its layout now
+            person.layout = _layout({n: person.filters[n].box for n in steered}, reported)
         for name in steered:
             f = person.filters[name]
-            f.steer(_target(f.box, reported, det), gain)
+            target = _target(f.box, reported, det)
+            if tolerance > 0 and name in person.layout:
+                target = _within(target, _placed(person.layout[name], det), tolerance)
+            f.steer(target, gain)
         if follows:  # the head moves with the torso's correction, keeping its size and place on it
             person.filters["head"].shift(torso.state[0:2] - before)
 

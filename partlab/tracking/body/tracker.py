@@ -97,6 +97,7 @@ class Person:
     occluded_frames: int = 0
     offsets: dict[str, float] = field(default_factory=dict)  # part Y - torso Y, in torso heights
     lost_since: int | None = None           # frame it went lost (no foreground support), coasting since
+    layout: dict[str, tuple] = field(default_factory=dict)  # parts in the person box at its first detection
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames

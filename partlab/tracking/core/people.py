@@ -45,6 +45,7 @@ class RegionScan:
     nms: float
     shrink: tuple[float, float]
     max_upscale: float
+    finer: float = 1.0
 
 
 class PeopleDetector:
@@ -94,21 +95,12 @@ class PeopleDetector:
         rects, scores = [], []
         for crop, ref_h in self.crops(regions, W, H):
             f = min(s.fill * WINDOW[1] * s.shrink[1] / ref_h, s.max_upscale)
-            x0, y0 = int(crop.x), int(crop.y)
-            x1, y1 = int(np.ceil(crop.x2)), int(np.ceil(crop.y2))
-            img = frame[y0:y1, x0:x1]
-            img = cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_LINEAR if f > 1 else cv2.INTER_AREA)
-            if img.shape[0] < WINDOW[1] or img.shape[1] < WINDOW[0]:
-                img = cv2.copyMakeBorder(img, 0, max(WINDOW[1] - img.shape[0], 0), 0,
-                                         max(WINDOW[0] - img.shape[1], 0), cv2.BORDER_REPLICATE)
-            r, w = self.hog.detectMultiScale(img, winStride=(8, 8), padding=(8, 8), scale=s.scale_step)
-            if len(r) == 0:
-                continue
-            r = np.asarray(r, np.float64) / f
-            r[:, 0] += x0
-            r[:, 1] += y0
-            rects.append(r)
-            scores.append(np.asarray(w, np.float64).ravel())
+            r, w = self._scan(frame, crop, f)
+            if len(r) and s.finer < 1 and f < s.max_upscale:
+                r, w = self._finer(frame, r, w, f)
+            if len(r):
+                rects.append(r)
+                scores.append(w)
         if not rects:
             return np.zeros((0, 5))
         r, w = np.concatenate(rects), np.concatenate(scores)
@@ -123,6 +115,46 @@ class PeopleDetector:
         boxes = np.stack([cx - bw / 2, cy - bh / 2, bw, bh], axis=1)
         keep = _nms(boxes, w, s.nms)
         return np.concatenate([boxes[keep], w[keep, None]], axis=1)
+
+    def _scan(self, frame: np.ndarray, crop: Box, f: float) -> tuple[np.ndarray, np.ndarray]:
+        """Windows ``(N, 4)`` (frame pixels) and scores HOG finds in ``crop`` of ``frame`` resized by ``f``."""
+        x0, y0 = int(crop.x), int(crop.y)
+        x1, y1 = int(np.ceil(crop.x2)), int(np.ceil(crop.y2))
+        img = frame[y0:y1, x0:x1]
+        img = cv2.resize(img, None, fx=f, fy=f, interpolation=cv2.INTER_LINEAR if f > 1 else cv2.INTER_AREA)
+        if img.shape[0] < WINDOW[1] or img.shape[1] < WINDOW[0]:
+            img = cv2.copyMakeBorder(img, 0, max(WINDOW[1] - img.shape[0], 0), 0,
+                                     max(WINDOW[0] - img.shape[1], 0), cv2.BORDER_REPLICATE)
+        r, w = self.hog.detectMultiScale(img, winStride=(8, 8), padding=(8, 8), scale=self.scan.scale_step)
+        if len(r) == 0:
+            return np.zeros((0, 4)), np.zeros(0)
+        r = np.asarray(r, np.float64) / f
+        r[:, 0] += x0
+        r[:, 1] += y0
+        return r, np.asarray(w, np.float64).ravel()
+
+    def _finer(self, frame: np.ndarray, r: np.ndarray, w: np.ndarray, f: float) -> tuple[np.ndarray, np.ndarray]:
+        """The windows of the scan's smallest scale (the person may be smaller than any window
+        it tried: a walker going away from the camera inside a track's box) scanned again, each
+        around itself, ``finer`` times smaller; their windows join the scan's."""
+        s = self.scan
+        H, W = frame.shape[:2]
+        smallest = WINDOW[1] / f * s.scale_step ** 0.5
+        at_min = r[:, 3] <= smallest
+        if not at_min.any() or w[at_min].max() < s.min_score:
+            return r, w
+        f2 = min(f / s.finer, s.max_upscale)
+        out_r, out_w = [r], [w]
+        for x, y, ww, hh in r[at_min & (w >= s.min_score)]:
+            m = s.margin * hh
+            crop = Box(x - m, y - m, ww + 2 * m, hh + 2 * m).clip(W, H)
+            if crop.w < 8 or crop.h < 8:
+                continue
+            r2, w2 = self._scan(frame, crop, f2)
+            small = r2[:, 3] < hh / s.scale_step ** 0.5 if len(r2) else np.zeros(0, bool)
+            out_r.append(r2[small])
+            out_w.append(w2[small])
+        return np.concatenate(out_r), np.concatenate(out_w)
 
 
 def _nms(boxes: np.ndarray, scores: np.ndarray, threshold: float) -> np.ndarray:
