@@ -71,6 +71,12 @@ def test_table_one_read_per_colour():
     v = two_hands({shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, False, P)
     assert v.kind == "handshake" and v.colour is None
     assert two_hands({}, {}, {}, {}, True, P).kind == "clap"
+    # a colour that stays around one hand (the trousers it hangs by) leaves a handshake sure; one
+    # that half changed hands (the giver keeps half of it, the other gains it) does not
+    sure = two_hands({blue: 0.34}, {shirt: 0.6}, {blue: 0.15}, {shirt: 0.45}, False, P)
+    assert sure.kind == "handshake" and sure.margin == pytest.approx(1.0)
+    unsure = two_hands({green: 0.4}, {}, {green: 0.2}, {green: 0.3}, False, P)
+    assert unsure.kind == "handshake" and unsure.margin < P.decision.min_confidence < sure.margin
     assert one_hand({}, {blue: 0.4}, P).kind == "pick"
     assert one_hand({blue: 0.4, shirt: 0.2}, {shirt: 0.2}, P).kind == "place"
     assert one_hand({shirt: 0.2}, {shirt: 0.2}, P) is None
