@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -26,8 +27,7 @@ from partlab.tracking.activities.objects import (
     HUE_BINS,
     HandColour,
     body_colours,
-    colour_masses,
-    fuse,
+    fuse_views,
     hand_colour,
     hue_to_hex,
 )
@@ -74,7 +74,8 @@ class ActivityTracker:
                 self._clothes_n[r.track_id] += 1
                 continue
             key = (r.track_id, r.part)
-            seen = hand_colour(view.color, foreground.get(stream), r.box, self.activity_params)
+            seen = replace(hand_colour(view.color, foreground.get(stream), r.box, self.activity_params),
+                           view=stream, visible=_visible(r.occluded))
             self._colours[key][r.frame].append(seen)
             if stream == next(iter(frames.views)):  # still moments are measured in the first view
                 self._centres[key][r.frame] = (r.box.x + r.box.w / 2, r.box.y + r.box.h / 2, max(r.box.w, r.box.h))
@@ -89,8 +90,32 @@ class ActivityTracker:
         joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
         clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
                    for t, n in self._clothes_n.items()}
-        self.events = recognise(joins, self._colours, self._centres, self.activity_params, clothes, self._where)
+        centres = {k: bridge_gaps(c, self.activity_params) for k, c in self._centres.items()}
+        self.events = recognise(joins, self._colours, centres, self.activity_params, clothes, self._where)
         return out
+
+
+def bridge_gaps(centres: Mapping[int, tuple[float, float, float]], params: ActivityParams) -> dict[int, tuple]:
+    """``centres`` with the short losses bridged: where a hand was unseen for at most
+    ``bridge_frames`` frames and is seen again within ``bridge_size`` hand sides of where it was
+    last seen, it is put where it was seen again over the unseen frames (a tracker loses a hand
+    that moved away from its estimate, and finds it where it went). Longer or farther losses stay
+    unseen."""
+    d = params.decision
+    out = dict(centres)
+    frames = sorted(centres)
+    for f0, f1 in zip(frames, frames[1:]):
+        if not 1 < f1 - f0 <= d.bridge_frames + 1:
+            continue
+        (x0, y0, s0), (x1, y1, s1) = centres[f0], centres[f1]
+        if np.hypot(x1 - x0, y1 - y0) <= d.bridge_size * max(s0, s1):
+            out.update({f: centres[f1] for f in range(f0 + 1, f1)})
+    return out
+
+
+def _visible(occluded: float) -> float:
+    """How much of a hand a record says is seen (trackers that do not say: all of it)."""
+    return 1.0 if not np.isfinite(occluded) else float(np.clip(1.0 - occluded, 0.0, 1.0))
 
 
 def clothes_hues(shares: np.ndarray, params: ActivityParams) -> np.ndarray:
@@ -112,7 +137,7 @@ def _held(colours: dict[int, list[HandColour]], lo: int, hi: int, params: Activi
     obs = [o for f in range(lo, hi + 1) for o in colours.get(f, ())]
     if len(obs) < max(2, params.decision.window // 3):
         return None
-    return colour_masses(fuse(obs), params)
+    return fuse_views(obs, params)
 
 
 def _held_seen(colours: dict[int, list[HandColour]], lo: int, hi: int, away: int,
