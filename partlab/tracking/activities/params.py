@@ -64,7 +64,9 @@ class Decision:
     # frames between the join (or the still moment) and each window: the paper's "a few frames"
     # for the hands to be apart again
     gap: int = number(3, POSITIVE_COUNT)
-    # a colour is held at a decision point when its share of the fused distribution is at least this
+    # a colour is held at a decision point when its share of the fused distribution is at least this:
+    # an object about 0.75 hand radii across in the circle of ``region.radius`` (2.6) hand radii
+    # (the 3-camera takes' 38-48 mm objects cover about 0.10 of it; 0.12 missed them)
     min_mass: float = number(0.08, FRACTION)
     # ... and not held when it is below this, or below ``absent_ratio`` of its share at the other
     # decision point (the object already near the hand before it is picked up); between: no decision
