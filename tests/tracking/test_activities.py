@@ -98,6 +98,23 @@ def test_a_short_loss_near_where_the_hand_was_is_bridged():
     assert any(a <= 10 and b >= 38 for a, b in still_moments(b, P))
 
 
+def test_a_colour_that_stays_put_did_not_change_hands():
+    from partlab.tracking.activities.recognise import _stayed_put
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    centres = {a: {f: (300.0, 420.0, 15.0) for f in range(0, 60)}, b: {f: (400.0, 370.0, 15.0) for f in range(0, 60)}}
+    windows = ((10, 17), (40, 47))
+    # tracks that swapped while the hands touched: the blue trousers by a's hand before are, after,
+    # around "b's" hand at the same place
+    swapped = {a: {f: ((112, 304.0, 430.0),) for f in range(10, 18)},
+               b: {f: ((112, 303.0, 428.0),) for f in range(40, 48)}}
+    assert _stayed_put(swapped, centres, a, b, 112, windows, P)
+    # an object given: by a's hand before, by b's hand (100 px away) after
+    given = {a: {f: ((40, 302.0, 428.0),) for f in range(10, 18)},
+             b: {f: ((40, 402.0, 378.0),) for f in range(40, 48)}}
+    assert not _stayed_put(given, centres, a, b, 40, windows, P)
+
+
 def test_table_one_read_per_colour():
     green, blue, shirt = 40, 110, 150
     assert two_hands({green: 0.3}, {}, {}, {green: 0.3}, False, P).kind == "exchange"
