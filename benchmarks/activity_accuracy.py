@@ -50,7 +50,8 @@ def _seeds(text: str) -> list[int]:
 
 
 class TruthHands:
-    """A 'tracker' that reports the scene's true head and hand boxes (wherever some of the part is seen)."""
+    """A 'tracker' that reports the scene's true head and hand boxes (wherever some of the part is
+    seen), with the truth's share of each that is hidden (``occluded``)."""
 
     events = None
 
@@ -66,6 +67,7 @@ class TruthHands:
         if g is None:
             return []
         return [TrackRecord(frames.index, int(r.track_id), r.part, Box(r.x, r.y, r.w, r.h), state="truth",
+                            occluded=float(r.occluded),
                             camera=getattr(r, "camera", "") or "", X=getattr(r, "X", float("nan")),
                             Y=getattr(r, "Y", float("nan")), Z=getattr(r, "Z", float("nan")))
                 for r in g.itertuples()]

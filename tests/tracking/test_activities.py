@@ -8,9 +8,9 @@ import pytest
 
 from partlab.labelling.events import evaluate_events, temporal_iou
 from partlab.labelling.synth import make_scene
-from partlab.tracking.activities.objects import colour_masses, fuse, hand_colour
+from partlab.tracking.activities.objects import HUE_BINS, HandColour, colour_masses, fuse, fuse_views, hand_colour
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.recognise import contacts, merged_joins, stays_behind, still_moments
+from partlab.tracking.activities.recognise import bridge_gaps, contacts, merged_joins, stays_behind, still_moments
 from partlab.tracking.activities.table import one_hand, two_hands
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
@@ -63,6 +63,58 @@ def test_reliability_is_higher_for_a_hand_held_away_from_the_body():
     assert out.rho > inside.rho + 0.3 and inside.rho == pytest.approx(P.reliability.rho_min)
 
 
+def _seen(view: str, hue: int, share: float, visible: float = 1.0) -> HandColour:
+    shares = np.zeros(HUE_BINS)
+    shares[hue] = share
+    return HandColour(shares, 0.6, view=view, visible=visible)
+
+
+def test_views_that_see_one_colour_a_little_differently_fuse_into_one():
+    # a yellow object at 27, 29 and 35 bins in three cameras (their white balance): bin by bin its
+    # share splits over two colours below min_mass; matched across views it is one of its share
+    obs = [_seen("a", 29, 0.11), _seen("b", 27, 0.11), _seen("c", 35, 0.10)] * 4
+    split = colour_masses(fuse(obs), P)
+    assert max(split.values()) < P.decision.min_mass
+    (hue, mass), = fuse_views(obs, P).items()
+    assert 28 <= hue <= 32 and mass == pytest.approx(0.107, abs=0.002)
+    # two colours far apart stay two; one view: eq. 29 as it is
+    two = fuse_views([_seen("a", 29, 0.2), _seen("b", 100, 0.3)], P)
+    assert sorted(two) == [29, 100] and two[29] == pytest.approx(0.1)
+    assert fuse_views([_seen("a", 29, 0.2)] * 2, P) == colour_masses(fuse([_seen("a", 29, 0.2)] * 2), P)
+    # a view where the hand is mostly hidden (behind the other person's shirt) weighs little
+    hidden = fuse_views([_seen("a", 29, 0.2), _seen("b", 150, 0.9, visible=0.05)], P)
+    assert hidden[150] < P.decision.min_mass < hidden[29]
+
+
+def test_a_short_loss_near_where_the_hand_was_is_bridged():
+    c = {f: (100.0, 100.0, 30.0) for f in range(0, 10)}
+    c.update({f: (120.0, 105.0, 30.0) for f in range(25, 40)})  # lost 10-24, found 21 px away
+    c.update({f: (300.0, 100.0, 30.0) for f in range(45, 50)})  # lost 40-44, found 6 hand sides away
+    b = bridge_gaps(c, P)
+    assert all(b[f] == (120.0, 105.0, 30.0) for f in range(10, 25))
+    assert not any(f in b for f in range(40, 45))
+    # the hand stood still from frame 10 (lost there) to 39: unbridged its still moment starts at 26
+    assert [m for m in still_moments(c, P) if m[1] >= 30] == [(26, 38)]
+    assert any(a <= 10 and b >= 38 for a, b in still_moments(b, P))
+
+
+def test_a_colour_that_stays_put_did_not_change_hands():
+    from partlab.tracking.activities.recognise import _stayed_put
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    centres = {a: {f: (300.0, 420.0, 15.0) for f in range(0, 60)}, b: {f: (400.0, 370.0, 15.0) for f in range(0, 60)}}
+    windows = ((10, 17), (40, 47))
+    # tracks that swapped while the hands touched: the blue trousers by a's hand before are, after,
+    # around "b's" hand at the same place
+    swapped = {a: {f: ((112, 304.0, 430.0),) for f in range(10, 18)},
+               b: {f: ((112, 303.0, 428.0),) for f in range(40, 48)}}
+    assert _stayed_put(swapped, centres, a, b, 112, windows, P)
+    # an object given: by a's hand before, by b's hand (100 px away) after
+    given = {a: {f: ((40, 302.0, 428.0),) for f in range(10, 18)},
+             b: {f: ((40, 402.0, 378.0),) for f in range(40, 48)}}
+    assert not _stayed_put(given, centres, a, b, 40, windows, P)
+
+
 def test_table_one_read_per_colour():
     green, blue, shirt = 40, 110, 150
     assert two_hands({green: 0.3}, {}, {}, {green: 0.3}, False, P).kind == "exchange"
@@ -71,6 +123,12 @@ def test_table_one_read_per_colour():
     v = two_hands({shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, {shirt: 0.3}, False, P)
     assert v.kind == "handshake" and v.colour is None
     assert two_hands({}, {}, {}, {}, True, P).kind == "clap"
+    # a colour that stays around one hand (the trousers it hangs by) leaves a handshake sure; one
+    # that half changed hands (the giver keeps half of it, the other gains it) does not
+    sure = two_hands({blue: 0.34}, {shirt: 0.6}, {blue: 0.15}, {shirt: 0.45}, False, P)
+    assert sure.kind == "handshake" and sure.margin == pytest.approx(1.0)
+    unsure = two_hands({green: 0.4}, {}, {green: 0.2}, {green: 0.3}, False, P)
+    assert unsure.kind == "handshake" and unsure.margin < P.decision.min_confidence < sure.margin
     assert one_hand({}, {blue: 0.4}, P).kind == "pick"
     assert one_hand({blue: 0.4, shirt: 0.2}, {shirt: 0.2}, P).kind == "place"
     assert one_hand({shirt: 0.2}, {shirt: 0.2}, P) is None

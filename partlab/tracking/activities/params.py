@@ -42,6 +42,10 @@ class Modes:
     # a colour covering at least this share of the region below the person's head (their clothes,
     # averaged over the run) is not taken for an object
     clothes_share: float = number(0.04, FRACTION)
+    # two cameras may see one colour this many degrees apart (their white balance differs: a 10 %
+    # cast on red moves a yellow by about 10 degrees); colours of different views this close are
+    # one colour when a hand's views are fused (eq. 29)
+    view_hue_shift: float = number(20.0, POSITIVE)
 
 
 @dataclass(frozen=True)
@@ -60,8 +64,10 @@ class Decision:
     # frames between the join (or the still moment) and each window: the paper's "a few frames"
     # for the hands to be apart again
     gap: int = number(3, POSITIVE_COUNT)
-    # a colour is held at a decision point when its share of the fused distribution is at least this
-    min_mass: float = number(0.12, FRACTION)
+    # a colour is held at a decision point when its share of the fused distribution is at least this:
+    # an object about 0.75 hand radii across in the circle of ``region.radius`` (2.6) hand radii
+    # (the 3-camera takes' 38-48 mm objects cover about 0.10 of it; 0.12 missed them)
+    min_mass: float = number(0.08, FRACTION)
     # ... and not held when it is below this, or below ``absent_ratio`` of its share at the other
     # decision point (the object already near the hand before it is picked up); between: no decision
     max_mass_absent: float = number(0.04, FRACTION)
@@ -100,6 +106,12 @@ class Decision:
     # (median over the frames): a held object moves with the hand (about 1), a resting one does not
     # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
     # than following. Seen in at least ``follow_frames`` such frames.
+    # a hand the tracker lost for at most ``bridge_frames`` frames and found again within
+    # ``bridge_size`` hand sides of where it was last seen was there all along (a tracker of skin
+    # blobs loses a hand that stops on a skin-coloured desk, or that takes an object, and finds it
+    # again where it stopped): the still moments read it at where it was found again over the gap
+    bridge_frames: int = number(20, POSITIVE_COUNT)
+    bridge_size: float = number(1.5, POSITIVE)
     follow_move: float = number(0.5, POSITIVE)
     follow_ratio: float = number(0.5, FRACTION)
     follow_frames: int = number(3, POSITIVE_COUNT)

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from collections.abc import Mapping
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
@@ -26,13 +27,12 @@ from partlab.tracking.activities.objects import (
     HUE_BINS,
     HandColour,
     body_colours,
-    colour_masses,
-    fuse,
+    fuse_views,
     hand_colour,
     hue_to_hex,
 )
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.table import one_hand, two_hands
+from partlab.tracking.activities.table import Verdict, one_hand, two_hands
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord
 
@@ -74,7 +74,8 @@ class ActivityTracker:
                 self._clothes_n[r.track_id] += 1
                 continue
             key = (r.track_id, r.part)
-            seen = hand_colour(view.color, foreground.get(stream), r.box, self.activity_params)
+            seen = replace(hand_colour(view.color, foreground.get(stream), r.box, self.activity_params),
+                           view=stream, visible=_visible(r.occluded))
             self._colours[key][r.frame].append(seen)
             if stream == next(iter(frames.views)):  # still moments are measured in the first view
                 self._centres[key][r.frame] = (r.box.x + r.box.w / 2, r.box.y + r.box.h / 2, max(r.box.w, r.box.h))
@@ -89,8 +90,32 @@ class ActivityTracker:
         joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
         clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
                    for t, n in self._clothes_n.items()}
-        self.events = recognise(joins, self._colours, self._centres, self.activity_params, clothes, self._where)
+        centres = {k: bridge_gaps(c, self.activity_params) for k, c in self._centres.items()}
+        self.events = recognise(joins, self._colours, centres, self.activity_params, clothes, self._where)
         return out
+
+
+def bridge_gaps(centres: Mapping[int, tuple[float, float, float]], params: ActivityParams) -> dict[int, tuple]:
+    """``centres`` with the short losses bridged: where a hand was unseen for at most
+    ``bridge_frames`` frames and is seen again within ``bridge_size`` hand sides of where it was
+    last seen, it is put where it was seen again over the unseen frames (a tracker loses a hand
+    that moved away from its estimate, and finds it where it went). Longer or farther losses stay
+    unseen."""
+    d = params.decision
+    out = dict(centres)
+    frames = sorted(centres)
+    for f0, f1 in zip(frames, frames[1:]):
+        if not 1 < f1 - f0 <= d.bridge_frames + 1:
+            continue
+        (x0, y0, s0), (x1, y1, s1) = centres[f0], centres[f1]
+        if np.hypot(x1 - x0, y1 - y0) <= d.bridge_size * max(s0, s1):
+            out.update({f: centres[f1] for f in range(f0 + 1, f1)})
+    return out
+
+
+def _visible(occluded: float) -> float:
+    """How much of a hand a record says is seen (trackers that do not say: all of it)."""
+    return 1.0 if not np.isfinite(occluded) else float(np.clip(1.0 - occluded, 0.0, 1.0))
 
 
 def clothes_hues(shares: np.ndarray, params: ActivityParams) -> np.ndarray:
@@ -112,7 +137,7 @@ def _held(colours: dict[int, list[HandColour]], lo: int, hi: int, params: Activi
     obs = [o for f in range(lo, hi + 1) for o in colours.get(f, ())]
     if len(obs) < max(2, params.decision.window // 3):
         return None
-    return colour_masses(fuse(obs), params)
+    return fuse_views(obs, params)
 
 
 def _held_seen(colours: dict[int, list[HandColour]], lo: int, hi: int, away: int,
@@ -299,8 +324,44 @@ def moved_windows(centres: Mapping[int, tuple], s0: int, s1: int,
     return (b0, b1), (a0, a1)
 
 
+def colour_at(where: Mapping[int, tuple], hue: int, lo: int, hi: int, params: ActivityParams) -> np.ndarray | None:
+    """The median image position of colour ``hue`` around a hand over frames ``lo..hi``
+    (:attr:`HandColour.where`, the first view), or None where it was not seen there."""
+    reach = params.decision.same_colour / DEGREES_PER_BIN
+    pts = [(x, y) for f in range(lo, hi + 1) for h, x, y in where.get(f, ())
+           if min((h - hue) % HUE_BINS, (hue - h) % HUE_BINS) <= reach]
+    return np.median(np.array(pts), axis=0) if pts else None
+
+
+def _stayed_put(where, centres, giver: Key, taker: Key, hue: int, windows, params: ActivityParams) -> bool:
+    """Whether the colour an exchange would pass from ``giver`` to ``taker`` is, after, where it was
+    before (within one hand side): what a tracker that swapped the two hands' identities while they
+    touched reports (each hand's surroundings, a sleeve or the trousers it hangs by, then seem to
+    change hands), not an object that went from one person to the other."""
+    (b0, b1), (a0, a1) = windows
+    before = colour_at(where.get(giver, {}), hue, b0, b1, params)
+    after = colour_at(where.get(taker, {}), hue, a0, a1, params)
+    sides = [c[2] for k in (giver, taker) for f, c in centres.get(k, {}).items() if b0 <= f <= a1]
+    if before is None or after is None or not sides:
+        return False
+    return bool(np.hypot(*(after - before)) < float(np.median(sides)))
+
+
+def _two_hand_verdict(seen: list[dict], a: Key, b: Key, windows, centres, where, params: ActivityParams) -> Verdict:
+    """Table 1 for two hands (:func:`~.table.two_hands`); an exchange whose colour stayed put
+    (:func:`_stayed_put`) is a touch of hands whose tracks swapped, less sure."""
+    ab, aa, bb, ba = seen
+    v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
+    if v.kind != "exchange" or v.colour is None:
+        return v
+    giver, taker = (a, b) if _mass_of(ab, v.colour, params) >= _mass_of(bb, v.colour, params) else (b, a)
+    if not _stayed_put(where, centres, giver, taker, v.colour, windows, params):
+        return v
+    return replace(two_hands({}, {}, {}, {}, a[0] == b[0], params), margin=0.5)
+
+
 def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityParams,
-               clothes: Mapping[int, np.ndarray]) -> tuple[list[dict], dict[Key, list]]:
+               clothes: Mapping[int, np.ndarray], where=None) -> tuple[list[dict], dict[Key, list]]:
     rows, busy = [], defaultdict(list)
     for j in merged_joins(joins, params):
         a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
@@ -315,7 +376,7 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                     for k in (a, b) for lo, hi, away in ((b0, b1, -1), (a0, a1, 1))]
             if all(s is not None for s in seen):
                 ab, aa, bb, ba = seen
-                v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
+                v = _two_hand_verdict(seen, a, b, ((b0, b1), (a0, a1)), centres, where or {}, params)
                 if v.kind == "exchange" and a[0] == b[0]:
                     continue  # an object moved from one of a person's hands to the other: no activity of Table 1
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
@@ -324,6 +385,11 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                 base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
         rows.append(base)
     return rows, busy
+
+
+def _mass_of(held: Mapping[int, float], hue: int, params: ActivityParams) -> float:
+    reach = params.decision.same_colour / DEGREES_PER_BIN
+    return max((m for h, m in held.items() if min((h - hue) % HUE_BINS, (hue - h) % HUE_BINS) <= reach), default=0.0)
 
 
 def _distinct(rows: list[dict]) -> list[dict]:
@@ -389,7 +455,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
     ``clothes``: per track, the hue bins the person wears (never taken for objects); ``where``: per
     hand and frame, the positions of the colours around it (:func:`stays_behind`)."""
     clothes, where = clothes or {}, where or {}
-    rows, busy = _join_rows(joins, colours, centres, params, clothes)
+    rows, busy = _join_rows(joins, colours, centres, params, clothes, where)
     d = params.decision
     for key, cs in centres.items():
         for s0, s1 in still_moments(cs, params):

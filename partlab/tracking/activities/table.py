@@ -65,9 +65,23 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
                     and _absent(_mass(src_a, hue, params), m, params)):
                 return Verdict("exchange", hue, _margin([m, gained], [_mass(dst_b, hue, params),
                                                                         _mass(src_a, hue, params)], params))
-    held = [m for t in (a_before, b_before, a_after, b_after) for m in t.values()]
-    margin = 1.0 - max(held, default=0.0) / max(d.min_mass, 1e-9)
+    margin = 1.0 - _moved(a_before, b_before, a_after, b_after, params) / max(d.min_mass, 1e-9)
     return Verdict("clap" if same_person else "handshake", None, float(max(0.2, min(1.0, 0.6 + 0.4 * margin))))
+
+
+def _moved(a_before: dict, b_before: dict, a_after: dict, b_after: dict, params: ActivityParams) -> float:
+    """How much of one colour went from one hand to the other, at most over the colours and the two
+    directions: the smaller of what the giving hand lost and what the receiving hand gained. A
+    colour that stays around one hand (a sleeve, the trousers a hand rests by, a shirt behind
+    both) moves nothing, however much of it there is: only a colour that half changed hands makes
+    a clap or a handshake unsure."""
+    out = 0.0
+    for src_b, dst_b, src_a, dst_a in ((a_before, b_before, a_after, b_after), (b_before, a_before, b_after, a_after)):
+        for hue in set(src_b) | set(dst_a):
+            lost = _mass(src_b, hue, params) - _mass(src_a, hue, params)
+            gained = _mass(dst_a, hue, params) - _mass(dst_b, hue, params)
+            out = max(out, min(lost, gained))
+    return out
 
 
 def one_hand(before: dict, after: dict, params: ActivityParams, stays=None) -> Verdict | None:
