@@ -2,8 +2,9 @@
 
 Per frame: the ROI is the depth pixels between two heights above the floor (sec. 2.1), back
 projected to world points through the stream's calibration; each point goes to the person whose
-predicted model is nearest (the exclusion principle, eq. 5, the prediction being the last
-estimate under the random-walk dynamics); each person's :class:`PersonFilter` then runs on its own
+predicted model is nearest (the exclusion principle, eq. 5, the prediction extrapolating the
+last two estimates; with two people or more and colour, the distance is corrected by how common
+the point's colour was on that person's nearest primitive, partlab's colour term); each person's :class:`PersonFilter` then runs on its own
 points. Blobs of points nobody owns start new people (their highest point is the top of a
 head); people who keep too few points are dropped.
 
