@@ -121,7 +121,9 @@ def run(scene, params: TopViewParams, seed: int) -> dict:
 
 def summary(rows: list[dict], key: str) -> str:
     v = np.array([r[key] for r in rows])
-    if key in ("arm80", "frames80", "assign"):
+    if key == "assign":
+        return f"{v.mean():.4f} +- {v.std():.4f}"
+    if key in ("arm80", "frames80"):
         return f"{v.mean():.3f} +- {v.std():.3f}"
     return f"{v.mean():.1f} +- {v.std():.1f}"
 

@@ -4,9 +4,10 @@ Per frame: the ROI is the depth pixels between two heights above the floor (sec.
 projected to world points through the stream's calibration; each point goes to the person whose
 predicted model is nearest (the exclusion principle, eq. 5, the prediction extrapolating the
 last two estimates; with two people or more and colour, the distance is corrected by how common
-the point's colour was on that person's nearest primitive, partlab's colour term); each person's :class:`PersonFilter` then runs on its own
-points. Blobs of points nobody owns start new people (their highest point is the top of a
-head); people who keep too few points are dropped.
+the point's colour was on that person's nearest primitive, partlab's colour term); each
+person's :class:`PersonFilter` then runs on its own points. Blobs of points nobody owns start
+new people (their highest point is the top of a head); people who keep too few points are
+dropped.
 
 Output per person and frame: rows ``head, right/left_shoulder, right/left_elbow,
 right/left_hand`` with ``X, Y, Z`` (world mm; the head row is the head's centre, the hand rows
