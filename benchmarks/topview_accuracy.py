@@ -41,7 +41,12 @@ from partlab.labelling.synth.topview import make_topview  # noqa: E402
 from partlab.tracking.frame import FrameSet  # noqa: E402
 from partlab.tracking.topview.likelihood import nearest  # noqa: E402
 from partlab.tracking.topview.model import JOINTS, WEIGHT_PARTS, joints, primitives  # noqa: E402
-from partlab.tracking.topview.params import LikelihoodParams, ResamplingParams, TopViewParams  # noqa: E402
+from partlab.tracking.topview.params import (  # noqa: E402
+    ExclusionParams,
+    LikelihoodParams,
+    ResamplingParams,
+    TopViewParams,
+)
 from partlab.tracking.topview.tracker import Geometry, TopViewTracker  # noqa: E402
 
 _HANDS = ((5, 4), (8, 5))  # (hand primitive, weighting part + 1 of its arm), right then left
@@ -116,7 +121,9 @@ def run(scene, params: TopViewParams, seed: int) -> dict:
 
 def summary(rows: list[dict], key: str) -> str:
     v = np.array([r[key] for r in rows])
-    if key in ("arm80", "frames80", "assign"):
+    if key == "assign":
+        return f"{v.mean():.4f} +- {v.std():.4f}"
+    if key in ("arm80", "frames80"):
         return f"{v.mean():.3f} +- {v.std():.3f}"
     return f"{v.mean():.1f} +- {v.std():.1f}"
 
@@ -210,12 +217,13 @@ def measure(args, counts: list[int], scenarios: list[str], results: dict[str, li
             for mode in modes:
                 for n in counts:
                     p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=n))
-                    results.setdefault(f"{scen.upper()} {mode} colour", []).append({"n": n, **run(scene, p, seed)})
+                    results.setdefault(f"{scen.upper()} {mode} colour", []).append(
+                        {"n": n, "seed": seed, **run(scene, p, seed)})
                 if args.depth_only:
                     p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
                                       likelihood=replace(LikelihoodParams(), use_colour=False))
                     results.setdefault(f"{scen.upper()} {mode} depth-only", []).append(
-                        {"n": args.default_particles, **run(scene, p, seed)})
+                        {"n": args.default_particles, "seed": seed, **run(scene, p, seed)})
             print(f"{scen} seed {seed} done", file=sys.stderr, flush=True)
             if args.json:  # after every seed, so that a long run interrupted keeps what it measured
                 args.json.write_text(json.dumps(results, indent=1))
@@ -223,8 +231,10 @@ def measure(args, counts: list[int], scenarios: list[str], results: dict[str, li
         for seed in seeds:
             scene = make_topview("topview_s3", seed, args.frames)
             for mode in modes:
-                p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles))
-                results.setdefault(f"S3 {mode} colour", []).append({"n": args.default_particles, **run(scene, p, seed)})
+                p = TopViewParams(resampling=ResamplingParams(mode=mode, n_particles=args.default_particles),
+                                  exclusion=replace(ExclusionParams(), colour_mm=args.eq5_colour_mm))
+                results.setdefault(f"S3 {mode} colour", []).append(
+                    {"n": args.default_particles, "seed": seed, **run(scene, p, seed)})
             print(f"s3 seed {seed} done", file=sys.stderr, flush=True)
             if args.json:
                 args.json.write_text(json.dumps(results, indent=1))
@@ -234,14 +244,14 @@ def print_tables(results: dict[str, list[dict]], args) -> None:
     """The accuracy and time table, survival per part and each joint's share within 80 mm."""
     print(f"{args.frames} frames at 320x240, started from the frame-0 truth; mean +- sd over seeds")
     print(f"{'take / resampling / cue':28s} {'N':>4s} {'seeds':>5s} {'eps mm':>14s} {'cpu ms':>14s} "
-          f"{'wall ms':>14s} {'arm<80':>16s} {'frames<80':>16s} {'assign':>16s}")
+          f"{'wall ms':>14s} {'cpu ms/person':>14s} {'arm<80':>16s} {'frames<80':>16s} {'assign':>16s}")
     for key, rows in results.items():
         for n in sorted({r["n"] for r in rows}):
             sel = [r for r in rows if r["n"] == n]
-            cells = [summary(sel, k) for k in ("eps", "cpu_ms", "wall_ms")]
+            cells = [summary(sel, k) for k in ("eps", "cpu_ms", "wall_ms", "cpu_ms_per_person")]
             cells += [summary(sel, k) for k in ("arm80", "frames80")]
             cells.append(summary(sel, "assign") if key.startswith("S3") else "")
-            widths = (14, 14, 14, 16, 16, 16)
+            widths = (14, 14, 14, 14, 16, 16, 16)
             print(f"{key:28s} {n:4d} {len(sel):5d} " + " ".join(f"{c:>{w}s}" for c, w in zip(cells, widths)))
     print("\nmissed frames (an arm joint >= 80 mm off) and those with a hand >= 80 mm off that no depth pixel "
           "sees (the true hand hidden); share of (frame, hand) pairs hidden")
@@ -253,6 +263,7 @@ def print_tables(results: dict[str, list[dict]], args) -> None:
             print(f"{key:28s} missed {m:4d} of {rows_n:5d}, with the hand hidden {h:4d} ({h / max(m, 1):.2f}); "
                   f"hands hidden {np.mean([r['hand_hidden'] for r in sel]):.3f}; frames<80 if those counted right "
                   f"{1 - (m - h) / max(rows_n, 1):.3f}")
+    print_per_seed(results, args)
     print("\nsurvival (distinct particles kept / N, mean over frames and seeds) at N =", args.default_particles)
     print(f"{'':28s} " + " ".join(f"{p:>10s}" for p in WEIGHT_PARTS))
     for key, rows in results.items():
@@ -266,6 +277,23 @@ def print_tables(results: dict[str, list[dict]], args) -> None:
         if sel:
             m, lo = np.mean(sel, 0), np.min(sel, 0)
             print(f"{key:28s} " + " ".join(f"{a:9.3f} ({b:4.2f})" for a, b in zip(m, lo)))
+
+
+def print_per_seed(results: dict[str, list[dict]], args) -> None:
+    """Each seed's frames<80 (and S3's assignment rate) at the default count, and the worst seed."""
+    print("\nper seed at N =", args.default_particles, "(seed: frames<80, S3 also assign)")
+    for key, rows in results.items():
+        sel = [r for r in rows if r["n"] == args.default_particles and "seed" in r]
+        if not sel:
+            continue
+        s3 = key.startswith("S3")
+        cells = [f"{r['seed']}: {r['frames80']:.3f}" + (f" {r['assign']:.4f}" if s3 else "") for r in sel]
+        worst = min(sel, key=lambda r: r["frames80"])
+        line = f"worst frames<80 {worst['frames80']:.3f} (seed {worst['seed']})"
+        if s3:
+            wa = min(sel, key=lambda r: r["assign"])
+            line += f", worst assign {wa['assign']:.4f} (seed {wa['seed']})"
+        print(f"{key:28s} {line}\n{'':28s} " + ", ".join(cells))
 
 
 def print_equal_time(results: dict[str, list[dict]]) -> None:
@@ -299,6 +327,8 @@ def main(argv=None) -> int:
     ap.add_argument("--particles", default="50,100,200")
     ap.add_argument("--default-particles", type=int, default=200)
     ap.add_argument("--scenarios", default="s1,s2,s3")
+    ap.add_argument("--eq5-colour-mm", type=float, default=ExclusionParams().colour_mm,
+                    help="S3: eq. 5's colour term (exclusion.colour_mm; 0 = distance only, the paper's eq. 5)")
     ap.add_argument("--json", type=Path, help="write every run's figures here")
     ap.add_argument("--plot", type=Path, help="draw epsilon against time per frame here (PNG)")
     ap.add_argument("--figure", type=Path, help="only draw an S3 frame (skeletons on depth, eq. 5 assignment) here")

@@ -71,3 +71,25 @@ def test_group_scenes_vary_the_number_of_people_camera_height_and_noise():
         # every person is seen (labelled pixels of their own) and nobody else is labelled
         assert set(np.unique(s.person[0])) == set(range(len(s.people) + 1))
         assert min((s.person[0] == k + 1).sum() for k in range(len(s.people))) > 100
+
+
+def test_no_forearm_goes_into_its_own_torso_and_other_frames_are_left_alone():
+    from partlab.labelling.synth.topview import CAMERA_HEIGHT_MM, _out_of_the_body, _people
+    from partlab.tracking.topview.likelihood import self_intersection
+    from partlab.tracking.topview.model import Body, neutral_state, primitives
+
+    body = Body()
+    free = neutral_state(0.0, 0.0, body)
+    inside = free.copy()
+    inside[13], inside[15] = -0.2, 1.6  # left arm against the body, elbow bent: the forearm goes in
+    assert self_intersection(primitives(inside[None], body), 1000.0).max() > 10.0
+    fixed = _out_of_the_body(np.stack([free, inside]), body)
+    assert self_intersection(primitives(fixed, body), 1000.0).max() == 0.0
+    assert np.array_equal(fixed[0], free)  # nothing went in: untouched
+    moved = np.flatnonzero(fixed[1] != inside)
+    assert set(moved) <= {13, 15} and np.abs(fixed[1] - inside).max() <= 1.5
+    # S1 seed 7's left forearm went 25 mm into the torso before the motions were kept out of it
+    rng = np.random.default_rng([7, 17])
+    rng.uniform(*CAMERA_HEIGHT_MM.get("topview_s1", (2850.0, 2950.0)))
+    person = _people("topview_s1", rng, 25)[0]
+    assert self_intersection(primitives(person.states, person.body), 1000.0).max() == 0.0

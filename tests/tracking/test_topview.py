@@ -292,3 +292,33 @@ def test_eq5_prediction_extrapolates_the_last_two_estimates():
     assert f.predicted(0.0) == pytest.approx(f.estimate)
     f.estimate[10] = 2.45  # clipped at the elbow's limit
     assert f.predicted(1.0)[10] == pytest.approx(2.5)
+
+
+def test_eq5_colour_term_gives_a_point_to_the_person_whose_nearest_part_shows_its_colour(s3):
+    tr = TopViewTracker(TopViewParams(resampling=ResamplingParams(n_particles=20)), np.random.default_rng(0),
+                        init=s3.init, cameras={"cam0": s3.camera})
+    for f in range(2):
+        fs = FrameSet.single(f, s3.color[f], s3.depth[f], camera=s3.camera)
+        tr.step(fs)
+    assert all(t.colour is not None and np.allclose(t.colour.sum(1)[t.colour.sum(1) > 0], 1.0) for t in tr.targets)
+    roi = tr.roi(fs.first)
+    a, b = tr.targets
+    # the second person moved half-way to the first: many points are then within 70 mm of both
+    b.filter.estimate[:2] += 0.5 * (a.filter.estimate[:2] - b.filter.estimate[:2])
+    geometric = TopViewTracker(TopViewParams(exclusion=ExclusionParams(colour_mm=0.0)), np.random.default_rng(0))
+    geometric.targets = tr.targets
+    by_distance = geometric.assign(roi, fitted=True)
+    # every point's colour is bin 5; only the first person ever showed it (on every primitive)
+    roi.bins = np.full(len(roi.points), 5)
+    a.colour = np.zeros_like(a.colour)
+    a.colour[:, 5] = 1.0
+    b.colour = np.zeros_like(b.colour)
+    b.colour[:, 7] = 1.0
+    owner = tr.assign(roi, fitted=True)
+    d = np.stack([nearest(roi.points, primitives(t.filter.estimate[None], t.filter.body)[0])[0] for t in tr.targets])
+    margin = d[0] - d[1]  # how much nearer the second person is
+    # the colour term: ln(1.02 / 0.02) * 20 mm = 79 mm in the first person's favour
+    assert np.all(owner[(margin < 70) & (by_distance >= 0)] == 0)
+    assert np.all(owner[(margin > 90) & (d[1] <= 250)] == 1)
+    near_b = (margin > 0) & (margin < 70) & (d[1] <= 250)  # without colour: the second person's
+    assert (by_distance[near_b] == 1).all() and near_b.sum() > 20

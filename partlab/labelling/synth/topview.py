@@ -42,6 +42,7 @@ import pandas as pd
 from partlab.labelling.synth.background import smooth_noise
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
+from partlab.tracking.topview.likelihood import self_intersection
 from partlab.tracking.topview.model import (
     DOF,
     JOINT_LIMITS,
@@ -160,7 +161,30 @@ def _motion(rng, n: int, body: Body, x: float, y: float, yaw: float,
         s[:, base + 2] = _wave(rng, t, (-0.3, 0.3), (0.0, 0.3))
         s[:, base + 4] = _wave(rng, t, (-0.3, 0.3), (0.0, 0.3))
     lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
-    return np.clip(s, lo, hi)
+    return _out_of_the_body(np.clip(s, lo, hi), body)
+
+
+def _out_of_the_body(s: np.ndarray, body: Body, step: float = 0.05, rounds: int = 30) -> np.ndarray:
+    """The sines know nothing of the body: where a forearm or hand would go into the person's
+    own torso or head (:func:`partlab.tracking.topview.likelihood.self_intersection`), the
+    shoulder's abduction, else the elbow's flexion, moves to the nearest value (``step`` rad at a
+    time, either way, within the joint's limits) that keeps them out, as the torso would stop
+    the arm. Frames where nothing goes in are left as they are."""
+    for base, part in ((7, PART_OF[4]), (12, PART_OF[7])):  # right arm, left arm
+        for dof in (base + 1, base + 3):  # abduction, elbow flexion
+            lo, hi = JOINT_LIMITS[dof]
+            todo = np.flatnonzero(self_intersection(primitives(s, body), 1000.0)[:, part] > 0)
+            value = s[todo, dof].copy()
+            for k in range(1, rounds + 1):
+                for sign in (-1.0, 1.0):
+                    if not len(todo):
+                        break
+                    trial = s[todo].copy()
+                    trial[:, dof] = np.clip(value + sign * k * step, lo, hi)
+                    out = self_intersection(primitives(trial, body), 1000.0)[:, part] <= 0
+                    s[todo[out], dof] = trial[out, dof]
+                    todo, value = todo[~out], value[~out]
+    return s
 
 
 def _people(name: str, rng, n: int) -> list[Person]:

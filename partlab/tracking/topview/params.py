@@ -11,6 +11,7 @@ from typing import ClassVar
 
 from partlab.tracking.core.params import (
     FRACTION,
+    NONNEG,
     POSITIVE,
     POSITIVE_COUNT,
     Parameters,
@@ -125,6 +126,17 @@ class ExclusionParams:
     #: :meth:`partlab.tracking.topview.tracker.TopViewTracker.step`)
     second_pass: bool = flag(True)
     second_pass_points: int = number(20, POSITIVE_COUNT)
+    #: partlab's colour term in eq. 5 (eq. 2's colour cue used for the assignment too; only with
+    #: two people or more and a colour stream): a point's cost for a person is its distance to
+    #: the person's model minus ``colour_mm`` times the log of how common its colour bin was, the
+    #: frame before, on that person's primitive nearest the point (``1 - colour_person_share``)
+    #: and on the whole person (``colour_person_share``), plus ``colour_floor``. A hand lying on
+    #: the other person's shoulders is 20-30 mm from their shirt and 40-90 mm from its own
+    #: model when that is off; a skin colour the shirt never showed costs the shirt
+    #: ``colour_mm * ln(1 / colour_floor)`` = 78 mm more. 0 = the paper's eq. 5 (distance only)
+    colour_mm: float = number(20.0, NONNEG)
+    colour_floor: float = number(0.02, POSITIVE)
+    colour_person_share: float = number(0.2, FRACTION)
 
 
 @dataclass(frozen=True)

@@ -2,10 +2,12 @@
 
 Per frame: the ROI is the depth pixels between two heights above the floor (sec. 2.1), back
 projected to world points through the stream's calibration; each point goes to the person whose
-predicted model is nearest (the exclusion principle, eq. 5, the prediction being the last
-estimate under the random-walk dynamics); each person's :class:`PersonFilter` then runs on its own
-points. Blobs of points nobody owns start new people (their highest point is the top of a
-head); people who keep too few points are dropped.
+predicted model is nearest (the exclusion principle, eq. 5, the prediction extrapolating the
+last two estimates; with two people or more and colour, the distance is corrected by how common
+the point's colour was on that person's nearest primitive, partlab's colour term); each
+person's :class:`PersonFilter` then runs on its own points. Blobs of points nobody owns start
+new people (their highest point is the top of a head); people who keep too few points are
+dropped.
 
 Output per person and frame: rows ``head, right/left_shoulder, right/left_elbow,
 right/left_hand`` with ``X, Y, Z`` (world mm; the head row is the head's centre, the hand rows
@@ -26,8 +28,8 @@ from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
 from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.topview.filter import PersonFilter
-from partlab.tracking.topview.likelihood import colour_bins, nearest
-from partlab.tracking.topview.model import JOINTS, Body, joints, neutral_state, primitives
+from partlab.tracking.topview.likelihood import colour_bins, nearest, nearest_primitive
+from partlab.tracking.topview.model import JOINTS, N_PRIMITIVES, Body, joints, neutral_state, primitives
 from partlab.tracking.topview.params import TopViewParams
 from partlab.tracking.topview.start import fit_person
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
@@ -38,6 +40,9 @@ class Target:
     track_id: int
     filter: PersonFilter
     missing: int = 0
+    #: ``(N_PRIMITIVES, bins)`` the share of each colour bin on each primitive of the last
+    #: frame's estimate, among the points the frame gave this person (eq. 5's colour term)
+    colour: np.ndarray | None = None
 
 
 @dataclass
@@ -203,16 +208,47 @@ class TopViewTracker:
     # -- the exclusion principle (eq. 5) -----------------------------------------------------
     def assign(self, roi: RoiPoints, fitted: bool = False) -> np.ndarray:
         """``(M,)`` index into :attr:`targets` of each ROI point's nearest predicted model (-1: none
-        within ``max_assign_mm``); ``fitted``: nearest this frame's estimated model instead."""
+        within ``max_assign_mm``); ``fitted``: nearest this frame's estimated model instead. With
+        two people or more and colour, the distance is corrected by the colour term
+        (:meth:`colour_cost`)."""
         if not self.targets or not len(roi.points):
             return np.full(len(roi.points), -1, np.int64)
         v = self.params.exclusion.velocity
         states = [t.filter.estimate if fitted else t.filter.predicted(v) for t in self.targets]
-        dist = np.stack([nearest(roi.points, primitives(s[None], t.filter.body)[0])[0]
-                         for s, t in zip(states, self.targets)])
-        owner = np.argmin(dist, 0)
-        owner[dist.min(0) > self.params.exclusion.max_assign_mm] = -1
+        near = [nearest_primitive(roi.points, primitives(s[None], t.filter.body)[0])
+                for s, t in zip(states, self.targets)]
+        dist = np.stack([d for d, _ in near])
+        cost = dist
+        if self._colour_on(roi) and all(t.colour is not None for t in self.targets):
+            cost = dist + np.stack([self.colour_cost(t, prim, roi.bins) for t, (_, prim) in zip(self.targets, near)])
+        owner = np.argmin(cost, 0)
+        owner[dist[owner, np.arange(len(owner))] > self.params.exclusion.max_assign_mm] = -1
         return owner
+
+    def colour_cost(self, t: Target, prim: np.ndarray, bins: np.ndarray) -> np.ndarray:
+        """``(M,)`` mm added to each point's distance to ``t``'s model (its nearest primitives
+        ``prim``): ``-colour_mm * ln(q + colour_floor)``, ``q`` how common the point's colour bin
+        was the frame before on that primitive and on the whole person."""
+        ex = self.params.exclusion
+        whole = t.colour.mean(0)
+        q = (1 - ex.colour_person_share) * t.colour[prim, bins] + ex.colour_person_share * whole[bins]
+        return -ex.colour_mm * np.log(q + ex.colour_floor)
+
+    def _colour_on(self, roi: RoiPoints) -> bool:
+        return len(self.targets) > 1 and self.params.exclusion.colour_mm > 0 and roi.bins is not None
+
+    def _update_colour(self, roi: RoiPoints, owner: np.ndarray) -> None:
+        """Each person's colour shares per primitive of this frame's estimate, from the points
+        the frame's assignment gave them (for eq. 5's colour term at the next frame)."""
+        n_bins = self.params.likelihood.colour_levels ** 3
+        for k, t in enumerate(self.targets):
+            mine = np.flatnonzero(owner == k)
+            if not len(mine):
+                continue
+            _, prim = nearest_primitive(roi.points[mine], primitives(t.filter.estimate[None], t.filter.body)[0])
+            h = np.zeros((N_PRIMITIVES, n_bins))
+            np.add.at(h, (prim, roi.bins[mine]), 1.0)
+            t.colour = h / np.maximum(h.sum(1, keepdims=True), 1.0)
 
     # -- one frame -----------------------------------------------------------------------------
     def step(self, frames: FrameSet, foreground=None) -> list[TrackRecord]:
@@ -238,9 +274,12 @@ class TopViewTracker:
             t.missing = 0
             keep.append(t)
             used[t.track_id] = self._measure(t, roi, mine, view.depth, cam, first=True)
+        dropped = len(keep) < len(self.targets)  # then ``owner`` indexes the targets before
         self.targets = keep
         if len(used) > 1 and self.params.exclusion.second_pass:
             owner = self._second_pass(roi, owner, used, view.depth, cam)
+        if self._colour_on(roi) and not dropped:
+            self._update_colour(roi, owner)
         assignment = np.zeros(view.depth.size, np.int32)
         ids = np.array([t.track_id for t in self.targets] + [0])
         assignment[roi.index] = ids[owner]
