@@ -85,6 +85,17 @@ def test_prune_and_merge_drops_weak_and_merges_close_candidates():
     np.testing.assert_allclose(out[0], [0, 0, 1000])  # the paper: the stronger point is kept
 
 
+def test_a_hand_cut_off_from_its_body_is_measured_from_its_persons_top():
+    sil = np.zeros((120, 160), np.uint8)
+    sil[10:110, 40:70] = 1  # the person: top at row 10
+    sil[60:70, 90:100] = 1  # a hand reaching over a table, a component of its own (100 px of 3100)
+    centres = np.array([[95.0, 65.0], [55.0, 30.0]])
+    assert observe_view(sil, centres).below.tolist() == [5.0, 20.0]  # the paper's: its own top
+    assert observe_view(sil, centres, fragment=0.25).below.tolist() == [55.0, 20.0]
+    sil[60:70, 120:130] = 1  # no larger component is nearer: the nearest one horizontally is taken
+    assert observe_view(sil, np.array([[125.0, 65.0]]), fragment=0.25).below.tolist() == [55.0]
+
+
 def test_ghost_pairs_of_two_hands_are_dropped_and_a_shared_blob_is_kept():
     params = Limbs3DParams()  # ghost_factor 0: a ghost is dropped
     # two views, two hands: true pairs (0-0, 1-1) and the two ghosts crossing them (0-1, 1-0)

@@ -71,6 +71,12 @@ class Limbs3DPriors:
     # silhouettes merge in one view and not the other (the handshake); false head-hand pairs by
     # ~400. 150 mm: 100 gave the 3-camera handshake (seeds 0-2) 105/49/114 mm, 150 gave 90/70/101
     sigma_v: float = number(150.0, POSITIVE)
+    # p_o's reference (our addition): a blob whose silhouette component is smaller than this
+    # fraction of the view's largest is measured from the top of the nearest larger component
+    # (priors.observe_view). Seated 2-camera seed 6: the right hand reaching across the table is
+    # an 89-pixel component of its own in cam0, so its Dv was ~0 there and ~590 mm in cam1, and
+    # its true pair got p_o 0 for 30 frames. 0 = off (the default until measured on every seed)
+    fragment: float = number(0.0, FRACTION)
     # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
     # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
     # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;

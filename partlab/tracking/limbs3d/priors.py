@@ -45,9 +45,13 @@ class ViewObservation:
     scale: float = 1.0  # image pixels per silhouette pixel (silhouettes may be found at lower resolution)
 
 
-def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0) -> ViewObservation:
+def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0,
+                 fragment: float = 0.0) -> ViewObservation:
     """The silhouette measures of one view (``silhouette``: ``(H, W)`` mask, nonzero = person;
-    ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel)."""
+    ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel). A blob in a
+    component smaller than ``fragment`` times the largest (a hand reaching across a table, cut
+    off from its body in this view) is measured from the top of the nearest larger component
+    (horizontally), its person's; 0 = from its own component's top."""
     sil = (np.asarray(silhouette) > 0).astype(np.uint8)
     centres = np.asarray(centres, float).reshape(-1, 2)
     h, w = sil.shape
@@ -57,8 +61,13 @@ def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0
     distance = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
     top_all = float(stats[1:, cv2.CC_STAT_TOP].min())
     below = np.empty(len(centres))
+    area = stats[:, cv2.CC_STAT_AREA].astype(float)
+    big = np.flatnonzero(area[1:] >= fragment * area[1:].max()) + 1
     for k, (x, y) in enumerate(centres):
         lab = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
+        if lab > 0 and fragment > 0 and lab not in big:
+            left, width = stats[big, cv2.CC_STAT_LEFT], stats[big, cv2.CC_STAT_WIDTH]
+            lab = big[np.argmin(np.maximum(np.maximum(left - x, x - (left + width)), 0))]
         top = float(stats[lab, cv2.CC_STAT_TOP]) if lab > 0 else top_all
         below[k] = (y - top) * scale
     return ViewObservation(centres, below, distance * np.float32(scale), True, scale)
