@@ -107,6 +107,7 @@ def learn(scenarios, k: int, n_cams: int, frames: int) -> Limbs3DParams:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first", type=int, default=0, help="the first seed (seeds first .. first + seeds - 1)")
     ap.add_argument("--scenarios", nargs="+", default=["standing", "seated", "handshake"])
     ap.add_argument("--cams", type=int, nargs="+", default=[2, 3, 4])
     ap.add_argument("--frames", type=int, default=150)
@@ -118,7 +119,7 @@ def main() -> None:
     learnt = learn(args.scenarios, args.learn, 3, args.frames) if args.learn else None
     rows = []
     for name in args.scenarios:
-        for seed in range(args.seeds):
+        for seed in range(args.first, args.first + args.seeds):
             scene = make_multiview_scene(name, max(args.scene_cams, *args.cams), seed=seed, n_frames=args.frames)
             for n_cams in args.cams:
                 e, fps = run(scene, n_cams, Limbs3DParams(), seed=seed)
