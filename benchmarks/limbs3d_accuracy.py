@@ -1,18 +1,21 @@
 """Multi-camera head-and-hands tracking accuracy (3D tracking of the hands and head of interacting
 people from several cameras, sec. 8: mean 3D error in mm per part).
 
-Per scenario and seed one scene is rendered from 4 cameras at 640x480 (in memory, no codec) and
-tracked with the first 2, 3 and 4 of them (``--tracker limbs3d`` from the truth's first frame).
+Per scenario and seed one scene is rendered from 4 cameras (``--scene-cams``) at 640x480 (in
+memory, no codec) and tracked with the first 2, 3 and 4 of them (``--tracker limbs3d`` from the truth's first frame).
 Prints, per scenario and camera count, the mean 3D error per part (mean over seeds, +- standard
 deviation over seeds), the median, the fraction of frames within 100 mm, hand swaps after the
 clap/handshake (a hand nearer the other hand's truth than its own for 10+ frames after frame 85),
-a run with camera 0 hidden for 30 frames (frames 60-89, 3+ cameras: targets in the lost state at
-frame 100, error over the hidden stretch) and CPU frames/s of the tracker alone.
+a run with camera 0 hidden for 30 frames (frames 60-89, ``--hide-from`` cameras and more: targets
+in the lost state at any frame of 60-100 hidden / with every camera, error over the hidden stretch
+and after it) and CPU frames/s of the tracker alone; last, per scenario and camera count, the mean
+of all parts (sd over seeds), the seeds with a part over 50 mm and the sums over seeds.
 
 With ``--learn K`` the prior variances are first fitted (sec. 6.4, :mod:`partlab.models.limbs3d`)
 on K held-apart seeds per scenario (seeds 1000, 1001, ...: never among the evaluated ones) and every
 evaluated take is tracked again with them (``learnt_mean``: mean 3D error of all parts).
 
+    nice python benchmarks/limbs3d_accuracy.py --seeds 10 --scenarios standing seated --cams 3
     nice python benchmarks/limbs3d_accuracy.py --seeds 10 --cams 2 3 --learn 1
 """
 
@@ -68,6 +71,24 @@ def swaps(e: pd.DataFrame, after: int = 85, frames: int = 10) -> int:
     return n
 
 
+def hidden(scene, n_cams: int, e: pd.DataFrame, seed: int, start: int = 60, stop: int = 90) -> dict:
+    """Camera 0 black for frames ``start``-``stop`` (30 frames): the error over that stretch and
+    after it, and the targets lost at any frame from ``start`` to ``stop + 10`` with the camera
+    hidden and in the same take with every camera (``e``: those lost anyway, a hand hidden by a
+    body), also at frame ``stop + 10``."""
+    eh, _ = run(scene, n_cams, Limbs3DParams(), hide=(start, stop), seed=seed)
+
+    def lost(df, frames):
+        sel = df[df["frame"].isin(frames) & (df["state"] == "lost")]
+        return int(sel[["track_id", "part"]].drop_duplicates().shape[0])
+
+    window = range(start, stop + 11)
+    stretch = eh[(eh["frame"] >= start) & (eh["frame"] < stop)]
+    return {"hidden_mean": stretch["err"].mean(), "hidden_after_mean": eh[eh["frame"] >= stop]["err"].mean(),
+            "hidden_lost": lost(eh, window), "unhidden_lost": lost(e, window),
+            "hidden_lost_at_100": lost(eh, [stop + 10]), "unhidden_lost_at_100": lost(e, [stop + 10])}
+
+
 def learn(scenarios, k: int, n_cams: int, frames: int) -> Limbs3DParams:
     """Sigmas fitted on ``k`` held-apart seeds per scenario (``n_cams`` views)."""
     errors = []
@@ -86,16 +107,20 @@ def learn(scenarios, k: int, n_cams: int, frames: int) -> Limbs3DParams:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first", type=int, default=0, help="the first seed (seeds first .. first + seeds - 1)")
     ap.add_argument("--scenarios", nargs="+", default=["standing", "seated", "handshake"])
     ap.add_argument("--cams", type=int, nargs="+", default=[2, 3, 4])
     ap.add_argument("--frames", type=int, default=150)
+    ap.add_argument("--scene-cams", type=int, default=4,
+                    help="cameras rendered (the camera arc depends on it); each run uses the first --cams of them")
+    ap.add_argument("--hide-from", type=int, default=2, help="the hidden-camera run for this many cameras and more")
     ap.add_argument("--learn", type=int, default=0, help="fit the sigmas on this many held-apart seeds per scenario")
     args = ap.parse_args()
     learnt = learn(args.scenarios, args.learn, 3, args.frames) if args.learn else None
     rows = []
     for name in args.scenarios:
-        for seed in range(args.seeds):
-            scene = make_multiview_scene(name, max(args.cams), seed=seed, n_frames=args.frames)
+        for seed in range(args.first, args.first + args.seeds):
+            scene = make_multiview_scene(name, max(args.scene_cams, *args.cams), seed=seed, n_frames=args.frames)
             for n_cams in args.cams:
                 e, fps = run(scene, n_cams, Limbs3DParams(), seed=seed)
                 row = {"scenario": name, "seed": seed, "cams": n_cams, "fps": fps, "swaps": swaps(e)}
@@ -105,23 +130,25 @@ def main() -> None:
                     row[f"{part}_within100"] = (g["err"] < 100).mean()
                 if learnt is not None:
                     row["learnt_mean"] = run(scene, n_cams, learnt, seed=seed)[0]["err"].mean()
-                if n_cams >= 3:
-                    eh, _ = run(scene, n_cams, Limbs3DParams(), hide=(60, 90), seed=seed)
-                    stretch = eh[(eh["frame"] >= 60) & (eh["frame"] < 90)]
-                    row["hidden_mean"] = stretch["err"].mean()
-                    row["hidden_lost_at_100"] = int(((eh["frame"] == 100) & (eh["state"] == "lost")).sum())
-                    # the same take with every camera: targets that were lost anyway (a hand hidden by a body)
-                    row["unhidden_lost_at_100"] = int(((e["frame"] == 100) & (e["state"] == "lost")).sum())
-                    row["hidden_within100_after"] = (eh[eh["frame"] >= 90]["err"] < 100).mean()
+                if n_cams >= args.hide_from:
+                    row.update(hidden(scene, n_cams, e, seed))
                 rows.append(row)
                 print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
     df = pd.DataFrame(rows)
     cols = [c for c in df.columns if c.endswith(("_mean", "_median", "_within100")) or c in
-            ("fps", "swaps", "hidden_lost_at_100", "unhidden_lost_at_100", "hidden_within100_after")]
+            ("fps", "swaps", "hidden_lost", "unhidden_lost", "hidden_lost_at_100", "unhidden_lost_at_100")]
     summary = df.groupby(["scenario", "cams"])[cols].agg(["mean", "std"])
     pd.set_option("display.width", 250)
     pd.set_option("display.max_columns", 60)
     print(summary.round(2).T.to_string())
+    parts = [c for c in df.columns if c.endswith("hand_mean") or c == "head_mean"]
+    for (name, n_cams), g in df.groupby(["scenario", "cams"]):
+        over = [f"{r.seed} ({', '.join(f'{c[:-5]} {getattr(r, c):.0f}' for c in parts if getattr(r, c) > 50)})"
+                for r in g.itertuples() if max(getattr(r, c) for c in parts) > 50]
+        sums = {c: int(g[c].sum()) for c in ("swaps", "hidden_lost", "unhidden_lost") if c in g}
+        print(f"{name} {n_cams} cameras, {len(g)} seeds: all parts {g[parts].mean(axis=1).mean():.1f} "
+              f"({g[parts].mean(axis=1).std():.1f}) mm; seeds with a part > 50 mm: {'; '.join(over) or 'none'}; "
+              f"summed over seeds: {sums}")
 
 
 if __name__ == "__main__":

@@ -7,9 +7,10 @@ import pytest
 from partlab.labelling.synth.multiview import look_at, make_multiview_scene
 from partlab.tracking.frame import Frame, FrameSet
 from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Observation
+from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import midpoints, pair_candidates
-from partlab.tracking.limbs3d.params import Limbs3DParams, Limbs3DPriors, Limbs3DStates
-from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.limbs3d.params import Limbs3DDynamics, Limbs3DParams, Limbs3DPriors, Limbs3DStates
+from partlab.tracking.limbs3d.priors import blob_keys, candidate_prior, observe_view, prune_and_merge
 from partlab.tracking.limbs3d.tracker import Limbs3DTracker, triangulate
 
 
@@ -82,6 +83,50 @@ def test_prune_and_merge_drops_weak_and_merges_close_candidates():
     np.testing.assert_allclose(out[0], [20 / 3, 0, 1000])  # prior-weighted mean (merge_average)
     out, w = prune_and_merge(pts, pr, Limbs3DParams(priors=Limbs3DPriors(merge_average=False)))
     np.testing.assert_allclose(out[0], [0, 0, 1000])  # the paper: the stronger point is kept
+
+
+def test_a_hand_cut_off_from_its_body_is_measured_from_its_persons_top():
+    sil = np.zeros((120, 160), np.uint8)
+    sil[10:110, 40:70] = 1  # the person: top at row 10
+    sil[60:70, 90:100] = 1  # a hand reaching over a table, a component of its own (100 px of 3100)
+    centres = np.array([[95.0, 65.0], [55.0, 30.0]])
+    assert observe_view(sil, centres).below.tolist() == [5.0, 20.0]  # the paper's: its own top
+    assert observe_view(sil, centres, fragment=0.25).below.tolist() == [55.0, 20.0]
+    sil[60:70, 120:130] = 1  # no larger component is nearer: the nearest one horizontally is taken
+    assert observe_view(sil, np.array([[125.0, 65.0]]), fragment=0.25).below.tolist() == [55.0]
+
+
+def test_ghost_pairs_of_two_hands_are_dropped_and_a_shared_blob_is_kept():
+    params = Limbs3DParams()  # ghost_factor 0: a ghost is dropped
+    # two views, two hands: true pairs (0-0, 1-1) and the two ghosts crossing them (0-1, 1-0)
+    pts = np.array([[0.0, 0, 1000], [400.0, 0, 1000], [200.0, 300, 900], [200.0, -300, 1100]])
+    views = np.array([[0, 1]] * 4)
+    blobs = np.array([[0, 0], [1, 1], [0, 1], [1, 0]])
+    out, w = prune_and_merge(pts, np.array([0.9, 0.8, 0.7, 0.6]), params, blob_keys(views, blobs))
+    np.testing.assert_allclose(out, pts[:2])  # each ghost's two blobs belong to the true hands
+    np.testing.assert_allclose(w, [0.9, 0.8])
+    out, _ = prune_and_merge(pts, np.array([0.9, 0.8, 0.7, 0.6]), Limbs3DParams(priors=Limbs3DPriors(ghost_factor=1.0)),
+                             blob_keys(views, blobs))
+    assert len(out) == 4  # off: the paper's candidates
+    # the hands are one blob in view 0: each still owns its blob in view 1, both are kept
+    out, _ = prune_and_merge(pts[:2], np.array([0.9, 0.8]), params, blob_keys(views[:2], np.array([[0, 0], [0, 1]])))
+    assert len(out) == 2
+
+
+def test_the_jump_mixture_lets_a_filter_reach_a_candidate_200_mm_off():
+    def reach(dyn):
+        out = []
+        for seed in range(10):
+            f = TargetFilter(np.array([0.0, 0, 1000]), dyn, np.random.default_rng(seed))
+            for _ in range(5):  # a still hand
+                f.predict()
+                f.update(np.array([[0.0, 0, 1000]]), np.array([0.9]))
+            f.predict()  # the clap starts: its only candidate is 200 mm along x
+            out.append(f.update(np.array([[200.0, 0, 1000]]), np.array([0.9]))[0])
+        return float(np.mean(out))
+
+    assert reach(Limbs3DDynamics()) > 115  # defaults: 128 mm of the 200 in one frame
+    assert reach(Limbs3DDynamics(jump_mix=0.0, weight_floor=1e-3)) < 100  # before: 88
 
 
 def test_state_machine_combines_and_splits_3d_targets_by_direction():

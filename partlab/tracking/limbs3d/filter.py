@@ -70,6 +70,9 @@ class TargetFilter:
         self.particles[rows, :3] = c[pick] + self.rng.normal(0, p.noise_xyz, (k, 3))
         x = self.particles[:, :3]
         f = np.exp(-0.5 * (((x - mean) / spread) ** 2).sum(-1)) / np.prod(spread)
+        if p.jump_mix > 0:  # heavier tail: a hand can start a fast move (a clap) in any frame
+            wide = spread * p.jump_scale
+            f = (1 - p.jump_mix) * f + p.jump_mix * np.exp(-0.5 * (((x - mean) / wide) ** 2).sum(-1)) / np.prod(wide)
         d2 = ((x[:, None] - c[None]) ** 2).sum(-1)
         g = np.exp(-d2 / (2 * p.noise_xyz**2)) @ w / p.noise_xyz**3
         q = (1 - p.candidate_mix) * f + p.candidate_mix * g

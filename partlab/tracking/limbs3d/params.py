@@ -71,6 +71,12 @@ class Limbs3DPriors:
     # silhouettes merge in one view and not the other (the handshake); false head-hand pairs by
     # ~400. 150 mm: 100 gave the 3-camera handshake (seeds 0-2) 105/49/114 mm, 150 gave 90/70/101
     sigma_v: float = number(150.0, POSITIVE)
+    # p_o's reference (our addition): a blob whose silhouette component is smaller than this
+    # fraction of the view's largest is measured from the top of the nearest larger component
+    # (priors.observe_view). Seated 2-camera seed 6: the right hand reaching across the table is
+    # an 89-pixel component of its own in cam0, so its Dv was ~0 there and ~590 mm in cam1, and
+    # its true pair got p_o 0 for 30 frames. 0 = off (the default until measured on every seed)
+    fragment: float = number(0.0, FRACTION)
     # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
     # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
     # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;
@@ -88,6 +94,10 @@ class Limbs3DPriors:
     # while two touching hands stay ~50 mm apart (centre to centre)
     merge_distance: float = number(45.0)
     merge_boost: float = number(0.5)
+    # a merged candidate whose blobs are all used by stronger candidates is a ghost (the crossing
+    # of the lines of sight of two different limbs, priors.suppress_ghosts; our addition): its
+    # prior is scaled by this (0 drops it, 1 = off)
+    ghost_factor: float = number(0.0, FRACTION)
     # the kept candidate moves to the prior-weighted mean of those it absorbs (the paper keeps the
     # stronger point; the mean of the pairs of 3-4 cameras is a better estimate of the centre)
     merge_average: bool = flag(True)
@@ -100,8 +110,10 @@ class Limbs3DDynamics:
     particles: int = number(200, POSITIVE_COUNT)
     # p(x | Z_c): Gaussian of this spread (mm) around each candidate, about a hand's radius
     sigma_x: float = number(45.0, POSITIVE)
-    # weight every particle keeps, so a filter whose candidates vanish diffuses around its place
-    weight_floor: float = number(1e-3, POSITIVE)
+    # weight every particle keeps, so a filter whose candidates vanish diffuses around its place;
+    # 1e-3 was above what the jump mixture gives a particle on a candidate 200 mm off (~1e-3), so
+    # the cloud stayed behind whatever the candidate's prior
+    weight_floor: float = number(1e-4, POSITIVE)
     # x_t = x_{t-1} + decay v_{t-1} + noise (mm per frame; a gesturing hand moves up to ~60 mm a
     # frame at 25 fps)
     noise_xyz: float = number(25.0)
@@ -112,6 +124,13 @@ class Limbs3DDynamics:
     # faster than the dynamics expect is not left behind; their weights are eq. 17's like any other
     candidate_mix: float = number(0.3, FRACTION)
     candidate_gate: float = number(250.0, POSITIVE)
+    # the dynamics' density in the importance weights f / q is a mixture: (1 - jump_mix) the
+    # predicted cloud's Gaussian, jump_mix one jump_scale times wider (our addition). A clap starts
+    # in 2-3 frames (a hand at ~3 m/s, 120 mm a frame): with the Gaussian alone the filter fell
+    # 200-300 mm behind its own strong candidate and was lost (standing seed 3: hands 285 and
+    # 162 mm at 3 cameras; with the mixture 52 and 18, and the ghosts below dropped)
+    jump_mix: float = number(0.2, FRACTION)
+    jump_scale: float = number(4.0, POSITIVE)
     # a candidate nearer another target's prediction (by this factor) is left to that target
     exclusive_ratio: float = number(1.0, POSITIVE)
     # a hand uses only candidates within this distance (mm) of its own person's head estimate, 0 =
@@ -129,6 +148,10 @@ class Limbs3DDynamics:
     # tracked but never bring a lost one back (one view cannot tell its depth). 0 = off
     single_view_prior: float = number(0.2, FRACTION)
     single_view_gate: float = number(100.0, POSITIVE)
+    # a lost target (held where it was lost) does not take candidates from a tracked one by being
+    # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
+    # often nearer the other hand's candidates than that hand's own lagging prediction
+    lost_yield: bool = flag(True)
     # a combined filter spreads its particles this much wider so it sees both modes
     combined_noise_scale: float = number(1.3, POSITIVE)
     # a lost target's particles spread this wide (mm) around where it is looked for

@@ -45,9 +45,13 @@ class ViewObservation:
     scale: float = 1.0  # image pixels per silhouette pixel (silhouettes may be found at lower resolution)
 
 
-def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0) -> ViewObservation:
+def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0,
+                 fragment: float = 0.0) -> ViewObservation:
     """The silhouette measures of one view (``silhouette``: ``(H, W)`` mask, nonzero = person;
-    ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel)."""
+    ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel). A blob in a
+    component smaller than ``fragment`` times the largest (a hand reaching across a table, cut
+    off from its body in this view) is measured from the top of the nearest larger component
+    (horizontally), its person's; 0 = from its own component's top."""
     sil = (np.asarray(silhouette) > 0).astype(np.uint8)
     centres = np.asarray(centres, float).reshape(-1, 2)
     h, w = sil.shape
@@ -57,8 +61,13 @@ def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0
     distance = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
     top_all = float(stats[1:, cv2.CC_STAT_TOP].min())
     below = np.empty(len(centres))
+    area = stats[:, cv2.CC_STAT_AREA].astype(float)
+    big = np.flatnonzero(area[1:] >= fragment * area[1:].max()) + 1
     for k, (x, y) in enumerate(centres):
         lab = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
+        if lab > 0 and fragment > 0 and lab not in big:
+            left, width = stats[big, cv2.CC_STAT_LEFT], stats[big, cv2.CC_STAT_WIDTH]
+            lab = big[np.argmin(np.maximum(np.maximum(left - x, x - (left + width)), 0))]
         top = float(stats[lab, cv2.CC_STAT_TOP]) if lab > 0 else top_all
         below[k] = (y - top) * scale
     return ViewObservation(centres, below, distance * np.float32(scale), True, scale)
@@ -117,18 +126,22 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
     return Prior(p_o, p_t, p_b), {"dv": ddv, "d": cands.error, "ds": ds}
 
 
-def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams) -> tuple[np.ndarray, np.ndarray]:
+def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams,
+                    blobs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Drop candidates below ``prior_threshold`` or outside the room, then merge close ones (sec.
     6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
-    ``merge_boost`` times its prior to the one that absorbs it (capped at 1).
+    ``merge_boost`` times its prior to the one that absorbs it (capped at 1). With ``blobs (C, 2)``
+    (each candidate's two blobs as view-blob keys, see :func:`blob_keys`), a merged candidate all
+    of whose blobs are already used by stronger ones is a ghost (:func:`suppress_ghosts`).
     Returns ``points (K, 3)`` and ``prior (K,)``, strongest first."""
     keep = (prior >= params.priors.prior_threshold) & np.isfinite(points).all(axis=1)
     keep &= (points[:, 2] > 0) & (points[:, 2] < params.priors.max_height)
     pts, pr = points[keep], prior[keep]
     order = np.argsort(-pr, kind="stable")
     pts, pr = pts[order], pr[order]
+    keys = blobs[keep][order] if blobs is not None else None
     alive = np.ones(len(pr), bool)
-    out_p, out_w = [], []
+    out_p, out_w, out_k = [], [], []
     if len(pr):
         dist = np.linalg.norm(pts[:, None] - pts[None], axis=-1)
     for i in range(len(pr)):
@@ -139,13 +152,45 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
         absorbed = np.flatnonzero(near)
         alive[absorbed] = False
         value = min(1.0, pr[i] + params.priors.merge_boost * float(pr[absorbed].sum()))
+        idx = np.concatenate([[i], absorbed]).astype(int)
         if params.priors.merge_average and len(absorbed):
-            idx = np.concatenate([[i], absorbed])
             p = (pts[idx] * pr[idx, None]).sum(0) / pr[idx].sum()
         else:
             p = pts[i]
         out_p.append(p)
         out_w.append(value)
+        if keys is not None:
+            out_k.append(set(keys[idx].ravel().tolist()))
     if not out_p:
         return np.zeros((0, 3)), np.zeros(0)
-    return np.array(out_p), np.array(out_w)
+    out_p, out_w = np.array(out_p), np.array(out_w)
+    if keys is not None and params.priors.ghost_factor < 1:
+        out_p, out_w = suppress_ghosts(out_p, out_w, out_k, params.priors.ghost_factor)
+    return out_p, out_w
+
+
+def blob_keys(views: np.ndarray, blobs: np.ndarray) -> np.ndarray:
+    """``(C, 2)`` integer keys of each candidate's two blobs (view and blob index in one number)."""
+    return np.asarray(views, np.int64) * 100000 + np.asarray(blobs, np.int64)
+
+
+def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], factor: float):
+    """Every skin blob is the image of one head or hand (our addition, not the paper's): from the
+    strongest merged candidate down, one whose blobs (``members``: the view-blob keys of the pairs
+    it merged) are all already used by stronger candidates is a ghost, the crossing of two lines of
+    sight through two different limbs (a left hand in one view paired with the right hand in
+    another), and its prior is scaled by ``factor`` (0 drops it). A true point seen by three views
+    merges three pairs and owns blobs no other point uses; two hands that are one blob in one view
+    still each own their blobs in the other views. Returns points and priors, strongest first."""
+    order = np.argsort(-prior, kind="stable")
+    used: set = set()
+    value = prior.copy()
+    for i in order:
+        if members[i] <= used:
+            value[i] *= factor
+        else:
+            used |= members[i]
+    keep = value >= 1e-9
+    points, value = points[keep], value[keep]
+    order = np.argsort(-value, kind="stable")
+    return points[order], value[order]

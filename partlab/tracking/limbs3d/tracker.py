@@ -39,7 +39,7 @@ from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Ob
 from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
-from partlab.tracking.limbs3d.priors import candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.limbs3d.priors import blob_keys, candidate_prior, observe_view, prune_and_merge
 from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
@@ -195,14 +195,14 @@ class Limbs3DTracker:
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
             centres.append(blobs.centres)
-            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0))
+            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment))
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
     def candidates(self, centres, views):
         cands = pair_candidates(self.cameras, centres)
         prior, raw = candidate_prior(cands, self.cameras, views, self.params)
-        points, weights = prune_and_merge(cands.points, prior.value, self.params)
+        points, weights = prune_and_merge(cands.points, prior.value, self.params, blob_keys(cands.views, cands.blobs))
         self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights}
         return points, weights
 
@@ -234,10 +234,12 @@ class Limbs3DTracker:
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
+        lost = np.array([m.state(k) == LimbState.LOST for k in active], bool)
         for a, k in enumerate(active):
             t = self.targets[k]
-            mine = self._usable(t, points, dist[:, a] if len(points) and len(active) > 1 else None,
-                                np.delete(dist, a, axis=1) if len(points) and len(active) > 1 else None,
+            rivals = self._rivals(a, lost)
+            few = not (len(points) and len(rivals))
+            mine = self._usable(t, points, None if few else dist[:, a], None if few else dist[:, rivals],
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
             if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
@@ -271,6 +273,15 @@ class Limbs3DTracker:
             elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
                 pass  # the leader's filter tracks both
         return self._records(index)
+
+    def _rivals(self, a: int, lost: np.ndarray) -> np.ndarray:
+        """The active targets (indices) whose predictions compete with target ``a``'s for candidates:
+        every other one, except that a lost target held where it was lost takes nothing from a
+        tracked one (``dynamics.lost_yield``)."""
+        rivals = np.delete(np.arange(len(lost)), a)
+        if self.params.dynamics.lost_yield and not lost[a]:
+            rivals = rivals[~lost[rivals]]
+        return rivals
 
     def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
