@@ -249,7 +249,9 @@ def test_a_stale_edit_from_a_second_session_is_refused_not_lost(server, page, st
     assert int(after.revision) == 1 and after.x > before.x and after.y == before.y  # the first edit stands
     # the refused session now shows the stored box and can apply its change again
     shown = "(window.partlabEditor.boxes.get(0) || []).find((b) => b.track_id === 1 && b.part === 'head')"
-    second.wait_for_function(f"() => {{ const b = {shown}; return b && b.revision === 1; }}")
+    # (its own refused drag bumped the box's revision optimistically: wait for the stored place too)
+    second.wait_for_function(f"() => {{ const b = {shown}; return b && b.revision === 1 && "
+                             f"Math.abs(b.x - {float(after.x)}) < 0.01 && Math.abs(b.y - {float(after.y)}) < 0.01; }}")
     _settled(second)
     _drag(second, heads[1], 0, 20)
     _wait_for(lambda: store.revision(clip.id, 0, 1, "head") == 2, timeout=60, what="the second session's retry")
