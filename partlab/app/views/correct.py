@@ -210,6 +210,10 @@ def editor_panel() -> None:
     # events the user made since the last run are applied first, so the editor is drawn with their result
     events = pending_events(editor_key)
     apply(events)
+    if any(e.get("kind") not in ("frame",) for e in events):
+        # the track list, timeline counts and progress below show the edit; the messages of
+        # apply() wait in the session for that run (shown now, a full rerun would wipe them at once)
+        st.rerun(scope="app")
     frame = current_frame()
     version = s.data_version(clip.id)
     data = clip_boxes(s.url, clip.id, version)
@@ -234,8 +238,6 @@ def editor_panel() -> None:
         st.rerun()
     if views:
         other_views(frame)
-    if any(e.get("kind") not in ("frame",) for e in events):
-        st.rerun(scope="app")  # the track list, timeline counts and progress below show the edit
 
 
 warm_tracker()
