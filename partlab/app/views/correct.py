@@ -217,8 +217,9 @@ def editor_panel() -> None:
     frame = current_frame()
     version = s.data_version(clip.id)
     data = clip_boxes(s.url, clip.id, version)
+    notes = st.container()  # always drawn, so that a message never shifts (and remounts) the editor below it
     for message in st.session_state.pop("correct_messages", []):
-        (st.error if message.startswith("Not saved") else st.info)(plain(message))
+        (notes.error if message.startswith("Not saved") else notes.info)(plain(message))
     try:
         cache = frame_cache(str(clip.path))
         cache.url(frame)
