@@ -148,7 +148,10 @@ class TrainingOptions:
     training clips (:func:`partlab.models.selection.select_components`; up to three more tracker
     runs per clip); without it, everything fitted is used. ``person`` (None: when the truth has
     person rows and the tracker runs): learn from the person boxes too
-    (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip)."""
+    (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip);
+    ``validation_seeds``: how many tracker seeds each person-box component is validated over (a
+    component is kept only if it lowers the edits pooled over them and on at least half; one seed's
+    edits vary by a few per 100 boxes for the same model, so one run decides by chance)."""
 
     seed: int = 0
     perturbed_per_person: int = 300
@@ -156,6 +159,7 @@ class TrainingOptions:
     fit_sharpness: bool | None = None
     validate: bool = True
     person: bool | None = None
+    validation_seeds: int = 3
 
 
 @dataclass
@@ -279,13 +283,19 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
     from partlab.models.person import fit_person, select_person
 
     inits = [first_boxes(g) for g in got.truths]
+    n_seeds = max(int(opts.validation_seeds), 1)
+    # validation run j: clip j % n, tracker seed opts.seed + clip + 1000 * (j // n); the first seed's
+    # runs are the ones the fits are made on
+    n = len(clips)
+    jobs = [(i, k) for k in range(n_seeds) for i in range(n)]
 
-    def run(i, params):
-        return tracker_runner(clips[i][0], clips[i][1], inits[i], opts.seed + i, params=params,
+    def run(j, params):
+        i, k = jobs[j]
+        return tracker_runner(clips[i][0], clips[i][1], inits[i], opts.seed + i + 1000 * k, params=params,
                               failure_detector=detector)
 
     step("tracking with the start")
-    base_tracks = [run(i, body_p) for i in range(len(clips))]
+    base_tracks = [run(j, body_p) for j in range(n)]
     fit = fit_person(clips, got.truths, base_tracks, body_p, table, progress=step)
     if not opts.validate:
         chosen = body_p
@@ -293,7 +303,12 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
             chosen = chosen.updated(changes)
         return chosen, {**fit.record, "fitted": sorted(fit.components), "kept": {c: True for c in fit.components},
                         "fields": sorted(f for changes in fit.components.values() for f in changes)}
-    chosen, record = select_person(run, got.truths, body_p, fit, base_tracks=base_tracks, progress=step)
+    if fit.components and n_seeds > 1:
+        step(f"tracking with the start, {n_seeds - 1} more seed(s)")
+        base_tracks += [run(j, body_p) for j in range(n, len(jobs))]
+    truths = [got.truths[i] for i, _k in jobs[:len(base_tracks)]]
+    groups = [k for _i, k in jobs[:len(base_tracks)]]
+    chosen, record = select_person(run, truths, body_p, fit, base_tracks=base_tracks, progress=step, groups=groups)
     return chosen, {**fit.record, "fitted": sorted(fit.components), **record}
 
 

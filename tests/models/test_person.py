@@ -108,6 +108,39 @@ def test_selection_keeps_only_what_lowers_the_edits():
     assert len(calls) == 3  # start, +extent, +ending
 
 
+def _moved_on(df, frac):
+    """``df`` with the boxes of its first ``frac`` of frames moved off their people."""
+    out = df.copy()
+    frames = np.sort(df.frame.unique())
+    off = df.frame.isin(frames[: int(round(frac * len(frames)))])
+    out.loc[off, "x"] += 3 * out.loc[off, "w"]
+    return out
+
+
+def test_selection_over_seeds_drops_a_change_that_helps_one_random_stream_only():
+    """Validated over three tracker seeds, a component that lowers the pooled edits because one
+    seed's run went much better, while the two others got worse, is not kept; judged on the
+    pooled edits alone (one group) it would have been."""
+    truth = normalise_tracks(_people(walking_truth(2, 20, seed=5)))
+
+    def run(i, params):  # seeds 0, 1: half the frames off at the start, 0.6 of them with the change;
+        change = params.detector.undetected_frames == 30  # seed 2: all off at the start, none with it
+        if i == 2:
+            return truth.copy() if change else _moved_on(truth, 1.0)
+        return _moved_on(truth, 0.6 if change else 0.5)
+
+    fit = P.PersonFit(components={"ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(run, [truth] * 3, BodyParams(), fit, groups=[0, 1, 2])
+    assert rec["scores_by_seed"]["start"] == pytest.approx([50.0, 50.0, 100.0])
+    assert rec["scores_by_seed"]["+ending"] == pytest.approx([60.0, 60.0, 0.0])
+    assert rec["scores"]["+ending"] < rec["scores"]["start"]  # pooled: lower
+    assert rec["kept"] == {"ending": False}
+    assert params.detector.undetected_frames == BodyParams().detector.undetected_frames
+    assert "3 tracker seeds" in rec["rule"]
+    _params, pooled = P.select_person(run, [truth] * 3, BodyParams(), fit)
+    assert pooled["kept"] == {"ending": True}
+
+
 def test_training_from_person_boxes_alone_recalibrates_a_wrong_person_box(tmp_path, capsys):
     """A bundle whose person boxes are written at 0.6 of the parts' bounding box (a miscalibrated
     start): training from the truth's person rows alone learns ``output.person`` back, validation
