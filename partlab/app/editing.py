@@ -73,6 +73,9 @@ class EditHistory:
     fills: dict[tuple[int, str], int] = field(default_factory=dict)
     #: ``revs`` of the other views of a take this session wrote into, by clip id
     view_revs: dict[int, dict[tuple[int, int, str], int]] = field(default_factory=dict)
+    #: ``seq`` of this session's box edits that were refused as stale: an edit the editor based on
+    #: one of them (``based_on``) carries that edit's optimistic revision and is refused too
+    refused: set[int] = field(default_factory=set)
     lock: threading.RLock = field(default_factory=threading.RLock, repr=False, compare=False)
 
     def touched(self, refill: list[tuple[int, str, int]]) -> dict[tuple[int, str], int]:
@@ -362,6 +365,20 @@ def _box_edit(store: Store, clip_id: int, ev: dict, history: EditHistory, author
     return step
 
 
+def _check_basis(ev: dict, history: EditHistory) -> None:
+    """Refuse a box edit made on top of one of this session's refused edits.
+
+    The editor counts a box's revision up as soon as it sends an edit (so the next drag of the
+    same box expects the revision its own edit will make). When that edit is refused, a drag made
+    before the page's answer arrives expects the revision someone else's edit made, and would
+    overwrite it unseen; ``based_on`` names the edit the editor's revision came from."""
+    based = ev.get("based_on")
+    if based and int(based) in history.refused:
+        raise StaleEditError(f"{ev.get('part')} #{ev.get('track_id')} at frame {ev.get('frame')} was changed by "
+                             "someone else before your previous edit of it (not saved either); the page now "
+                             "shows the stored box: apply your change again")
+
+
 def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHistory,
                  author: str = "", fill: bool = False, follow: Follow | None = None) -> ApplyResult:
     """Write the editor's events to the store in order; see :mod:`partlab.app.box_editor` for
@@ -377,6 +394,7 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 store.set_occluders(clip_id, [_box(b) for b in ev.get("boxes", [])])
                 res.written += 1
             elif kind in ("edit", "delete"):
+                _check_basis(ev, history)
                 step = _box_edit(store, clip_id, ev, history, author, fill, follow)
                 if step.run_id is not None:
                     res.refills.append(step)
@@ -404,6 +422,8 @@ def apply_events(store: Store, clip_id: int, events: list[dict], history: EditHi
                 res.written += 1
                 res.notes.append(f"redid the {step.label}")
         except StaleEditError as exc:
+            if kind in ("edit", "delete") and ev.get("seq") is not None:
+                history.refused.add(int(ev["seq"]))
             res.errors.append(f"Not saved: {exc}")
         except (StoreError, ValueError, KeyError, TypeError) as exc:
             res.errors.append(f"Not saved ({kind}): {exc}")

@@ -40,6 +40,31 @@ def test_stale_edit_is_refused_with_the_store_message(store, tracked_clip):
     assert _box(store, clip.id, 0, "head").x == 1.0  # the first edit was not lost
 
 
+def test_a_drag_made_on_top_of_a_refused_edit_does_not_overwrite_the_other_users_box(store, tracked_clip):
+    """The editor counts a box's revision up when it sends an edit. When that edit is refused
+    (someone else's edit came first), a drag made before the page's answer arrives expects the
+    other user's revision: it is refused too (``based_on`` names the refused edit), and the other
+    user's box stays. Once the page showed the stored box, the same user's edit is saved."""
+    _, clip = tracked_clip
+    edit = dict(kind="edit", frame=0, track_id=1, part="head", failure=False, occluded=0)
+    assert apply_events(store, clip.id, [dict(edit, seq=1, box=[1, 2, 3, 4], revision=0)], EditHistory()).errors == []
+    mine = EditHistory()  # this session still saw revision 0
+    res = apply_events(store, clip.id, [dict(edit, seq=1, box=[9, 9, 3, 4], revision=0)], mine)
+    assert res.written == 0 and "changed by someone else" in res.errors[0]
+    res = apply_events(store, clip.id, [dict(edit, seq=2, box=[20, 20, 3, 4], revision=1, based_on=1)], mine)
+    assert res.written == 0 and "before your previous edit" in res.errors[0], res.errors
+    res = apply_events(store, clip.id, [dict(kind="delete", frame=0, track_id=1, part="head", seq=3, revision=2,
+                                             based_on=2)], mine)
+    assert res.written == 0 and len(res.errors) == 1  # a chain of them, deletes too
+    assert (_box(store, clip.id, 0, "head").x, int(_box(store, clip.id, 0, "head").revision)) == (1.0, 1)
+    # after the rerun the editor has the stored box (revision 1, from Python): saved
+    res = apply_events(store, clip.id, [dict(edit, seq=4, box=[20, 20, 3, 4], revision=1, based_on=0)], mine)
+    assert res.errors == [] and _box(store, clip.id, 0, "head").x == 20.0
+    # and this session's own chain of edits goes on as before
+    res = apply_events(store, clip.id, [dict(edit, seq=5, box=[21, 20, 3, 4], revision=2, based_on=4)], mine)
+    assert res.errors == [] and int(_box(store, clip.id, 0, "head").revision) == 3
+
+
 def test_undo_and_redo_walk_this_sessions_edits(store, tracked_clip):
     _, clip = tracked_clip
     hist = EditHistory()

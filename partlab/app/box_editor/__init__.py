@@ -16,7 +16,9 @@ Events (dicts): ``{"kind": "edit", "frame", "track_id", "part", "box": [x, y, w,
 ``{"kind": "redo"}``, ``{"kind": "occluders", "boxes": [[x, y, w, h], ...]}``, and for the
 timeline's events ``{"kind": "event_add", "type", "start_frame", "end_frame"}``,
 ``{"kind": "event_edit", "event_id", "revision", "start_frame"?, "end_frame"?, "type"?}``,
-``{"kind": "event_delete", "event_id", "revision"}``.
+``{"kind": "event_delete", "event_id", "revision"}``. Box edits and deletes also carry
+``based_on``: the ``seq`` of this editor's earlier edit whose optimistic revision they expect
+(0: the revision came from Python), so an edit made on top of a refused one is refused too.
 """
 
 from __future__ import annotations

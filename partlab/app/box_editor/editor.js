@@ -648,8 +648,10 @@ class Editor {
 
   emitBox(b, extra) {
     this.emit({ kind: "edit", track_id: b.track_id, part: b.part, box: [b.x, b.y, b.w, b.h],
-      failure: !!b.failure, occluded: Number(b.occluded || 0), revision: b.revision ?? null, fill: this.fill, ...extra });
+      failure: !!b.failure, occluded: Number(b.occluded || 0), revision: b.revision ?? null, based_on: b.basedOn || 0,
+      fill: this.fill, ...extra });
     b.revision = (b.revision ?? 0) + 1; // optimistic: the next edit of this box expects our revision
+    b.basedOn = this.seq; // ... which holds only if that edit is saved: Python refuses the next one otherwise
     b.human = true;
   }
 
@@ -687,7 +689,8 @@ class Editor {
       list.splice(list.indexOf(b), 1);
       this.selected = null;
       if (occl) this.emitOccluders();
-      else this.emit({ kind: "delete", track_id: b.track_id, part: b.part, revision: b.revision ?? null });
+      else this.emit({ kind: "delete", track_id: b.track_id, part: b.part, revision: b.revision ?? null,
+        based_on: b.basedOn || 0 });
       this.setStatus(`deleted ${b.part} of #${b.track_id}`);
       this.render();
     } else if ((name === "failure" || name === "occluded") && !occl) {
