@@ -29,19 +29,24 @@ On a shared machine, split the seeds over processes and summarise their rows aft
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
 import pandas as pd
 
-from partlab.labelling.evaluation import box_correct
-from partlab.labelling.stereo import StereoRig
-from partlab.labelling.synth.depth_scene import make_depth_scene
-from partlab.tracking.depth.params import DepthParams
-from partlab.tracking.frame import FrameSet
-from partlab.tracking.protocol import TrackContext
-from partlab.tracking.run import build_tracker
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
+
+from partlab.labelling.evaluation import box_correct  # noqa: E402
+from partlab.labelling.stereo import StereoRig  # noqa: E402
+from partlab.labelling.synth.depth_scene import make_depth_scene  # noqa: E402
+from partlab.tracking.depth.params import DepthParams  # noqa: E402
+from partlab.tracking.frame import FrameSet  # noqa: E402
+from partlab.tracking.protocol import TrackContext  # noqa: E402
+from partlab.tracking.run import build_tracker  # noqa: E402
 
 VARIANTS = ("color_ms", "color_is", "all", "stereo")
 HANDS = ("left_hand", "right_hand")

@@ -9,12 +9,16 @@ Prints counts, round-trip errors and timings; writes into a temporary directory 
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
 
 
 def main() -> None:

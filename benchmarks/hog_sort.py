@@ -14,12 +14,18 @@ is installed; numbers as in the paper's defaults.
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import cv2
 import numpy as np
 import pandas as pd
 from scipy.optimize import linear_sum_assignment
 
-from partlab.tracking.core.box import iou_xywh
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
+
+from partlab.tracking.core.box import iou_xywh  # noqa: E402
 
 
 def hog_detector() -> cv2.HOGDescriptor:

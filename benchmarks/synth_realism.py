@@ -11,6 +11,7 @@ the same two camera numbers are printed for a real clip's first frames, for comp
 from __future__ import annotations
 
 import argparse
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -18,8 +19,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from partlab.labelling.synth import SCENARIOS, render_scenario
-from partlab.tracking.tracks import read_tracks_csv
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
+
+from partlab.labelling.synth import SCENARIOS, render_scenario  # noqa: E402
+from partlab.tracking.tracks import read_tracks_csv  # noqa: E402
 
 
 def camera_stats(path: Path, n: int = 60) -> tuple[float, float]:

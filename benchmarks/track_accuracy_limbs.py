@@ -23,17 +23,22 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from tqdm import tqdm
 
-from partlab.tracking import measures
-from partlab.tracking.core.background import BackgroundModel
-from partlab.tracking.limbs.tracker import LimbTracker
-from partlab.tracking.params import LimbParams
-from partlab.tracking.parts import LIMB_PARTS
-from partlab.tracking.run import run_single_view
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
+
+from partlab.tracking import measures  # noqa: E402
+from partlab.tracking.core.background import BackgroundModel  # noqa: E402
+from partlab.tracking.limbs.tracker import LimbTracker  # noqa: E402
+from partlab.tracking.params import LimbParams  # noqa: E402
+from partlab.tracking.parts import LIMB_PARTS  # noqa: E402
+from partlab.tracking.run import run_single_view  # noqa: E402
 
 
 class PlateForeground:

@@ -10,14 +10,19 @@ per tracked target, on frames of the given size. A script, not a test:
 from __future__ import annotations
 
 import argparse
+import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
 
-from partlab.tracking.limbs.tracker import LimbTracker
-from partlab.tracking.params import LimbParams
-from partlab.tracking.run import run_single_view
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))  # this checkout's partlab, not an installed one
+
+from partlab.tracking.limbs.tracker import LimbTracker  # noqa: E402
+from partlab.tracking.params import LimbParams  # noqa: E402
+from partlab.tracking.run import run_single_view  # noqa: E402
 
 SKIN = (105, 145, 195)
 
