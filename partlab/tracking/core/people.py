@@ -10,7 +10,8 @@ the frame, its window shrunk to the body (the 64 x 128 window holds a person of 
 it) and suppressed to one box per person (non-maximum suppression).
 
 :func:`associate` pairs detections with tracks by the Hungarian method on IoU
-(``scipy.optimize.linear_sum_assignment``), as SORT (Bewley et al. 2016) and Breitenstein et al.
+(:mod:`partlab.tracking.core.assignment`, SciPy's algorithm without importing ``scipy.optimize``),
+as SORT (Bewley et al. 2016) and Breitenstein et al.
 (2009, "Robust tracking-by-detection using a detector confidence particle filter") do.
 """
 
@@ -21,6 +22,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from partlab.tracking.core.assignment import linear_sum_assignment
 from partlab.tracking.core.box import Box, iou_xywh
 
 #: the default detector's window (width, height) in pixels
@@ -190,8 +192,6 @@ def associate(tracks: np.ndarray, detections: np.ndarray, iou_min: float, affini
     al. 2017, with colour in place of a learnt embedding)."""
     if len(tracks) == 0 or len(detections) == 0:
         return []
-    from scipy.optimize import linear_sum_assignment  # lazy: scipy.optimize costs a start-up 2x numpy's
-
     iou = iou_xywh(np.asarray(tracks, float)[:, :4], np.asarray(detections, float)[:, :4])
     if affinity is None:  # IoU alone: assign over every pair, then keep those overlapping enough
         rows, cols = linear_sum_assignment(-iou)
@@ -216,7 +216,5 @@ def associate_near(previous: np.ndarray, detections: np.ndarray, max_distance: f
     d = np.hypot(*(ca[:, None, :] - cb[None, :, :]).transpose(2, 0, 1)) / np.maximum(b[None, :, 3], 1e-6)
     ratio = a[:, None, 3] / np.maximum(b[None, :, 3], 1e-6)
     cost = np.where((ratio <= 1.5) & (ratio >= 1 / 1.5), d, 1e6)
-    from scipy.optimize import linear_sum_assignment
-
     rows, cols = linear_sum_assignment(cost)
     return [(int(i), int(j)) for i, j in zip(rows, cols) if cost[i, j] <= max_distance]
