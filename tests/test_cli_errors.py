@@ -1,5 +1,6 @@
 """The top-level handler: one line and an exit code, never a traceback; nothing saved is lost."""
 
+import csv
 import errno
 
 import numpy as np
@@ -18,17 +19,29 @@ def clip(tmp_path):
 
 
 def test_a_full_disk_leaves_the_earlier_tracks_file(tmp_path, clip, monkeypatch, capsys):
-    out = tmp_path / "tracks.csv"
+    out, init = tmp_path / "tracks.csv", tmp_path / "init.csv"
+    init.write_text("frame,track_id,part,x,y,w,h\n0,1,person,10,5,20,40\n")  # rows to write after the header
     out.write_text("frame,track_id,part,x,y,w,h\n0,1,head,1,2,3,4\n")
     before = out.read_text()
-    real = pd.DataFrame.to_csv
+    real_csv, real_writer = pd.DataFrame.to_csv, csv.writer
 
     def half_then_full(self, path, *a, **k):
-        real(self.head(0), path, *a, **k)  # a partial file that would still parse
+        real_csv(self.head(0), path, *a, **k)  # a partial file that would still parse
         raise OSError(errno.ENOSPC, "No space left on device", str(path))
 
+    class HeaderThenFull:  # the writer without pandas (partlab track's): the header, then a full disk
+        def __init__(self, fh, **k):
+            self.inner, self.rows = real_writer(fh, **k), 0
+
+        def writerow(self, row):
+            if self.rows:
+                raise OSError(errno.ENOSPC, "No space left on device")
+            self.rows += 1
+            return self.inner.writerow(row)
+
     monkeypatch.setattr(pd.DataFrame, "to_csv", half_then_full)
-    assert cli.main(["track", str(clip), "-o", str(out), "--no-progress"]) == 2
+    monkeypatch.setattr(csv, "writer", HeaderThenFull)
+    assert cli.main(["track", str(clip), "-o", str(out), "--no-progress", "--init", str(init)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no space left" in err[0]
     assert out.read_text() == before
@@ -41,7 +54,7 @@ def test_an_unexpected_error_is_one_line_with_a_hint(clip, tmp_path, monkeypatch
     def boom(*a, **k):
         raise KeyError("lost")
 
-    monkeypatch.setattr(run, "run_frames", boom)
+    monkeypatch.setattr(run, "_step_all", boom)  # the loop both run_frames and run_records use
     assert cli.main(["track", str(clip), "-o", str(tmp_path / "t.csv"), "--no-progress"]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["partlab track: unexpected KeyError: 'lost' (rerun with --debug for the traceback)"]

@@ -18,12 +18,13 @@ def clip(tmp_path_factory):
     return out / "clip.mp4"
 
 
-@pytest.mark.parametrize("tracker", ["body", "limbs", "all"])
-def test_a_short_track_loads_no_store_scipy_or_app(clip, tracker, tmp_path):
+@pytest.mark.parametrize("tracker, init", [("body", False), ("body", True), ("limbs", False), ("all", False)])
+def test_a_short_track_loads_no_store_scipy_or_app(clip, tracker, init, tmp_path):
     out = tmp_path / "tracks.csv"
+    extra = ["--init", str(clip.parent / "init.csv")] if init else []  # tracks started: detections are assigned
     code = ("import sys\n"
             "from partlab.cli import main\n"
-            f"assert main(['track', {str(clip)!r}, '--tracker', {tracker!r}, '-o', {str(out)!r}]) == 0\n"
+            f"assert main(['track', {str(clip)!r}, '--tracker', {tracker!r}, '-o', {str(out)!r}, *{extra!r}]) == 0\n"
             f"print('loaded:', *(m for m in {HEAVY!r} if m in sys.modules))\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.is_file()

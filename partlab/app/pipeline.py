@@ -5,11 +5,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from os import PathLike
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from partlab.labelling.take import open_take
 from partlab.tracking.run import RunResult, track
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 def track_path(path: str | PathLike, tracker: str = "body", **options) -> RunResult:

@@ -93,15 +93,21 @@ def write_events(events, args) -> None:
 
 def run(args) -> int:
     from partlab.app.pipeline import track_path
-    from partlab.tracking.tracks import TracksCSVError, read_tracks_csv, write_tracks_csv
+    from partlab.tracking.tracks import (
+        TracksCSVError,
+        read_track_records,
+        read_tracks_csv,
+        write_track_records,
+        write_tracks_csv,
+    )
 
     init = None
     if args.init:
         try:
-            init = read_tracks_csv(args.init)
+            init = read_track_records(args.init)  # rows, not a table: a short run need not import pandas
         except TracksCSVError as exc:
             raise CommandError(str(exc)) from None
-        if init.empty:
+        if not init:
             raise CommandError(f"{args.init}: no boxes to start from")
     keyframes = None
     if args.keyframes:
@@ -139,13 +145,17 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    tracks = result.tracks
+    records = getattr(result, "records", None)
     try:
-        write_tracks_csv(tracks, args.output)
+        if records is not None:
+            write_track_records(records, args.output)
+        else:
+            write_tracks_csv(result.tracks, args.output)
     except OSError as exc:
         raise CommandError(f"{args.output}: cannot write: {describe_os_error(exc)}") from None
-    people = tracks["track_id"].nunique() if len(tracks) else 0
-    print(f"wrote {len(tracks)} boxes of {people} track(s) to {args.output}")
+    rows = records if records is not None else result.tracks
+    people = len({r.track_id for r in records}) if records is not None else rows["track_id"].nunique()
+    print(f"wrote {len(rows)} boxes of {people} track(s) to {args.output}")
     if args.events:
         write_events(result.events, args)
     return 0

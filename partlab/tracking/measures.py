@@ -24,12 +24,15 @@ Boxes are ``(..., 4)`` arrays ``[x, y, w, h]`` (top-left corner and size) or tra
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import BODY_PARTS
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Zhao & Lee sec. 5.2: a box is wrong when half of it or more covers other things.
 MIN_COVER: float = 0.5

@@ -13,22 +13,26 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
-import pandas as pd
 
 from partlab.tracking.camera import Camera
 from partlab.tracking.core.box import Box
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 
 @dataclass(frozen=True)
 class TrackContext:
     """Everything a tracker is started with besides its parameters and random generator.
 
-    ``init``: tracks table of the boxes to start from (None: find people automatically);
+    ``init``: the boxes to start from, a tracks table or a list of :class:`TrackRecord` (the
+    command line's, read without pandas; :meth:`init_table` gives the table), or None: find
+    people automatically;
     ``occluders``: fixed regions that can hide people; ``fps``: frames per second of the take;
     ``cameras``: the take's calibration per stream (None where a stream has none);
     ``failure_detector``: a :class:`FailureDetector` or None; ``backgrounds``: per stream an
@@ -36,12 +40,18 @@ class TrackContext:
     ``<stream>_background.png``), for trackers that subtract a fixed background.
     """
 
-    init: pd.DataFrame | None = None
+    init: pd.DataFrame | list[TrackRecord] | None = None
     occluders: Sequence[Box] = ()
     fps: float = 25.0
     cameras: Mapping[str, Camera | None] = field(default_factory=dict)
     failure_detector: Any = None
     backgrounds: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+    def init_table(self) -> pd.DataFrame | None:
+        """``init`` as a tracks table (None when there is none)."""
+        if isinstance(self.init, list):
+            return records_to_frame(self.init)
+        return self.init
 
 
 class Tracker(Protocol):
@@ -85,10 +95,13 @@ class SingleView:
         view = frames.first
         return self.tracker.step(frames.index, view.color, foreground.get(view.stream))
 
+    def rows(self, records: list[TrackRecord]) -> list[TrackRecord]:
+        """The run's rows from every row ``step`` returned (e.g. rows of lost tracks withdrawn)."""
+        finish = getattr(self.tracker, "finish", None)
+        return finish(records) if finish is not None else records
+
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
-        finish = getattr(self.tracker, "finish", None)  # e.g. rows of lost tracks withdrawn
-        if finish is not None:
-            records = finish(records)
+        records = self.rows(records)
         return records_to_frame(records) if records else empty_tracks()
 
 

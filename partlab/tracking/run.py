@@ -12,18 +12,20 @@ parameters draws from its own fixed stream of the seed (:mod:`partlab.tracking.r
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
-from typing import Any
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from partlab.errors import UserError
 from partlab.tracking import registry
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.frame import FrameSet, TakeSource
 from partlab.tracking.protocol import SingleView, TrackContext, Tracker
-from partlab.tracking.tracks import TrackRecord, TracksCSVError, empty_tracks, normalise_tracks
+from partlab.tracking.tracks import TrackRecord, TracksCSVError, empty_tracks, normalise_tracks, records_to_frame
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 Progress = Callable[[int, int], None]
 
@@ -31,10 +33,19 @@ Progress = Callable[[int, int], None]
 @dataclass
 class RunResult:
     """``tracks``: the tracks table (frame indexes of the whole take); ``events``: what the
-    tracker recognised (joins, activities), or None when it recognises nothing."""
+    tracker recognised (joins, activities), or None when it recognises nothing. A single-view
+    run keeps its rows as ``records`` (:class:`TrackRecord`) and makes the table when it is
+    first asked for, so ``partlab track`` writes them without importing pandas."""
 
-    tracks: pd.DataFrame
+    _tracks: pd.DataFrame | None = None
     events: pd.DataFrame | None = None
+    records: list[TrackRecord] | None = field(default=None, repr=False)
+
+    @property
+    def tracks(self) -> pd.DataFrame:
+        if self._tracks is None:
+            self._tracks = records_to_frame(self.records or [])
+        return self._tracks
 
 
 def model_params(model: Any, key: str) -> Any:
@@ -96,6 +107,18 @@ def run_frames(tracker: Tracker, frames: Iterable[FrameSet], background: Callabl
     ``background(stream)`` makes the background model of a stream (called once per stream; None:
     no foreground masks). ``progress(done, total)`` is called after every frame.
     """
+    return tracker.table(_step_all(tracker, frames, background, progress, total))
+
+
+def run_records(tracker: SingleView, frames: Iterable[FrameSet], background: Callable[[str], Any] | None = None,
+                progress: Progress | None = None, total: int | None = None) -> list[TrackRecord]:
+    """:func:`run_frames` of a single-view tracker, its rows as :class:`TrackRecord`."""
+    return tracker.rows(_step_all(tracker, frames, background, progress, total))
+
+
+def _step_all(tracker: Tracker, frames: Iterable[FrameSet], background: Callable[[str], Any] | None,
+              progress: Progress | None, total: int | None) -> list[TrackRecord]:
+    """Every row ``tracker.step`` returns over ``frames`` (one background model per stream)."""
     models: dict[str, Any] = {}
     records: list[TrackRecord] = []
     done = 0
@@ -112,7 +135,7 @@ def run_frames(tracker: Tracker, frames: Iterable[FrameSet], background: Callabl
         done += 1
         if progress is not None:
             progress(done, total if total is not None else done)
-    return tracker.table(records)
+    return records
 
 
 def check_take(entry: registry.TrackerEntry, take: TakeSource) -> None:
@@ -147,7 +170,9 @@ def track(take: TakeSource, tracker: str = "body", *, init: pd.DataFrame | None 
     stop = n if stop is None else min(int(stop), n)
     if stop <= start:
         raise UserError(f"stop frame {stop} is not after start frame {start}")
-    if init is not None:
+    if isinstance(init, list):  # rows read without pandas (the command line)
+        init = [r for r in init if r.frame >= start]
+    elif init is not None:
         try:
             init = normalise_tracks(init)
         except (TracksCSVError, ValueError, KeyError) as exc:
@@ -159,6 +184,10 @@ def track(take: TakeSource, tracker: str = "body", *, init: pd.DataFrame | None 
     built = build_tracker(tracker, model=model, seed=seed, context=context)
     body_params = model_params(model, "body")  # the background model's settings
     background = (lambda stream: BackgroundModel(body_params)) if entry.foreground else None
-    tracks = run_frames(built, take.frames(start, stop), background, progress, total=stop - start)
+    frames = take.frames(start, stop)
+    if isinstance(built, SingleView):  # its rows are the output: no table until one is asked for
+        records = run_records(built, frames, background, progress, total=stop - start)
+        return RunResult(events=built.events, records=records)
+    tracks = run_frames(built, frames, background, progress, total=stop - start)
     events = getattr(built, "events", None)
     return RunResult(tracks if len(tracks) else empty_tracks(), events)

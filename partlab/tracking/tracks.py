@@ -8,6 +8,9 @@ one-stream take) and ``X, Y, Z`` are the part's 3D position in millimetres in th
 frame (empty when unknown). Readers ignore columns they do not know. In memory a tracks table is
 a pandas DataFrame with exactly these columns (optional ones filled with their defaults); the
 writer leaves out ``camera`` and ``X, Y, Z`` when no row has them, so 2D files stay as they were.
+:func:`read_track_records` and :func:`write_track_records` read and write the same files as lists
+of :class:`TrackRecord` without pandas (``partlab track``'s start-up: importing pandas costs more
+than tracking a short clip).
 """
 
 from __future__ import annotations
@@ -18,12 +21,14 @@ import math
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from partlab.limits import MAX_ID, max_coord, max_csv_rows
 from partlab.tracking.core.box import Box
 from partlab.tracking.parts import PART_NAMES
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 REQUIRED_COLUMNS: tuple[str, ...] = ("frame", "track_id", "part", "x", "y", "w", "h")
 OPTIONAL_COLUMNS: tuple[str, ...] = ("score", "failure", "occluded", "state", "source", "camera", "X", "Y", "Z")
@@ -90,11 +95,15 @@ class TrackRecord:
 
 def empty_tracks() -> pd.DataFrame:
     """A tracks table with no rows and the canonical columns and dtypes."""
+    import pandas as pd
+
     return normalise_tracks(pd.DataFrame({c: [] for c in REQUIRED_COLUMNS}))
 
 
 def records_to_frame(records) -> pd.DataFrame:
     """Tracks table from an iterable of :class:`TrackRecord`."""
+    import pandas as pd
+
     rows = [r.as_row() for r in records]
     if not rows:
         return empty_tracks()
@@ -226,6 +235,24 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
     Every malformed cell is reported as ``FILE line L, column 'C': problem`` (lines
     counted from 1, the header being line 1), so a user can open the file there.
     """
+    import pandas as pd
+
+    return normalise_tracks(pd.DataFrame(_read_columns(source, name)))
+
+
+def read_track_records(source: str | PathLike | io.TextIOBase, *, name: str | None = None) -> list[TrackRecord]:
+    """:func:`read_tracks_csv`'s rows, in the file's order, as :class:`TrackRecord` (no pandas)."""
+    cols = _read_columns(source, name)
+    n = len(cols["frame"])
+    get = {c: cols.get(c) or [DEFAULTS[c]] * n for c in OPTIONAL_COLUMNS}
+    return [TrackRecord(cols["frame"][i], cols["track_id"][i], cols["part"][i],
+                        Box(cols["x"][i], cols["y"][i], cols["w"][i], cols["h"][i]),
+                        *(get[c][i] for c in OPTIONAL_COLUMNS))
+            for i in range(n)]
+
+
+def _read_columns(source: str | PathLike | io.TextIOBase, name: str | None) -> dict[str, list]:
+    """The checked cells of a tracks CSV by column (the columns the file has)."""
     label, text = _read_text(source, name)
     reader = _rows(csv.reader(io.StringIO(text, newline="")), label)
     try:
@@ -250,7 +277,7 @@ def read_tracks_csv(source: str | PathLike | io.TextIOBase, *, name: str | None 
         for col, i in index.items():
             cell = row[i].strip() if i < len(row) else ""
             cols[col].append(_parse_cell(col, cell, f"{label} line {lineno}, column '{col}'", coord_limit))
-    return normalise_tracks(pd.DataFrame(cols))
+    return cols
 
 
 def _read_text(source: str | PathLike | io.TextIOBase, name: str | None) -> tuple[str, str]:
@@ -341,6 +368,8 @@ def _parse_cell(col: str, cell: str, where: str, coord_limit: float):
 
 def normalise_tracks(df: pd.DataFrame) -> pd.DataFrame:
     """Canonical column order, dtypes and defaults; extra columns are dropped."""
+    import pandas as pd
+
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
     if missing:
         raise TracksCSVError(f"tracks table lacks column(s) {', '.join(missing)}")
@@ -387,3 +416,28 @@ def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> 
             df.to_csv(tmp, index=False, float_format="%.2f", lineterminator="\n")
     else:
         df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
+
+
+def write_track_records(records: list[TrackRecord], dest: str | PathLike) -> None:
+    """:func:`write_tracks_csv` of ``records`` without pandas: the same bytes (same order, ``%.2f``
+    floats, empty cells for NaN, ``failure`` as 0/1, the take columns only when a row has them)."""
+    order = {p: i for i, p in enumerate(PART_NAMES)}
+    rows = sorted(records, key=lambda r: (r.frame, r.track_id, order.get(r.part, len(order))))
+    take = any(r.camera != "" or not (math.isnan(r.X) and math.isnan(r.Y) and math.isnan(r.Z)) for r in rows)
+    header = [c for c in COLUMNS if take or c not in TAKE_COLUMNS]
+
+    def num(v: float) -> str:
+        return "" if math.isnan(v) else "%.2f" % v  # noqa: UP031 (pandas' float_format, the same text)
+
+    from partlab.files import replacing
+
+    with replacing(dest) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow(header)
+        for r in rows:
+            b = r.box
+            row = [r.frame, r.track_id, r.part, num(b.x), num(b.y), num(b.w), num(b.h), num(r.score),
+                   int(r.failure), num(r.occluded), r.state, r.source]
+            if take:
+                row += [r.camera, num(r.X), num(r.Y), num(r.Z)]
+            out.writerow(row)

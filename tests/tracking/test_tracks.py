@@ -81,3 +81,36 @@ def test_write_sorts_by_frame_track_part():
     write_tracks_csv(df, buf)
     rows = buf.getvalue().splitlines()[1:]
     assert [r.split(",")[:3] for r in rows] == [["0", "1", "torso"], ["0", "2", "head"], ["1", "1", "head"]]
+
+
+def _mixed_records(take: bool) -> list[TrackRecord]:
+    import math
+
+    recs = [TrackRecord(5, 2, "hipleg", Box(-0.0, 1.005, 2.675, 300.125), score=float("nan")),
+            TrackRecord(5, 2, "head", Box(10.5, 20, 8, 9), score=0.755, failure=True, occluded=0.25,
+                        state="lost, coasting", source="human"),
+            TrackRecord(0, 10, "person", Box(1e5, 2, 3, 4), score=-1.5),
+            TrackRecord(5, 1, "right_hand", Box(7, 8, 9, 10), state='say "hi"'),
+            TrackRecord(0, 3, "torso", Box(1, 2, 3, 4))]
+    if take:
+        recs.append(TrackRecord(2, 4, "head", Box(1, 1, 5, 5), camera="cam1", X=12.345, Y=math.nan, Z=-0.004))
+    return recs
+
+
+@pytest.mark.parametrize("take", [False, True])
+def test_the_pandas_free_writer_and_reader_give_the_tables_bytes_and_rows(tmp_path, take):
+    from partlab.tracking.tracks import read_track_records, write_track_records
+
+    recs = _mixed_records(take)
+    write_tracks_csv(records_to_frame(recs), tmp_path / "pandas.csv")
+    write_track_records(recs, tmp_path / "plain.csv")
+    text = (tmp_path / "pandas.csv").read_bytes()
+    assert (tmp_path / "plain.csv").read_bytes() == text
+    assert (b"cam1" in text) is take and b'"lost, coasting"' in text
+    back = read_track_records(tmp_path / "plain.csv")
+    # the same rows, in the file's order (compared as text: NaN is not equal to itself)
+    assert [repr(r) for r in frame_to_records(read_tracks_csv(tmp_path / "plain.csv"))] == [repr(r) for r in back]
+    assert [(r.frame, r.track_id, r.part) for r in back][:3] == [(0, 3, "torso"), (0, 10, "person"), (2, 4, "head")
+                                                                 if take else (5, 1, "right_hand")]
+    with pytest.raises(TracksCSVError, match="line 2, column 'w'"):
+        read_track_records(io.StringIO(HEADER + "\n0,1,head,1,2,-3,4\n"), name="t.csv")

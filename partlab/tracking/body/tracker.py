@@ -28,9 +28,9 @@ from __future__ import annotations
 
 from collections import deque
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from partlab.tracking.body.cue import DetectionCue
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
@@ -42,7 +42,10 @@ from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
 from partlab.tracking.params import BodyParams
 from partlab.tracking.parts import BODY_PARTS
 from partlab.tracking.protocol import FailureDetector, FailureVerdict
-from partlab.tracking.tracks import TrackRecord, normalise_tracks
+from partlab.tracking.tracks import TrackRecord, frame_to_records
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass
@@ -53,26 +56,34 @@ class TrackStart:
     boxes: dict[str, Box]
 
 
-def init_starts(init: pd.DataFrame, whole: bool = False) -> dict[int, TrackStart]:
-    """Per track id, its first listed frame and the boxes given there.
+def init_starts(init: pd.DataFrame | list[TrackRecord], whole: bool = False) -> dict[int, TrackStart]:
+    """Per track id (ascending), its first listed frame and the boxes given there (in the
+    order of their rows).
 
-    Rows of parts this tracker does not track (hands) are ignored; a track with neither
-    a person row nor a body-part row at its first frame is refused with a clear message.
+    ``init``: a tracks table or its rows as :class:`TrackRecord`. Rows of parts this tracker
+    does not track (hands) are ignored; a track with neither a person row nor a body-part row
+    at its first frame is refused with a clear message.
     """
-    df = normalise_tracks(init)
+    records = init if isinstance(init, list) else frame_to_records(init)
     wanted = ("person",) + BODY_PARTS
-    df = df[df["part"].isin(wanted)]
+    by_track: dict[int, list[TrackRecord]] = {}
+    for r in records:
+        if r.part in wanted:
+            by_track.setdefault(r.track_id, []).append(r)
     starts: dict[int, TrackStart] = {}
-    for tid, rows in df.groupby("track_id", sort=True):
-        first = int(rows["frame"].min())
-        at = rows[rows["frame"] == first]
+    for tid in sorted(by_track):
+        rows = by_track[tid]
+        first = min(r.frame for r in rows)
         boxes = {}
-        for r in at.itertuples(index=False):
-            if r.w < 2 or r.h < 2:
-                raise ValueError(f"init track {tid} frame {first}: the {r.part} box {r.w:g} x {r.h:g} is too small "
+        for r in rows:
+            if r.frame != first:
+                continue
+            b = r.box
+            if b.w < 2 or b.h < 2:
+                raise ValueError(f"init track {tid} frame {first}: the {r.part} box {b.w:g} x {b.h:g} is too small "
                                  f"to track (at least 2 x 2 pixels)")
-            boxes[str(r.part)] = Box(float(r.x), float(r.y), float(r.w), float(r.h))
-        starts[int(tid)] = TrackStart(first, boxes)
+            boxes[r.part] = Box(float(b.x), float(b.y), float(b.w), float(b.h))
+        starts[tid] = TrackStart(first, boxes)
     return starts
 
 
@@ -162,7 +173,8 @@ class BodyTracker:
     """
 
     def __init__(self, params: BodyParams | None = None, rng: np.random.Generator | None = None,
-                 init: pd.DataFrame | None = None, occluders=(), failure_detector: FailureDetector | None = None,
+                 init: pd.DataFrame | list[TrackRecord] | None = None, occluders=(),
+                 failure_detector: FailureDetector | None = None,
                  whole: bool = False, fps: float = 25.0):
         self.params = params or BodyParams()
         self.rng = rng if rng is not None else np.random.default_rng(0)

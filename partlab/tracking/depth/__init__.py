@@ -13,4 +13,4 @@ def build(params, rngs, context):
     """The registry's factory (:mod:`partlab.tracking.registry`)."""
     from partlab.tracking.depth.tracker import DepthTracker
 
-    return DepthTracker(params["depth"], rngs["depth"], init=context.init)
+    return DepthTracker(params["depth"], rngs["depth"], init=context.init_table())

@@ -15,7 +15,7 @@ def build(params, rngs, context):
 
     p = params["limbs"]
     try:
-        tracker = LimbTracker(p, rngs["limbs"], init=context.init)
+        tracker = LimbTracker(p, rngs["limbs"], init=context.init_table())
     except ValueError as exc:
         raise UserError(f"bad init table: {exc}") from None
     view = SingleView(tracker, p)

@@ -17,7 +17,7 @@ def build(params, rngs, context):
     if len(cameras) < 2:
         raise UserError(f"tracker 'limbs3d' needs two or more calibrated views, the take has {len(cameras)}")
     try:
-        return Limbs3DTracker(params["limbs3d"], rngs["limbs3d"], cameras, init=context.init,
+        return Limbs3DTracker(params["limbs3d"], rngs["limbs3d"], cameras, init=context.init_table(),
                               backgrounds=getattr(context, "backgrounds", None))
     except ValueError as exc:
         raise UserError(f"bad init table: {exc}") from None

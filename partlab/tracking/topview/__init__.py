@@ -14,4 +14,4 @@ def build(params, rngs, context):
     """The registry's factory (:mod:`partlab.tracking.registry`)."""
     from partlab.tracking.topview.tracker import TopViewTracker
 
-    return TopViewTracker(params["topview"], rngs["topview"], init=context.init, cameras=context.cameras)
+    return TopViewTracker(params["topview"], rngs["topview"], init=context.init_table(), cameras=context.cameras)
