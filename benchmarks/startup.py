@@ -5,9 +5,12 @@ Renders a 5-frame synthetic clip (``partlab synth --frames 5``) in a scratch fol
 turn and ``--repeat`` times each: ``python -c pass``, ``partlab --help``, ``partlab track CLIP``
 (people found automatically) and ``partlab track CLIP --init init.csv``. Prints the median and
 spread of each wall time, their ratio to ``python -c pass`` (the machine is shared, so the ratio
-says more than the seconds), and the import time of ``partlab track`` by top-level package.
+says more than the seconds), the CPU seconds (user + system: less shaken by other work on a
+shared machine than the wall time), and the import time of ``partlab track`` by top-level package.
+``--against DIR`` runs the same cases from another checkout too (e.g. ``git worktree add
+/tmp/old HEAD~3``), interleaved with this one's, so a busy machine slows both alike.
 
-    python benchmarks/startup.py [--repeat 5]
+    python benchmarks/startup.py [--repeat 5] [--against /tmp/old]
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ from __future__ import annotations
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -27,10 +31,14 @@ ROOT = Path(__file__).resolve().parents[1]
 PY = sys.executable
 
 
-def wall(cmd: list[str], env: dict) -> float:
+def wall(cmd: list[str], env: dict) -> tuple[float, float]:
+    """Wall and CPU (user + system) seconds of one run of ``cmd``."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - t
+    elapsed = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return elapsed, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def imports(cmd: list[str], env: dict) -> dict[str, float]:
@@ -46,6 +54,7 @@ def imports(cmd: list[str], env: dict) -> dict[str, float]:
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--against", type=Path, help="another checkout to time side by side with this one")
     a = ap.parse_args()
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     tmp = Path(tempfile.mkdtemp(prefix="partlab-startup-"))
@@ -59,16 +68,21 @@ def main() -> None:
         "partlab track --init (5 frames)": [PY, "-m", "partlab", "track", clip, "--init", str(tmp / "s" / "init.csv"),
                                             "-o", str(tmp / "t.csv"), "--no-progress"],
     }
-    for cmd in cases.values():  # warm the file cache and numba's on-disk cache
-        wall(cmd, env)
-    times = {name: [] for name in cases}
+    envs = {"": env}
+    if a.against is not None:
+        envs[f" [{a.against}]"] = dict(os.environ, PYTHONPATH=str(a.against.resolve()))
+    runs = {(name + tag): (cmd, e) for name, cmd in cases.items() for tag, e in envs.items()}
+    for cmd, e in runs.values():  # warm the file cache and numba's on-disk cache
+        wall(cmd, e)
+    times = {name: [] for name in runs}
     for _ in range(a.repeat):  # interleaved, so that a busy moment hits every case alike
-        for name, cmd in cases.items():
-            times[name].append(wall(cmd, env))
-    base = statistics.median(times["python -c pass"])
+        for name, (cmd, e) in runs.items():
+            times[name].append(wall(cmd, e))
+    base = statistics.median(t for t, _ in times["python -c pass"])
     for name, xs in times.items():
-        m = statistics.median(xs)
-        print(f"{name:34s} median {m:.2f} s (min {min(xs):.2f}, max {max(xs):.2f}), {m / base:.1f}x python -c pass")
+        m, cpu = statistics.median(t for t, _ in xs), statistics.median(c for _, c in xs)
+        print(f"{name:34s} median {m:.2f} s (min {min(t for t, _ in xs):.2f}, max {max(t for t, _ in xs):.2f}), "
+              f"{m / base:.1f}x python -c pass; CPU {cpu:.2f} s")
     by = imports(cases["partlab track --init (5 frames)"], env)
     total = sum(by.values())
     print(f"import time of partlab track --init: {total:.2f} s; " +
