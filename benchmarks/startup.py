@@ -35,7 +35,9 @@ def wall(cmd: list[str], env: dict) -> tuple[float, float]:
     """Wall and CPU (user + system) seconds of one run of ``cmd``."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # run from the checkout itself: ``python -m`` puts the working directory before PYTHONPATH
+    subprocess.run(cmd, env=env, cwd=env["PYTHONPATH"], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
     elapsed = time.perf_counter() - t
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     return elapsed, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
