@@ -10,7 +10,14 @@ from partlab.labelling.events import evaluate_events, temporal_iou
 from partlab.labelling.synth import make_scene
 from partlab.tracking.activities.objects import HUE_BINS, HandColour, colour_masses, fuse, fuse_views, hand_colour
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.recognise import bridge_gaps, contacts, merged_joins, stays_behind, still_moments
+from partlab.tracking.activities.recognise import (
+    bridge_gaps,
+    contacts,
+    handovers,
+    merged_joins,
+    stays_behind,
+    still_moments,
+)
 from partlab.tracking.activities.table import one_hand, two_hands
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
@@ -183,6 +190,34 @@ def test_3d_touches_come_from_whichever_view_saw_each_hand():
                          X=gap, Y=0.0, Z=1000.0))
     found = contacts(pd.DataFrame(rows), P)
     assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
+
+
+def _one_hand(kind, start, end, track, hue, part="right_hand", confidence=0.8):
+    return dict(start_frame=start, end_frame=end, kind=kind, track_id_a=track, part_a=part, track_id_b=0,
+                part_b="", ended_by="still", object_colour="#00ff00", confidence=confidence, hue=hue)
+
+
+def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
+    green, blue = 40, 110
+    gap = P.decision.handover_gap
+    shake = dict(start_frame=95, end_frame=99, kind="handshake", track_id_a=1, part_a="right_hand", track_id_b=2,
+                 part_b="left_hand", ended_by="contact", object_colour="", confidence=1.0)
+    rows = [_one_hand("place", 90, 100, 1, green, confidence=0.9),
+            _one_hand("pick", 100 + gap, 125, 2, green + 3, part="left_hand", confidence=0.7), shake]
+    out = handovers(rows, P)
+    assert len(out) == 1  # the handshake over the handover is its touch, not an activity of its own
+    ex = out[0]
+    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 125)
+    assert (ex["track_id_a"], ex["part_a"], ex["track_id_b"], ex["part_b"]) == (1, "right_hand", 2, "left_hand")
+    assert ex["confidence"] == pytest.approx(0.7)
+    # not a handover: picked up too late, another colour, by the same person, or picked before placed
+    for pick in (_one_hand("pick", 101 + gap, 125, 2, green), _one_hand("pick", 100, 125, 2, blue),
+                 _one_hand("pick", 100, 125, 1, green, part="left_hand"), _one_hand("pick", 80, 89, 2, green)):
+        out = handovers([rows[0], pick, shake], P)
+        assert sorted(r["kind"] for r in out) == ["handshake", "pick", "place"]
+    # two picks of the colour: the nearer in time takes it, the other stays a pick
+    out = handovers([rows[0], _one_hand("pick", 112, 125, 3, green), _one_hand("pick", 103, 120, 2, green)], P)
+    assert sorted((r["kind"], r["track_id_b"]) for r in out) == [("exchange", 2), ("pick", 0)]
 
 
 def test_temporal_matching():

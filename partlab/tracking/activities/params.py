@@ -115,6 +115,10 @@ class Decision:
     follow_move: float = number(0.5, POSITIVE)
     follow_ratio: float = number(0.5, FRACTION)
     follow_frames: int = number(3, POSITIVE_COUNT)
+    # an object one person's hand places and another person's hand picks up at most this many
+    # frames later (a handover whose hands the tracker never brings together: a short moment where
+    # nobody seems to hold it) was given, one exchange; a handshake of the two over it is dropped
+    handover_gap: int = number(15, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)

@@ -472,7 +472,53 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
-                                 confidence=round(v.margin, 3)))
-    out = pd.DataFrame(_distinct(rows), columns=list(ACTIVITY_COLUMNS))
-    out = out[(out["confidence"] >= params.decision.min_confidence) | (out["kind"] == "hand_head")]
+                                 confidence=round(v.margin, 3), hue=v.colour))
+    rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
+    out = pd.DataFrame(handovers(rows, params), columns=list(ACTIVITY_COLUMNS))
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)
+
+
+def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
+    """``rows`` (activity rows; one-hand ones with the object's hue bin as ``hue``) with each
+    object given from one person to another read as one exchange: a *place* by one person's hand
+    followed, at most ``handover_gap`` frames after it ends, by a *pick* of the same colour
+    (``same_colour``) by another person's hand. Where a tracker never brings the two hands together
+    (nor within ``contact_mm`` of each other in 3D) Table 1's two-hand rows are never read, and the
+    object seems to rest for a moment where nobody holds it. The exchange spans both still moments,
+    goes from the placing hand (``a``) to the picking one (``b``), with the less sure of the two
+    confidences; a handshake of the two people overlapping it is dropped (the touch of the
+    handover). Each place and each pick gives at most one exchange, the nearest in time first."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+
+    def same(h1, h2) -> bool:
+        return h1 is not None and h2 is not None and min((h1 - h2) % HUE_BINS, (h2 - h1) % HUE_BINS) <= reach
+
+    places = [i for i, r in enumerate(rows) if r["kind"] == "place"]
+    picks = [i for i, r in enumerate(rows) if r["kind"] == "pick"]
+    pairs = sorted((rows[j]["start_frame"] - rows[i]["end_frame"], i, j) for i in places for j in picks
+                   if rows[j]["track_id_a"] != rows[i]["track_id_a"]
+                   and rows[j]["start_frame"] >= rows[i]["start_frame"]
+                   and rows[j]["start_frame"] - rows[i]["end_frame"] <= d.handover_gap
+                   and same(rows[i].get("hue"), rows[j].get("hue")))
+    used: set[int] = set()
+    exchanges = []
+    for _, i, j in pairs:
+        if i in used or j in used:
+            continue
+        used |= {i, j}
+        give, take = rows[i], rows[j]
+        exchanges.append(dict(start_frame=give["start_frame"], end_frame=max(give["end_frame"], take["end_frame"]),
+                              kind="exchange", track_id_a=give["track_id_a"], part_a=give["part_a"],
+                              track_id_b=take["track_id_a"], part_b=take["part_a"], ended_by="still",
+                              object_colour=give["object_colour"], hue=give.get("hue"),
+                              confidence=min(give["confidence"], take["confidence"])))
+
+    def covered(r: dict) -> bool:
+        people = {r["track_id_a"], r["track_id_b"]}
+        return r["kind"] == "handshake" and any(
+            people == {e["track_id_a"], e["track_id_b"]} and _overlap((r["start_frame"], r["end_frame"]),
+                                                                     (e["start_frame"], e["end_frame"])) > 0
+            for e in exchanges)
+
+    return [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
