@@ -465,17 +465,72 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             worn = clothes.get(key[0], np.zeros(0, int))
             before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
                              for lo, hi in ((b0, b1), (a0, a1)))
+            only = None
+            if before is not None and after is None:
+                # unseen where it should have moved on (a giver's hand lost as the taker pulls the
+                # object away): what it held at the end of its still moment tells a place, nothing else
+                after, only = _without(_held(colours.get(key, {}), s1 - d.window, s1, params), worn), "place"
             if before is None or after is None:
                 continue
             v = one_hand(before, after, params,
                          lambda hue, k=key, c=cs, a=s0, b=s1: stays_behind(where.get(k, {}), c, hue, a, b, params))
+            if v is not None and only is not None and v.kind != only:
+                continue
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
                                  confidence=round(v.margin, 3), hue=v.colour))
     rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
+    rows += other_sides(rows, colours, clothes, params)
     out = pd.DataFrame(handovers(rows, params), columns=list(ACTIVITY_COLUMNS))
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)
+
+
+def other_sides(rows: list[dict], colours: Mapping[Key, Mapping[int, list[HandColour]]],
+                clothes: Mapping[int, np.ndarray], params: ActivityParams) -> list[dict]:
+    """The other side of a handover no still moment shows: for each pick (place) that no place
+    (pick) of its colour by another person's hand pairs with (:func:`handovers`), the place (pick)
+    of another person's hand that held (did not hold) that colour just before the still moment and
+    did not (did) just after, over the same frames. A giver's hand that moves while it lets go, or
+    that the tracker loses right after, stands still nowhere (limbs3d, handshake seed 5: the giver
+    let go over 85-91 while moving; the taker stood still over 92-108). Rows of one-hand
+    activities carry their colour as ``hue``."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+    out = []
+    for r in rows:
+        if r["kind"] not in ("pick", "place") or r.get("hue") is None:
+            continue
+        other = "place" if r["kind"] == "pick" else "pick"
+        if any(q["kind"] == other and q["track_id_a"] != r["track_id_a"] and q.get("hue") is not None
+               and min((q["hue"] - r["hue"]) % HUE_BINS, (r["hue"] - q["hue"]) % HUE_BINS) <= reach
+               and _gap(q, r) <= d.handover_gap for q in rows):
+            continue
+        (b0, b1), (a0, a1) = _windows(r["start_frame"], r["end_frame"], params)
+        best = None
+        for key, cs in colours.items():
+            if key[0] == r["track_id_a"] or key[1] not in HAND_PARTS:
+                continue
+            worn = clothes.get(key[0], np.zeros(0, int))
+            before = _without(_held_seen(cs, b0, b1, -1, params), worn)
+            after = _without(_held_seen(cs, a0, a1, 1, params), worn)
+            if before is None or after is None:
+                continue
+            was, now = _mass_of(before, r["hue"], params), _mass_of(after, r["hue"], params)
+            held, gone = (was, now) if other == "place" else (now, was)
+            if held < d.min_mass or gone > max(d.max_mass_absent, d.absent_ratio * held):
+                continue
+            conf = round(min(r["confidence"], 1.0 - gone / max(held, 1e-9)), 3)
+            if conf >= d.min_confidence and (best is None or conf > best["confidence"]):
+                best = dict(r, kind=other, track_id_a=key[0], part_a=key[1], confidence=conf)
+        if best is not None:
+            out.append(best)
+    return out
+
+
+def _gap(a: dict, b: dict) -> int:
+    """Frames between two rows' spans (0 or less where they overlap), in either order."""
+    return max(b["start_frame"] - a["end_frame"], a["start_frame"] - b["end_frame"])
 
 
 def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
@@ -484,10 +539,13 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     followed, at most ``handover_gap`` frames after it ends, by a *pick* of the same colour
     (``same_colour``) by another person's hand. Where a tracker never brings the two hands together
     (nor within ``contact_mm`` of each other in 3D) Table 1's two-hand rows are never read, and the
-    object seems to rest for a moment where nobody holds it. The exchange spans both still moments,
-    goes from the placing hand (``a``) to the picking one (``b``), with the less sure of the two
-    confidences; a handshake of the two people overlapping it is dropped (the touch of the
-    handover). Each place and each pick gives at most one exchange, the nearest in time first."""
+    object seems to rest for a moment where nobody holds it. The taker's still moment may also end
+    up to ``handover_gap`` frames *before* the giver's starts: its pick is read after it, where the
+    hand moved on to take the object (limbs3d, handshake seed 3: the taker stood still over 59-67,
+    took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
+    with the giver's still moment and ends with the later of the two, goes from the placing hand
+    (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
+    the two people overlapping it is dropped (the touch of the handover). Each place and each pick gives at most one exchange, the nearest in time first."""
     d = params.decision
     reach = d.same_colour / DEGREES_PER_BIN
 
@@ -496,10 +554,9 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
 
     places = [i for i, r in enumerate(rows) if r["kind"] == "place"]
     picks = [i for i, r in enumerate(rows) if r["kind"] == "pick"]
-    pairs = sorted((rows[j]["start_frame"] - rows[i]["end_frame"], i, j) for i in places for j in picks
+    pairs = sorted((_gap(rows[i], rows[j]), i, j) for i in places for j in picks
                    if rows[j]["track_id_a"] != rows[i]["track_id_a"]
-                   and rows[j]["start_frame"] >= rows[i]["start_frame"]
-                   and rows[j]["start_frame"] - rows[i]["end_frame"] <= d.handover_gap
+                   and _gap(rows[i], rows[j]) <= d.handover_gap
                    and same(rows[i].get("hue"), rows[j].get("hue")))
     used: set[int] = set()
     exchanges = []
