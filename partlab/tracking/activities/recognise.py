@@ -545,7 +545,8 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
     with the giver's still moment and ends with the later of the two, goes from the placing hand
     (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
-    the two people overlapping it is dropped (the touch of the handover). Each place and each pick gives at most one exchange, the nearest in time first."""
+    the two people overlapping it is dropped (the touch of the handover). Each place and each pick
+    gives at most one exchange, the nearest in time first."""
     d = params.decision
     reach = d.same_colour / DEGREES_PER_BIN
 
