@@ -1,6 +1,8 @@
 """Carried objects and activities: the colour around a hand, Table 1 read per colour, and the
 activities found on rendered scenes."""
 
+from dataclasses import replace
+
 import cv2
 import numpy as np
 import pandas as pd
@@ -70,9 +72,11 @@ def test_reliability_is_higher_for_a_hand_held_away_from_the_body():
     assert out.rho > inside.rho + 0.3 and inside.rho == pytest.approx(P.reliability.rho_min)
 
 
-def _seen(view: str, hue: int, share: float, visible: float = 1.0) -> HandColour:
+def _seen(view: str, hue: int, share: float, visible: float = 1.0, also: dict | None = None) -> HandColour:
     shares = np.zeros(HUE_BINS)
     shares[hue] = share
+    for h, m in (also or {}).items():
+        shares[h] = m
     return HandColour(shares, 0.6, view=view, visible=visible)
 
 
@@ -88,6 +92,19 @@ def test_views_that_see_one_colour_a_little_differently_fuse_into_one():
     two = fuse_views([_seen("a", 29, 0.2), _seen("b", 100, 0.3)], P)
     assert sorted(two) == [29, 100] and two[29] == pytest.approx(0.1)
     assert fuse_views([_seen("a", 29, 0.2)] * 2, P) == colour_masses(fuse([_seen("a", 29, 0.2)] * 2), P)
+
+
+def test_a_colour_one_view_alone_shows_is_behind_the_hand_and_views_group_nearest_first():
+    # the other person's purple shirt over most of one view's circle, an object held in two views
+    obs = [_seen("a", 142, 0.8, also={112: 0.16}), _seen("b", 112, 0.22), _seen("c", 60, 0.0)] * 3
+    held = fuse_views(obs, P)
+    assert 142 not in held and held[112] == pytest.approx((0.22 + 0.16) / 3, abs=0.01)
+    assert 142 in fuse_views(obs, replace(P, modes=replace(P.modes, min_views=1)))
+    # view c's 35 is stronger than a's 29 and b's 28, and nearer them than a's green 43: it joins them
+    obs = [_seen("a", 43, 0.33, also={29: 0.081}), _seen("b", 44, 0.2, also={28: 0.08}), _seen("c", 35, 0.085)]
+    held = fuse_views(obs, P)
+    yellow = next(h for h in held if 28 <= h <= 35)
+    assert held[yellow] == pytest.approx((0.085 + 0.081 + 0.08) / 3, abs=0.005)
     # a view where the hand is mostly hidden (behind the other person's shirt) weighs little
     hidden = fuse_views([_seen("a", 29, 0.2), _seen("b", 150, 0.9, visible=0.05)], P)
     assert hidden[150] < P.decision.min_mass < hidden[29]

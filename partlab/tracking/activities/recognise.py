@@ -365,8 +365,6 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
     rows, busy = [], defaultdict(list)
     for j in merged_joins(joins, params):
         a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
-        busy[a].append((start, end))
-        busy[b].append((start, end))
         base = dict(start_frame=start, end_frame=end, kind=j["kind"], track_id_a=a[0], part_a=a[1],
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
@@ -384,6 +382,11 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
                 base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
         rows.append(base)
+        if base["confidence"] >= params.decision.min_confidence or base["kind"] == "hand_head":
+            # a touch that is reported is the two hands' activity; one that is not (a hand unseen at a
+            # decision point) leaves their still moments to be read on their own
+            busy[a].append((start, end))
+            busy[b].append((start, end))
     return rows, busy
 
 
@@ -457,6 +460,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
     clothes, where = clothes or {}, where or {}
     rows, busy = _join_rows(joins, colours, centres, params, clothes, where)
     d = params.decision
+    last = max((f for cs in colours.values() for f in cs), default=0)  # the run's last frame seen
     for key, cs in centres.items():
         for s0, s1 in still_moments(cs, params):
             if any(s0 <= e + d.gap + d.window and s1 >= b - d.gap - d.window for b, e in busy.get(key, ())):
@@ -466,7 +470,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
                              for lo, hi in ((b0, b1), (a0, a1)))
             only = None
-            if before is not None and after is None:
+            if before is not None and after is None and a1 <= last:
                 # unseen where it should have moved on (a giver's hand lost as the taker pulls the
                 # object away): what it held at the end of its still moment tells a place, nothing else
                 after, only = _without(_held(colours.get(key, {}), s1 - d.window, s1, params), worn), "place"
