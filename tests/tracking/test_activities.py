@@ -209,6 +209,19 @@ def test_3d_touches_come_from_whichever_view_saw_each_hand():
     assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
 
 
+def test_what_one_view_shows_all_along_is_told_from_what_every_view_lost():
+    from partlab.tracking.activities.recognise import _one_view_mass
+
+    # trousers beside a hanging hand: view b shows them throughout, view a only at times
+    trousers = {f: [_seen("a", 40, 0.0), _seen("b", 40, 0.27)] for f in range(10, 20)}
+    assert _one_view_mass(trousers, 10, 19, 40, P) == pytest.approx(0.27)
+    # an object handed over: gone from both views
+    given = {f: [_seen("a", 40, 0.0), _seen("b", 40, 0.0, also={90: 0.2})] for f in range(10, 20)}
+    assert _one_view_mass(given, 10, 19, 40, P) == 0.0
+    # one view: nothing to compare (the one-camera table decides)
+    assert _one_view_mass({f: [_seen("b", 40, 0.27)] for f in range(10, 20)}, 10, 19, 40, P) == 0.0
+
+
 def _one_hand(kind, start, end, track, hue, part="right_hand", confidence=0.8):
     return dict(start_frame=start, end_frame=end, kind=kind, track_id_a=track, part_a=part, track_id_b=0,
                 part_b="", ended_by="still", object_colour="#00ff00", confidence=confidence, hue=hue)
