@@ -1,6 +1,8 @@
 """Carried objects and activities: the colour around a hand, Table 1 read per colour, and the
 activities found on rendered scenes."""
 
+from dataclasses import replace
+
 import cv2
 import numpy as np
 import pandas as pd
@@ -10,7 +12,14 @@ from partlab.labelling.events import evaluate_events, temporal_iou
 from partlab.labelling.synth import make_scene
 from partlab.tracking.activities.objects import HUE_BINS, HandColour, colour_masses, fuse, fuse_views, hand_colour
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.recognise import bridge_gaps, contacts, merged_joins, stays_behind, still_moments
+from partlab.tracking.activities.recognise import (
+    bridge_gaps,
+    contacts,
+    handovers,
+    merged_joins,
+    stays_behind,
+    still_moments,
+)
 from partlab.tracking.activities.table import one_hand, two_hands
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
@@ -63,9 +72,11 @@ def test_reliability_is_higher_for_a_hand_held_away_from_the_body():
     assert out.rho > inside.rho + 0.3 and inside.rho == pytest.approx(P.reliability.rho_min)
 
 
-def _seen(view: str, hue: int, share: float, visible: float = 1.0) -> HandColour:
+def _seen(view: str, hue: int, share: float, visible: float = 1.0, also: dict | None = None) -> HandColour:
     shares = np.zeros(HUE_BINS)
     shares[hue] = share
+    for h, m in (also or {}).items():
+        shares[h] = m
     return HandColour(shares, 0.6, view=view, visible=visible)
 
 
@@ -81,6 +92,19 @@ def test_views_that_see_one_colour_a_little_differently_fuse_into_one():
     two = fuse_views([_seen("a", 29, 0.2), _seen("b", 100, 0.3)], P)
     assert sorted(two) == [29, 100] and two[29] == pytest.approx(0.1)
     assert fuse_views([_seen("a", 29, 0.2)] * 2, P) == colour_masses(fuse([_seen("a", 29, 0.2)] * 2), P)
+
+
+def test_a_colour_one_view_alone_shows_is_behind_the_hand_and_views_group_nearest_first():
+    # the other person's purple shirt over most of one view's circle, an object held in two views
+    obs = [_seen("a", 142, 0.8, also={112: 0.16}), _seen("b", 112, 0.22), _seen("c", 60, 0.0)] * 3
+    held = fuse_views(obs, P)
+    assert 142 not in held and held[112] == pytest.approx((0.22 + 0.16) / 3, abs=0.01)
+    assert 142 in fuse_views(obs, replace(P, modes=replace(P.modes, min_views=1)))
+    # view c's 35 is stronger than a's 29 and b's 28, and nearer them than a's green 43: it joins them
+    obs = [_seen("a", 43, 0.33, also={29: 0.081}), _seen("b", 44, 0.2, also={28: 0.08}), _seen("c", 35, 0.085)]
+    held = fuse_views(obs, P)
+    yellow = next(h for h in held if 28 <= h <= 35)
+    assert held[yellow] == pytest.approx((0.085 + 0.081 + 0.08) / 3, abs=0.005)
     # a view where the hand is mostly hidden (behind the other person's shirt) weighs little
     hidden = fuse_views([_seen("a", 29, 0.2), _seen("b", 150, 0.9, visible=0.05)], P)
     assert hidden[150] < P.decision.min_mass < hidden[29]
@@ -183,6 +207,50 @@ def test_3d_touches_come_from_whichever_view_saw_each_hand():
                          X=gap, Y=0.0, Z=1000.0))
     found = contacts(pd.DataFrame(rows), P)
     assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
+
+
+def test_what_one_view_shows_all_along_is_told_from_what_every_view_lost():
+    from partlab.tracking.activities.recognise import _one_view_mass
+
+    # trousers beside a hanging hand: view b shows them throughout, view a only at times
+    trousers = {f: [_seen("a", 40, 0.0), _seen("b", 40, 0.27)] for f in range(10, 20)}
+    assert _one_view_mass(trousers, 10, 19, 40, P) == pytest.approx(0.27)
+    # an object handed over: gone from both views
+    given = {f: [_seen("a", 40, 0.0), _seen("b", 40, 0.0, also={90: 0.2})] for f in range(10, 20)}
+    assert _one_view_mass(given, 10, 19, 40, P) == 0.0
+    # one view: nothing to compare (the one-camera table decides)
+    assert _one_view_mass({f: [_seen("b", 40, 0.27)] for f in range(10, 20)}, 10, 19, 40, P) == 0.0
+
+
+def _one_hand(kind, start, end, track, hue, part="right_hand", confidence=0.8):
+    return dict(start_frame=start, end_frame=end, kind=kind, track_id_a=track, part_a=part, track_id_b=0,
+                part_b="", ended_by="still", object_colour="#00ff00", confidence=confidence, hue=hue)
+
+
+def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
+    green, blue = 40, 110
+    gap = P.decision.handover_gap
+    shake = dict(start_frame=95, end_frame=99, kind="handshake", track_id_a=1, part_a="right_hand", track_id_b=2,
+                 part_b="left_hand", ended_by="contact", object_colour="", confidence=1.0)
+    rows = [_one_hand("place", 90, 100, 1, green, confidence=0.9),
+            _one_hand("pick", 100 + gap, 125, 2, green + 3, part="left_hand", confidence=0.7), shake]
+    out = handovers(rows, P)
+    assert len(out) == 1  # the handshake over the handover is its touch, not an activity of its own
+    ex = out[0]
+    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 125)
+    assert (ex["track_id_a"], ex["part_a"], ex["track_id_b"], ex["part_b"]) == (1, "right_hand", 2, "left_hand")
+    assert ex["confidence"] == pytest.approx(0.7)
+    # the taker may have stood still just before the giver did (its pick is read after it)
+    out = handovers([rows[0], _one_hand("pick", 70, 90 - gap, 2, green), shake], P)
+    assert [(r["kind"], r["start_frame"], r["end_frame"]) for r in out] == [("exchange", 90, 100)]
+    # not a handover: picked up too late or too early, another colour, or by the same person
+    for pick in (_one_hand("pick", 101 + gap, 125, 2, green), _one_hand("pick", 60, 89 - gap, 2, green),
+                 _one_hand("pick", 100, 125, 2, blue), _one_hand("pick", 100, 125, 1, green, part="left_hand")):
+        out = handovers([rows[0], pick, shake], P)
+        assert sorted(r["kind"] for r in out) == ["handshake", "pick", "place"]
+    # two picks of the colour: the nearer in time takes it, the other stays a pick
+    out = handovers([rows[0], _one_hand("pick", 112, 125, 3, green), _one_hand("pick", 103, 120, 2, green)], P)
+    assert sorted((r["kind"], r["track_id_b"]) for r in out) == [("exchange", 2), ("pick", 0)]
 
 
 def test_temporal_matching():

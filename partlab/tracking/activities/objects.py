@@ -189,7 +189,10 @@ def fuse_views(observations: list[HandColour], params: ActivityParams) -> dict[i
     weights, a colour of one view matched to the nearest of another within ``view_hue_shift``
     degrees (its hue the weighted mean of theirs). Each camera renders a hue a little differently
     (its white balance): averaged bin by bin, a yellow object seen at 54, 58 and 70 degrees by
-    three views splits into two colours of half its share each. One view: eq. 29 as is."""
+    three views splits into two colours of half its share each. Where more than ``min_views``
+    views saw the hand, a colour needs ``min_views`` of them (at ``max_mass_absent`` or more): an
+    object in the hand is seen from nearly every side, a shirt or a wall behind it only from the
+    views it lies behind in. One view: eq. 29 as is."""
     views: dict[str, list[HandColour]] = {}
     for o in observations:
         views.setdefault(o.view, []).append(o)
@@ -197,22 +200,26 @@ def fuse_views(observations: list[HandColour], params: ActivityParams) -> dict[i
         return colour_masses(fuse(observations), params)
     tol = params.modes.view_hue_shift / DEGREES_PER_BIN
     weights = {v: sum(_weight(o) for o in obs) for v, obs in views.items()}
-    # each view's colours, strongest first, join the nearest colour of the views before them that
-    # has none of their view yet
-    found = sorted(((m * weights[v], h, v, m) for v, obs in views.items()
-                    for h, m in colour_masses(fuse(obs), params).items()), reverse=True)
-    groups: list[dict[str, tuple[int, float]]] = []
-    for _, h, v, m in found:
-        near = [(float(_hue_distance(h, _group_hue(g, weights))), k) for k, g in enumerate(groups) if v not in g]
-        d, k = min(near, default=(np.inf, -1))
-        if d <= tol:
-            groups[k][v] = (h, m)
-        else:
-            groups.append({v: (h, m)})
+    # every view's colours start as colours of their own; the two nearest in hue that share no view
+    # join, until none are within ``view_hue_shift`` (nearest first, not strongest first: a view's
+    # yellow at 35 bins joined another colour at 43 when it came before the other views' 29 and 28)
+    groups: list[dict[str, tuple[int, float]]] = [{v: (h, m)} for v, obs in views.items()
+                                                  for h, m in colour_masses(fuse(obs), params).items()]
+    while True:
+        hues = [_group_hue(g, weights) for g in groups]
+        pairs = [(float(_hue_distance(hues[i], hues[j])), i, j) for i in range(len(groups))
+                 for j in range(i + 1, len(groups)) if not set(groups[i]) & set(groups[j])]
+        d, i, j = min(pairs, default=(np.inf, -1, -1))
+        if d > tol:
+            break
+        groups[i] = {**groups[i], **groups.pop(j)}
     total = sum(weights.values())
     out: dict[int, float] = {}
     reach = params.decision.same_colour / DEGREES_PER_BIN
+    need = params.modes.min_views if len(views) > params.modes.min_views else 1
     for g in groups:
+        if sum(m >= params.decision.max_mass_absent for _, m in g.values()) < need:
+            continue  # what lies behind the hand in one view (another person's shirt), not what it holds
         h, mass = _group_hue(g, weights), sum(weights[v] * m for v, (_, m) in g.items()) / total
         q = next((q for q in out if _hue_distance(h, q) <= reach), None)
         out[h if q is None else q] = mass if q is None else max(out[q], mass)

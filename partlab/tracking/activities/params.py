@@ -46,6 +46,11 @@ class Modes:
     # cast on red moves a yellow by about 10 degrees); colours of different views this close are
     # one colour when a hand's views are fused (eq. 29)
     view_hue_shift: float = number(20.0, POSITIVE)
+    # where more than this many views see a hand, a colour around it counts only if at least this
+    # many show it: a hand seen in front of another person's shirt in one of three views showed
+    # that shirt over 0.96 of its circle there and nothing in the others (3-camera handshake seed 3,
+    # limbs3d hands: a false pick). 1 = every colour of every view counts
+    min_views: int = number(2, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)
@@ -115,6 +120,10 @@ class Decision:
     follow_move: float = number(0.5, POSITIVE)
     follow_ratio: float = number(0.5, FRACTION)
     follow_frames: int = number(3, POSITIVE_COUNT)
+    # an object one person's hand places and another person's hand picks up at most this many
+    # frames later (a handover whose hands the tracker never brings together: a short moment where
+    # nobody seems to hold it) was given, one exchange; a handshake of the two over it is dropped
+    handover_gap: int = number(15, POSITIVE_COUNT)
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,8 @@ from partlab.tracking.activities.objects import (
     HUE_BINS,
     HandColour,
     body_colours,
+    colour_masses,
+    fuse,
     fuse_views,
     hand_colour,
     hue_to_hex,
@@ -365,8 +367,6 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
     rows, busy = [], defaultdict(list)
     for j in merged_joins(joins, params):
         a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
-        busy[a].append((start, end))
-        busy[b].append((start, end))
         base = dict(start_frame=start, end_frame=end, kind=j["kind"], track_id_a=a[0], part_a=a[1],
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
@@ -384,6 +384,12 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
                 base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
         rows.append(base)
+        # a touch is its hands' activity even when it is not reported (a hand unseen at a decision
+        # point): reading their still moments on their own instead found one more limbs3d exchange
+        # (3-camera handshake seed 6) and 6 more false picks and places with the one-camera limb
+        # tracker (seeds 0-9)
+        busy[a].append((start, end))
+        busy[b].append((start, end))
     return rows, busy
 
 
@@ -457,6 +463,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
     clothes, where = clothes or {}, where or {}
     rows, busy = _join_rows(joins, colours, centres, params, clothes, where)
     d = params.decision
+    last = max((f for cs in colours.values() for f in cs), default=0)  # the run's last frame seen
     for key, cs in centres.items():
         for s0, s1 in still_moments(cs, params):
             if any(s0 <= e + d.gap + d.window and s1 >= b - d.gap - d.window for b, e in busy.get(key, ())):
@@ -465,14 +472,141 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             worn = clothes.get(key[0], np.zeros(0, int))
             before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
                              for lo, hi in ((b0, b1), (a0, a1)))
+            only = None
+            if before is not None and after is None and a1 <= last:
+                # unseen where it should have moved on (a giver's hand lost as the taker pulls the
+                # object away): what it held at the end of its still moment tells a place, nothing else
+                after, only = _without(_held(colours.get(key, {}), s1 - d.window, s1, params), worn), "place"
+                a0, a1 = s1 - d.window, s1
             if before is None or after is None:
                 continue
             v = one_hand(before, after, params,
                          lambda hue, k=key, c=cs, a=s0, b=s1: stays_behind(where.get(k, {}), c, hue, a, b, params))
+            if v is not None and only is not None and v.kind != only:
+                continue
+            if v is not None and v.colour is not None:
+                # the side where the colour is gone (after a place, before a pick): a view that still
+                # shows it as much as the views together showed it held saw no change there
+                lo, hi, held = (a0, a1, before) if v.kind == "place" else (b0, b1, after)
+                if _one_view_mass(colours.get(key, {}), lo, hi, v.colour, params) >= _mass_of(held, v.colour, params):
+                    continue
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
-                                 confidence=round(v.margin, 3)))
-    out = pd.DataFrame(_distinct(rows), columns=list(ACTIVITY_COLUMNS))
-    out = out[(out["confidence"] >= params.decision.min_confidence) | (out["kind"] == "hand_head")]
+                                 confidence=round(v.margin, 3), hue=v.colour))
+    rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
+    rows += other_sides(rows, colours, clothes, params)
+    out = pd.DataFrame(handovers(rows, params), columns=list(ACTIVITY_COLUMNS))
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)
+
+
+def other_sides(rows: list[dict], colours: Mapping[Key, Mapping[int, list[HandColour]]],
+                clothes: Mapping[int, np.ndarray], params: ActivityParams) -> list[dict]:
+    """The other side of a handover no still moment shows: for each pick (place) that no place
+    (pick) of its colour by another person's hand pairs with (:func:`handovers`), the place (pick)
+    of another person's hand that held (did not hold) that colour just before the still moment and
+    did not (did) just after, over the same frames. A giver's hand that moves while it lets go, or
+    that the tracker loses right after, stands still nowhere (limbs3d, handshake seed 5: the giver
+    let go over 85-91 while moving; the taker stood still over 92-108). Rows of one-hand
+    activities carry their colour as ``hue``."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+    out = []
+    for r in rows:
+        if r["kind"] not in ("pick", "place") or r.get("hue") is None:
+            continue
+        other = "place" if r["kind"] == "pick" else "pick"
+        if any(q["kind"] == other and q["track_id_a"] != r["track_id_a"] and q.get("hue") is not None
+               and min((q["hue"] - r["hue"]) % HUE_BINS, (r["hue"] - q["hue"]) % HUE_BINS) <= reach
+               and _gap(q, r) <= d.handover_gap for q in rows):
+            continue
+        (b0, b1), (a0, a1) = _windows(r["start_frame"], r["end_frame"], params)
+        best = None
+        for key, cs in colours.items():
+            if key[0] == r["track_id_a"] or key[1] not in HAND_PARTS:
+                continue
+            worn = clothes.get(key[0], np.zeros(0, int))
+            before = _without(_held_seen(cs, b0, b1, -1, params), worn)
+            after = _without(_held_seen(cs, a0, a1, 1, params), worn)
+            if before is None or after is None:
+                continue
+            was, now = _mass_of(before, r["hue"], params), _mass_of(after, r["hue"], params)
+            held, gone = (was, now) if other == "place" else (now, was)
+            if held < d.min_mass or gone > max(d.max_mass_absent, d.absent_ratio * held):
+                continue
+            conf = round(min(r["confidence"], 1.0 - gone / max(held, 1e-9)), 3)
+            if conf >= d.min_confidence and (best is None or conf > best["confidence"]):
+                best = dict(r, kind=other, track_id_a=key[0], part_a=key[1], confidence=conf)
+        if best is not None:
+            out.append(best)
+    return out
+
+
+def _one_view_mass(colours: Mapping[int, list[HandColour]], lo: int, hi: int, hue: int,
+                   params: ActivityParams) -> float:
+    """The largest share of colour ``hue`` any single view shows around a hand over ``lo..hi``
+    (eq. 29 per view), 0 where fewer than two views saw it. A view that sees the hand against
+    the person's trousers shows them all along, while another sees them only as the hand passes
+    (3-camera handshake seed 6, limbs3d hands: one view 0.26-0.43 throughout, another 0.19 -> 0,
+    a false place and a false pick as the views' agreement came and went)."""
+    views: dict[str, list[HandColour]] = {}
+    for f in range(lo, hi + 1):
+        for o in colours.get(f, ()):
+            views.setdefault(o.view, []).append(o)
+    if len(views) < 2:
+        return 0.0
+    return max(_mass_of(colour_masses(fuse(obs), params), hue, params) for obs in views.values())
+
+
+def _gap(a: dict, b: dict) -> int:
+    """Frames between two rows' spans (0 or less where they overlap), in either order."""
+    return max(b["start_frame"] - a["end_frame"], a["start_frame"] - b["end_frame"])
+
+
+def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
+    """``rows`` (activity rows; one-hand ones with the object's hue bin as ``hue``) with each
+    object given from one person to another read as one exchange: a *place* by one person's hand
+    followed, at most ``handover_gap`` frames after it ends, by a *pick* of the same colour
+    (``same_colour``) by another person's hand. Where a tracker never brings the two hands together
+    (nor within ``contact_mm`` of each other in 3D) Table 1's two-hand rows are never read, and the
+    object seems to rest for a moment where nobody holds it. The taker's still moment may also end
+    up to ``handover_gap`` frames *before* the giver's starts: its pick is read after it, where the
+    hand moved on to take the object (limbs3d, handshake seed 3: the taker stood still over 59-67,
+    took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
+    with the giver's still moment and ends with the later of the two, goes from the placing hand
+    (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
+    the two people overlapping it is dropped (the touch of the handover). Each place and each pick
+    gives at most one exchange, the nearest in time first."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+
+    def same(h1, h2) -> bool:
+        return h1 is not None and h2 is not None and min((h1 - h2) % HUE_BINS, (h2 - h1) % HUE_BINS) <= reach
+
+    places = [i for i, r in enumerate(rows) if r["kind"] == "place"]
+    picks = [i for i, r in enumerate(rows) if r["kind"] == "pick"]
+    pairs = sorted((_gap(rows[i], rows[j]), i, j) for i in places for j in picks
+                   if rows[j]["track_id_a"] != rows[i]["track_id_a"]
+                   and _gap(rows[i], rows[j]) <= d.handover_gap
+                   and same(rows[i].get("hue"), rows[j].get("hue")))
+    used: set[int] = set()
+    exchanges = []
+    for _, i, j in pairs:
+        if i in used or j in used:
+            continue
+        used |= {i, j}
+        give, take = rows[i], rows[j]
+        exchanges.append(dict(start_frame=give["start_frame"], end_frame=max(give["end_frame"], take["end_frame"]),
+                              kind="exchange", track_id_a=give["track_id_a"], part_a=give["part_a"],
+                              track_id_b=take["track_id_a"], part_b=take["part_a"], ended_by="still",
+                              object_colour=give["object_colour"], hue=give.get("hue"),
+                              confidence=min(give["confidence"], take["confidence"])))
+
+    def covered(r: dict) -> bool:
+        people = {r["track_id_a"], r["track_id_b"]}
+        return r["kind"] == "handshake" and any(
+            people == {e["track_id_a"], e["track_id_b"]} and _overlap((r["start_frame"], r["end_frame"]),
+                                                                     (e["start_frame"], e["end_frame"])) > 0
+            for e in exchanges)
+
+    return [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
