@@ -198,3 +198,29 @@ def test_a_hand_uses_only_candidates_within_reach_of_its_own_head():
     assert tr._usable(hand, points, None, None, head).tolist() == [True, False]
     assert tr._usable(face, points, None, None, head).tolist() == [True, True]  # a head has no reach limit
     assert tr._usable(hand, points, None, None, None).tolist() == [True, True]  # no head estimate: no limit
+
+
+def test_a_single_view_candidate_takes_the_depth_where_the_other_view_sees_a_body_in_front_of_it():
+    a, b = _two_cameras()
+    params = Limbs3DParams().updated({"dynamics.single_view_support": 8.0})
+    tr = Limbs3DTracker(params, np.random.default_rng(0), {"cam0": a, "cam1": b})
+    hand = np.array([100.0, 50.0, 1200.0])  # seen as a blob by cam0 only: cam1 sees a body in front of it
+    blob = a.project(hand[None])[0]
+    v = a.rays(blob[None])[0]
+    pred = hand + 300.0 * v + np.array([0.0, 0.0, 20.0])  # the prediction 300 mm too deep along cam0's line
+    sil = np.zeros((480, 640), np.uint8)
+    u, w = b.project(hand[None])[0]
+    cv2.circle(sil, (int(u), int(w)), 10, 1, -1)  # the body hiding the hand from cam1: a 10 px disc
+    views = [observe_view(np.zeros((480, 640), np.uint8), np.array([blob])), observe_view(sil, np.zeros((0, 2)))]
+    [free] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)))  # no views given
+    assert np.linalg.norm(free - hand) > 250  # on the line, at the prediction's depth
+    [point] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)), views)
+    np.testing.assert_allclose(np.cross(point - a.centre, v), 0, atol=1e-6)  # still on the blob's line of sight
+    uv = b.project(point[None])[0]
+    assert np.hypot(uv[0] - u, uv[1] - w) <= 10 + 8 + 1  # hidden by cam1's silhouette (within the support)
+    # ~ the disc's edge nearest the prediction (18 px ~ 100 mm at 3.3 m in cam1), not 300 mm off
+    assert np.linalg.norm(point - hand) < 120
+    # a view without any silhouette (a covered lens) does not constrain the depth
+    dark = [views[0], observe_view(np.zeros((480, 640), np.uint8), np.zeros((0, 2)))]
+    [same] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)), dark)
+    np.testing.assert_allclose(same, free, atol=1e-6)

@@ -148,6 +148,13 @@ class Limbs3DDynamics:
     # tracked but never bring a lost one back (one view cannot tell its depth). 0 = off
     single_view_prior: float = number(0.2, FRACTION)
     single_view_gate: float = number(100.0, POSITIVE)
+    # a single-view candidate's depth (our addition): a hand that no other view sees as a blob is
+    # hidden there, so it lies where its line of sight projects onto a silhouette (within this
+    # many pixels) in every other view that sees people; of those points of the line (within
+    # single_view_depth mm of the prediction's), the one nearest the prediction, so the hand hidden
+    # behind its own body is not pushed off it along the line. 0 = the point nearest the prediction
+    single_view_support: float = number(0.0)
+    single_view_depth: float = number(600.0, POSITIVE)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
     # often nearer the other hand's candidates than that hand's own lagging prediction
