@@ -94,6 +94,30 @@ def test_a_hand_cut_off_from_its_body_is_measured_from_its_persons_top():
     assert observe_view(sil, centres, fragment=0.25).below.tolist() == [55.0, 20.0]
     sil[60:70, 120:130] = 1  # no larger component is nearer: the nearest one horizontally is taken
     assert observe_view(sil, np.array([[125.0, 65.0]]), fragment=0.25).below.tolist() == [55.0]
+    both = observe_view(sil, centres, fragment=0.25, either=True)  # both references kept
+    assert both.below.tolist() == [5.0, 20.0] and both.below_person.tolist() == [55.0, 20.0]
+
+
+def test_with_fragment_either_p_o_takes_the_better_of_the_two_references():
+    from partlab.tracking.limbs3d.priors import ViewObservation
+
+    a, b = _two_cameras()
+    X = np.array([[100.0, 50.0, 1000.0]])
+    cands = pair_candidates([a, b], [a.project(X), b.project(X)])
+    za, zb = a.to_camera(X)[0, 2], b.to_camera(X)[0, 2]
+    rows_b = 600.0 * b.K[1, 1] / zb  # 600 mm below its person's top in cam1
+    dist = np.zeros((480, 640), np.float32)
+
+    def p_o(own_mm, person_mm):
+        va = ViewObservation(a.project(X), np.array([own_mm * a.K[1, 1] / za]), dist, True, 1.0,
+                             None if person_mm is None else np.array([person_mm * a.K[1, 1] / za]))
+        vb = ViewObservation(b.project(X), np.array([rows_b]), dist, True, 1.0)
+        return float(candidate_prior(cands, [a, b], [va, vb], Limbs3DParams())[0].p_o[0])
+
+    assert p_o(0.0, None) < 0.001  # a fragment measured from its own top: 600 mm off, sigma_v 150
+    assert p_o(0.0, 600.0) == pytest.approx(1.0, abs=1e-6)  # from its person's top it agrees
+    assert p_o(600.0, 0.0) == pytest.approx(1.0, abs=1e-6)  # and the other way round
+    assert p_o(450.0, 0.0) == pytest.approx(np.exp(-0.5), rel=1e-6)  # the better one: 150 mm off
 
 
 def test_ghost_pairs_of_two_hands_are_dropped_and_a_shared_blob_is_kept():

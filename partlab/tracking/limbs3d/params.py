@@ -77,6 +77,10 @@ class Limbs3DPriors:
     # an 89-pixel component of its own in cam0, so its Dv was ~0 there and ~590 mm in cam1, and
     # its true pair got p_o 0 for 30 frames. 0 = off (the default until measured on every seed)
     fragment: float = number(0.0, FRACTION)
+    # with fragment > 0: p_o takes the better of the two references (every blob from its own
+    # component's top, and a fragment's from its person's), so a pair that agreed from their own
+    # components' tops is not lost (standing 3 cameras seed 8 with fragment alone: right hand 184 mm)
+    fragment_either: bool = flag(False)
     # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
     # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
     # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;

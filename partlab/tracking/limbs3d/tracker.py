@@ -201,7 +201,8 @@ class Limbs3DTracker:
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
             centres.append(blobs.centres)
-            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment))
+            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
+                                      either=p.priors.fragment_either))
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
