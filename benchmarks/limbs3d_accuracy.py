@@ -22,16 +22,21 @@ evaluated take is tracked again with them (``learnt_mean``: mean 3D error of all
 from __future__ import annotations
 
 import argparse
+import pickle
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from partlab.labelling.synth.multiview import make_multiview_scene
-from partlab.models.limbs3d import PairErrors, fit_sigmas, true_pair_errors
-from partlab.tracking.frame import Frame, FrameSet
-from partlab.tracking.limbs3d.params import Limbs3DParams
-from partlab.tracking.limbs3d.tracker import Limbs3DTracker
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # this checkout's partlab, not an installed one
+
+from partlab.labelling.synth.multiview import make_multiview_scene  # noqa: E402
+from partlab.models.limbs3d import PairErrors, fit_sigmas, true_pair_errors  # noqa: E402
+from partlab.tracking.frame import Frame, FrameSet  # noqa: E402
+from partlab.tracking.limbs3d.params import Limbs3DParams  # noqa: E402
+from partlab.tracking.limbs3d.tracker import Limbs3DTracker  # noqa: E402
 
 
 def run(scene, n_cams: int, params: Limbs3DParams, hide: tuple[int, int] | None = None, seed: int = 0):
@@ -71,12 +76,28 @@ def swaps(e: pd.DataFrame, after: int = 85, frames: int = 10) -> int:
     return n
 
 
-def hidden(scene, n_cams: int, e: pd.DataFrame, seed: int, start: int = 60, stop: int = 90) -> dict:
+def meetings(e: pd.DataFrame, events: pd.DataFrame, contact: float = 135.0) -> dict:
+    """Per kind of the scene's events (clap, handshake, exchange): the fraction of the event's
+    frames at which the two tracked hands are within ``contact`` mm of each other (the activities'
+    ``decision.contact_mm``: what the recognition needs to see them touch)."""
+    pos = e.set_index(["frame", "track_id", "part"])[["X", "Y", "Z"]]
+    out: dict = {}
+    for ev in events.itertuples():
+        frames = range(int(ev.start_frame), int(ev.end_frame) + 1)
+        a = pos.reindex([(f, ev.track_id_a, ev.part_a) for f in frames]).to_numpy(float)
+        b = pos.reindex([(f, ev.track_id_b, ev.part_b) for f in frames]).to_numpy(float)
+        met = np.linalg.norm(a - b, axis=1) < contact  # NaN (no estimate) counts as apart
+        out.setdefault(f"meet_{ev.kind}", []).append(float(met.mean()))
+    return {k: float(np.mean(v)) for k, v in out.items()}
+
+
+def hidden(scene, n_cams: int, e: pd.DataFrame, seed: int, params: Limbs3DParams, start: int = 60,
+           stop: int = 90) -> dict:
     """Camera 0 black for frames ``start``-``stop`` (30 frames): the error over that stretch and
     after it, and the targets lost at any frame from ``start`` to ``stop + 10`` with the camera
     hidden and in the same take with every camera (``e``: those lost anyway, a hand hidden by a
     body), also at frame ``stop + 10``."""
-    eh, _ = run(scene, n_cams, Limbs3DParams(), hide=(start, stop), seed=seed)
+    eh, _ = run(scene, n_cams, params, hide=(start, stop), seed=seed)
 
     def lost(df, frames):
         sel = df[df["frame"].isin(frames) & (df["state"] == "lost")]
@@ -104,6 +125,28 @@ def learn(scenarios, k: int, n_cams: int, frames: int) -> Limbs3DParams:
     return fitted
 
 
+def _value(default, text: str):
+    if isinstance(default, bool):
+        return text.lower() in ("1", "true", "yes")
+    return type(default)(float(text))
+
+
+def _scene(args, name: str, seed: int):
+    """The scene of one scenario and seed, rendered or (``--cache``) read back."""
+    n = max(args.scene_cams, *args.cams)
+    path = Path(args.cache) / f"{name}_{seed}_{n}cams_{args.frames}.pkl" if args.cache else None
+    if path is not None and path.exists():
+        with path.open("rb") as f:
+            return pickle.load(f)
+    scene = make_multiview_scene(name, n, seed=seed, n_frames=args.frames)
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.with_suffix(".tmp").open("wb") as f:
+            pickle.dump(scene, f)
+        path.with_suffix(".tmp").rename(path)
+    return scene
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=10)
@@ -115,15 +158,22 @@ def main() -> None:
                     help="cameras rendered (the camera arc depends on it); each run uses the first --cams of them")
     ap.add_argument("--hide-from", type=int, default=2, help="the hidden-camera run for this many cameras and more")
     ap.add_argument("--learn", type=int, default=0, help="fit the sigmas on this many held-apart seeds per scenario")
+    ap.add_argument("--set", nargs="*", default=[], metavar="GROUP.NAME=VALUE",
+                    help="tracker parameters other than the defaults (e.g. dynamics.single_view_support=8)")
+    ap.add_argument("--cache", default="", help="keep the rendered scenes here (pickles, ~0.56 GB each) and reuse them")
     args = ap.parse_args()
+    params = Limbs3DParams()
+    if args.set:
+        params = params.updated({k: _value(params.get(k), v) for k, v in (a.split("=", 1) for a in args.set)})
     learnt = learn(args.scenarios, args.learn, 3, args.frames) if args.learn else None
     rows = []
     for name in args.scenarios:
         for seed in range(args.first, args.first + args.seeds):
-            scene = make_multiview_scene(name, max(args.scene_cams, *args.cams), seed=seed, n_frames=args.frames)
+            scene = _scene(args, name, seed)
             for n_cams in args.cams:
-                e, fps = run(scene, n_cams, Limbs3DParams(), seed=seed)
+                e, fps = run(scene, n_cams, params, seed=seed)
                 row = {"scenario": name, "seed": seed, "cams": n_cams, "fps": fps, "swaps": swaps(e)}
+                row.update(meetings(e, scene.events))
                 for part, g in e.groupby("part"):
                     row[f"{part}_mean"] = g["err"].mean()
                     row[f"{part}_median"] = g["err"].median()
@@ -131,11 +181,11 @@ def main() -> None:
                 if learnt is not None:
                     row["learnt_mean"] = run(scene, n_cams, learnt, seed=seed)[0]["err"].mean()
                 if n_cams >= args.hide_from:
-                    row.update(hidden(scene, n_cams, e, seed))
+                    row.update(hidden(scene, n_cams, e, seed, params))
                 rows.append(row)
                 print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
     df = pd.DataFrame(rows)
-    cols = [c for c in df.columns if c.endswith(("_mean", "_median", "_within100")) or c in
+    cols = [c for c in df.columns if c.endswith(("_mean", "_median", "_within100")) or c.startswith("meet_") or c in
             ("fps", "swaps", "hidden_lost", "unhidden_lost", "hidden_lost_at_100", "unhidden_lost_at_100")]
     summary = df.groupby(["scenario", "cams"])[cols].agg(["mean", "std"])
     pd.set_option("display.width", 250)
@@ -146,6 +196,8 @@ def main() -> None:
         over = [f"{r.seed} ({', '.join(f'{c[:-5]} {getattr(r, c):.0f}' for c in parts if getattr(r, c) > 50)})"
                 for r in g.itertuples() if max(getattr(r, c) for c in parts) > 50]
         sums = {c: int(g[c].sum()) for c in ("swaps", "hidden_lost", "unhidden_lost") if c in g}
+        sums.update({c: round(float(g[c].mean()), 2) for c in g.columns
+                     if c.startswith("meet_") and g[c].notna().any()})
         print(f"{name} {n_cams} cameras, {len(g)} seeds: all parts {g[parts].mean(axis=1).mean():.1f} "
               f"({g[parts].mean(axis=1).std():.1f}) mm; seeds with a part > 50 mm: {'; '.join(over) or 'none'}; "
               f"summed over seeds: {sums}")

@@ -94,6 +94,30 @@ def test_a_hand_cut_off_from_its_body_is_measured_from_its_persons_top():
     assert observe_view(sil, centres, fragment=0.25).below.tolist() == [55.0, 20.0]
     sil[60:70, 120:130] = 1  # no larger component is nearer: the nearest one horizontally is taken
     assert observe_view(sil, np.array([[125.0, 65.0]]), fragment=0.25).below.tolist() == [55.0]
+    both = observe_view(sil, centres, fragment=0.25, either=True)  # both references kept
+    assert both.below.tolist() == [5.0, 20.0] and both.below_person.tolist() == [55.0, 20.0]
+
+
+def test_with_fragment_either_p_o_takes_the_better_of_the_two_references():
+    from partlab.tracking.limbs3d.priors import ViewObservation
+
+    a, b = _two_cameras()
+    X = np.array([[100.0, 50.0, 1000.0]])
+    cands = pair_candidates([a, b], [a.project(X), b.project(X)])
+    za, zb = a.to_camera(X)[0, 2], b.to_camera(X)[0, 2]
+    rows_b = 600.0 * b.K[1, 1] / zb  # 600 mm below its person's top in cam1
+    dist = np.zeros((480, 640), np.float32)
+
+    def p_o(own_mm, person_mm):
+        va = ViewObservation(a.project(X), np.array([own_mm * a.K[1, 1] / za]), dist, True, 1.0,
+                             None if person_mm is None else np.array([person_mm * a.K[1, 1] / za]))
+        vb = ViewObservation(b.project(X), np.array([rows_b]), dist, True, 1.0)
+        return float(candidate_prior(cands, [a, b], [va, vb], Limbs3DParams())[0].p_o[0])
+
+    assert p_o(0.0, None) < 0.001  # a fragment measured from its own top: 600 mm off, sigma_v 150
+    assert p_o(0.0, 600.0) == pytest.approx(1.0, abs=1e-6)  # from its person's top it agrees
+    assert p_o(600.0, 0.0) == pytest.approx(1.0, abs=1e-6)  # and the other way round
+    assert p_o(450.0, 0.0) == pytest.approx(np.exp(-0.5), rel=1e-6)  # the better one: 150 mm off
 
 
 def test_ghost_pairs_of_two_hands_are_dropped_and_a_shared_blob_is_kept():
@@ -198,3 +222,29 @@ def test_a_hand_uses_only_candidates_within_reach_of_its_own_head():
     assert tr._usable(hand, points, None, None, head).tolist() == [True, False]
     assert tr._usable(face, points, None, None, head).tolist() == [True, True]  # a head has no reach limit
     assert tr._usable(hand, points, None, None, None).tolist() == [True, True]  # no head estimate: no limit
+
+
+def test_a_single_view_candidate_takes_the_depth_where_the_other_view_sees_a_body_in_front_of_it():
+    a, b = _two_cameras()
+    params = Limbs3DParams().updated({"dynamics.single_view_support": 8.0})
+    tr = Limbs3DTracker(params, np.random.default_rng(0), {"cam0": a, "cam1": b})
+    hand = np.array([100.0, 50.0, 1200.0])  # seen as a blob by cam0 only: cam1 sees a body in front of it
+    blob = a.project(hand[None])[0]
+    v = a.rays(blob[None])[0]
+    pred = hand + 300.0 * v + np.array([0.0, 0.0, 20.0])  # the prediction 300 mm too deep along cam0's line
+    sil = np.zeros((480, 640), np.uint8)
+    u, w = b.project(hand[None])[0]
+    cv2.circle(sil, (int(u), int(w)), 10, 1, -1)  # the body hiding the hand from cam1: a 10 px disc
+    views = [observe_view(np.zeros((480, 640), np.uint8), np.array([blob])), observe_view(sil, np.zeros((0, 2)))]
+    [free] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)))  # no views given
+    assert np.linalg.norm(free - hand) > 250  # on the line, at the prediction's depth
+    [point] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)), views)
+    np.testing.assert_allclose(np.cross(point - a.centre, v), 0, atol=1e-6)  # still on the blob's line of sight
+    uv = b.project(point[None])[0]
+    assert np.hypot(uv[0] - u, uv[1] - w) <= 10 + 8 + 1  # hidden by cam1's silhouette (within the support)
+    # ~ the disc's edge nearest the prediction (18 px ~ 100 mm at 3.3 m in cam1), not 300 mm off
+    assert np.linalg.norm(point - hand) < 120
+    # a view without any silhouette (a covered lens) does not constrain the depth
+    dark = [views[0], observe_view(np.zeros((480, 640), np.uint8), np.zeros((0, 2)))]
+    [same] = tr._single_view(pred, [np.array([blob]), np.zeros((0, 2))], np.zeros((0, 3)), dark)
+    np.testing.assert_allclose(same, free, atol=1e-6)

@@ -75,8 +75,15 @@ class Limbs3DPriors:
     # fraction of the view's largest is measured from the top of the nearest larger component
     # (priors.observe_view). Seated 2-camera seed 6: the right hand reaching across the table is
     # an 89-pixel component of its own in cam0, so its Dv was ~0 there and ~590 mm in cam1, and
-    # its true pair got p_o 0 for 30 frames. 0 = off (the default until measured on every seed)
-    fragment: float = number(0.0, FRACTION)
+    # its true pair got p_o 0 for 30 frames. 0 = off. 0.25 with fragment_either (2026-12-02,
+    # docs/trackers/limbs3d.md, seeds 0-9 at 2 and 3 cameras and held-out 20-24): standing 3
+    # cameras all parts 24 -> 21 mm, every seed under 50; seated 2 cameras 19 -> 16, seed 6 96 -> 33
+    fragment: float = number(0.25, FRACTION)
+    # with fragment > 0: p_o takes the better of the two references (every blob from its own
+    # component's top, and a fragment's from its person's), so a pair that agreed from their own
+    # components' tops is not lost (standing 3 cameras seed 8 with fragment alone: right hand 184 mm,
+    # 40 with both)
+    fragment_either: bool = flag(True)
     # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
     # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
     # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;
@@ -148,6 +155,13 @@ class Limbs3DDynamics:
     # tracked but never bring a lost one back (one view cannot tell its depth). 0 = off
     single_view_prior: float = number(0.2, FRACTION)
     single_view_gate: float = number(100.0, POSITIVE)
+    # a single-view candidate's depth (our addition): a hand that no other view sees as a blob is
+    # hidden there, so it lies where its line of sight projects onto a silhouette (within this
+    # many pixels) in every other view that sees people; of those points of the line (within
+    # single_view_depth mm of the prediction's), the one nearest the prediction, so the hand hidden
+    # behind its own body is not pushed off it along the line. 0 = the point nearest the prediction
+    single_view_support: float = number(0.0)
+    single_view_depth: float = number(600.0, POSITIVE)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
     # often nearer the other hand's candidates than that hand's own lagging prediction

@@ -43,15 +43,19 @@ class ViewObservation:
     distance: np.ndarray
     has_silhouette: bool
     scale: float = 1.0  # image pixels per silhouette pixel (silhouettes may be found at lower resolution)
+    #: ``(K,)`` rows from the top of each blob's person (the nearest larger component for a blob in
+    #: a fragment, see :func:`observe_view`); None: the same as ``below``
+    below_person: np.ndarray | None = None
 
 
 def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0,
-                 fragment: float = 0.0) -> ViewObservation:
+                 fragment: float = 0.0, either: bool = False) -> ViewObservation:
     """The silhouette measures of one view (``silhouette``: ``(H, W)`` mask, nonzero = person;
     ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel). A blob in a
     component smaller than ``fragment`` times the largest (a hand reaching across a table, cut
     off from its body in this view) is measured from the top of the nearest larger component
-    (horizontally), its person's; 0 = from its own component's top."""
+    (horizontally), its person's; 0 = from its own component's top. With ``either``, ``below`` is
+    from its own component's top and ``below_person`` from its person's (p_o takes the better)."""
     sil = (np.asarray(silhouette) > 0).astype(np.uint8)
     centres = np.asarray(centres, float).reshape(-1, 2)
     h, w = sil.shape
@@ -60,17 +64,20 @@ def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0
     n, labels, stats, _ = cv2.connectedComponentsWithStats(sil, 8)
     distance = cv2.distanceTransform(1 - sil, cv2.DIST_L2, 3)
     top_all = float(stats[1:, cv2.CC_STAT_TOP].min())
-    below = np.empty(len(centres))
+    below, person = np.empty(len(centres)), np.empty(len(centres))
     area = stats[:, cv2.CC_STAT_AREA].astype(float)
     big = np.flatnonzero(area[1:] >= fragment * area[1:].max()) + 1
     for k, (x, y) in enumerate(centres):
-        lab = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
+        lab = own = labels[int(np.clip(round(y), 0, h - 1)), int(np.clip(round(x), 0, w - 1))]
         if lab > 0 and fragment > 0 and lab not in big:
             left, width = stats[big, cv2.CC_STAT_LEFT], stats[big, cv2.CC_STAT_WIDTH]
             lab = big[np.argmin(np.maximum(np.maximum(left - x, x - (left + width)), 0))]
         top = float(stats[lab, cv2.CC_STAT_TOP]) if lab > 0 else top_all
-        below[k] = (y - top) * scale
-    return ViewObservation(centres, below, distance * np.float32(scale), True, scale)
+        top_own = float(stats[own, cv2.CC_STAT_TOP]) if own > 0 else top_all
+        below[k] = (y - (top_own if either else top)) * scale
+        person[k] = (y - top) * scale
+    return ViewObservation(centres, below, distance * np.float32(scale), True, scale,
+                           person if either else None)
 
 
 def silhouette_distance(camera: Camera, view: ViewObservation, points: np.ndarray) -> np.ndarray:
@@ -99,14 +106,16 @@ class Prior:
         return self.p_o * self.p_t * self.p_b
 
 
-def _below_mm(cands: PairCandidates, cameras: list[Camera], views: list[ViewObservation], side: int) -> np.ndarray:
+def _below_mm(cands: PairCandidates, cameras: list[Camera], views: list[ViewObservation], side: int,
+              person: bool = False) -> np.ndarray:
     """``Dv`` of each candidate's blob in its ``side`` (0, 1) view: rows below the silhouette's top
     at the candidate's depth in that camera, in mm (``rows * depth / f_y``)."""
     out = np.empty(len(cands))
     for m in np.unique(cands.views[:, side]):
         sel = cands.views[:, side] == m
         depth = cameras[m].to_camera(cands.points[sel])[:, 2]
-        out[sel] = views[m].below[cands.blobs[sel, side]] * depth / cameras[m].K[1, 1]
+        rows = views[m].below_person if person and views[m].below_person is not None else views[m].below
+        out[sel] = rows[cands.blobs[sel, side]] * depth / cameras[m].K[1, 1]
     return out
 
 
@@ -118,6 +127,9 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
         z = np.zeros(0)
         return Prior(z, z, z), {"dv": z, "d": z, "ds": np.zeros((0, len(views)))}
     ddv = _below_mm(cands, cameras, views, 0) - _below_mm(cands, cameras, views, 1)
+    if any(v.below_person is not None for v in views):  # priors.fragment_either: the better reference
+        alt = _below_mm(cands, cameras, views, 0, True) - _below_mm(cands, cameras, views, 1, True)
+        ddv = np.where(np.abs(alt) < np.abs(ddv), alt, ddv)
     p_o = np.exp(-ddv**2 / (2 * params.priors.sigma_v**2))
     p_t = np.exp(-cands.error**2 / (2 * params.priors.sigma_d**2))
     ds = np.stack([silhouette_distance(c, v, cands.points) if v.has_silhouette else np.zeros(len(cands))

@@ -39,7 +39,13 @@ from partlab.tracking.limbs.state_machine import LimbState, LimbStateMachine, Ob
 from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
-from partlab.tracking.limbs3d.priors import blob_keys, candidate_prior, observe_view, prune_and_merge
+from partlab.tracking.limbs3d.priors import (
+    blob_keys,
+    candidate_prior,
+    observe_view,
+    prune_and_merge,
+    silhouette_distance,
+)
 from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
 
@@ -195,7 +201,8 @@ class Limbs3DTracker:
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
             centres.append(blobs.centres)
-            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment))
+            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
+                                      either=p.priors.fragment_either))
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
@@ -244,7 +251,7 @@ class Limbs3DTracker:
             use, use_w = points[mine], weights[mine]
             if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
                     len(use) and (np.linalg.norm(use - preds[a], axis=1) < p.dynamics.candidate_gate).any()):
-                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0))
+                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
                 use = np.vstack([use.reshape(-1, 3), single])
                 use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
             est = t.filter.update(use, use_w)
@@ -283,13 +290,16 @@ class Limbs3DTracker:
             rivals = rivals[~lost[rivals]]
         return rivals
 
-    def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray) -> np.ndarray:
+    def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray,
+                     views: list | None = None) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
         ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
         within ``single_view_gate`` mm that is nearer to it than to every other target's projection
-        (``others (M, 3)``), at the point of the blob's line of sight nearest ``pred``."""
+        (``others (M, 3)``), at the point of the blob's line of sight nearest ``pred`` (with
+        ``dynamics.single_view_support`` and ``views``, the silhouette measures of every view, the
+        nearest such point hidden by a silhouette in every other view, :meth:`_hidden_depth`)."""
         out = []
-        for cam, cen in zip(self.cameras, centres):
+        for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
             cen = np.asarray(cen, float).reshape(-1, 2)
             depth = cam.to_camera(pred[None])[0, 2]
             if not len(cen) or depth <= 0:
@@ -303,8 +313,32 @@ class Limbs3DTracker:
             if d[j] > cam.K[0, 0] * self.params.dynamics.single_view_gate / depth:
                 continue
             v = cam.rays(cen[j:j + 1])[0]
-            out.append(cam.centre + v * float(v @ (pred - cam.centre)))
+            s = float(v @ (pred - cam.centre))
+            if self.params.dynamics.single_view_support > 0 and views is not None:
+                s = self._hidden_depth(m, v, s, views)
+            out.append(cam.centre + v * s)
         return np.array(out).reshape(-1, 3)
+
+    def _hidden_depth(self, m: int, v: np.ndarray, s: float, views: list) -> float:
+        """The distance along view ``m``'s line of sight ``v`` (from its centre), within
+        ``single_view_depth`` of ``s``, nearest ``s`` whose point lies in the room and projects within
+        ``single_view_support`` pixels of a silhouette in every other view that has one; ``s``
+        itself when none does."""
+        d = self.params.dynamics
+        step = 10.0
+        ts = s + np.arange(-d.single_view_depth, d.single_view_depth + step, step)
+        ts = ts[ts > 0]
+        if not len(ts):
+            return s
+        pts = self.cameras[m].centre + ts[:, None] * v
+        ok = (pts[:, 2] > 0) & (pts[:, 2] < self.params.priors.max_height)
+        for k, (cam, view) in enumerate(zip(self.cameras, views)):
+            if k == m or not view.has_silhouette:
+                continue
+            ok &= silhouette_distance(cam, view, pts) <= d.single_view_support
+        if not ok.any():
+            return s
+        return float(ts[ok][np.argmin(np.abs(ts[ok] - s))])
 
     def _usable(self, t: _Target, points: np.ndarray, mine, others, head) -> np.ndarray:
         """The candidates target ``t`` may use: those no other target's prediction is nearer to
