@@ -102,28 +102,28 @@ def sort_tracks(detections: list[np.ndarray], iou_min: float = 0.3, min_hits: in
     rows = []
     for frame, dets in enumerate(detections):
         preds = np.array([t.predict() for t in tracks]).reshape(-1, 4)
-        matched_t, matched_d = set(), set()
-        if len(tracks) and len(dets):
-            iou = iou_xywh(dets[:, :4], preds)
-            r, c = linear_sum_assignment(-iou)
-            for d, t in zip(r, c):
-                if iou[d, t] >= iou_min:
-                    tracks[t].update(dets[d])
-                    matched_t.add(t)
-                    matched_d.add(d)
-        for t, tr in enumerate(tracks):
-            if t not in matched_t:
-                tr.misses += 1
-        for d in range(len(dets)):
-            if d not in matched_d:
-                tracks.append(_Track(dets[d], next_id))
-                next_id += 1
-        tracks = [t for t in tracks if t.misses <= max_age]
-        for t in tracks:
-            if t.misses == 0 and (t.hits >= min_hits or frame < min_hits):
-                x, y, w, h = t.box()
-                rows.append((frame, t.id, "person", x, y, w, h))
+        matched_t, matched_d = _associate(tracks, preds, dets, iou_min, list(range(len(tracks))))
+        tracks, next_id = _age_and_birth(tracks, matched_t, dets, matched_d, next_id, max_age)
+        rows += _reported(tracks, frame, min_hits)
     return pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def _age_and_birth(tracks, matched_t, births, matched_b, next_id: int, max_age: int):
+    """Unmatched tracks age (dropped past ``max_age``); unmatched ``births`` start tracks."""
+    for t, tr in enumerate(tracks):
+        if t not in matched_t:
+            tr.misses += 1
+    for d in range(len(births)):
+        if d not in matched_b:
+            tracks.append(_Track(births[d], next_id))
+            next_id += 1
+    return [t for t in tracks if t.misses <= max_age], next_id
+
+
+def _reported(tracks, frame: int, min_hits: int) -> list[tuple]:
+    """The rows of the tracks matched this frame and confirmed (or in the first frames)."""
+    return [(frame, t.id, "person", *t.box()) for t in tracks
+            if t.misses == 0 and (t.hits >= min_hits or frame < min_hits)]
 
 
 def _associate(tracks, preds, dets, iou_min: float, pool) -> tuple[set, set]:
@@ -154,18 +154,8 @@ def byte_tracks(detections: list[np.ndarray], high: float = 0.5, low: float = 0.
         weak = dets[dets[:, 4] < high] if len(dets) else dets
         m1, d1 = _associate(tracks, preds, strong, iou_min, list(range(len(tracks))))
         m2, _ = _associate(tracks, preds, weak, 0.5, [t for t in range(len(tracks)) if t not in m1])
-        for t, tr in enumerate(tracks):
-            if t not in m1 and t not in m2:
-                tr.misses += 1
-        for d in range(len(strong)):
-            if d not in d1:
-                tracks.append(_Track(strong[d], next_id))
-                next_id += 1
-        tracks = [t for t in tracks if t.misses <= max_age]
-        for t in tracks:
-            if t.misses == 0 and (t.hits >= min_hits or frame < min_hits):
-                x, y, w, h = t.box()
-                rows.append((frame, t.id, "person", x, y, w, h))
+        tracks, next_id = _age_and_birth(tracks, m1 | m2, strong, d1, next_id, max_age)
+        rows += _reported(tracks, frame, min_hits)
     return pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
 
 
