@@ -131,6 +131,7 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
 CPU: list[float] = []
 PART_RATES = ("head", "torso", "hipleg")
 ONLY: list[str] = []  # --methods
+SAVE: list[Path] = []  # --save-proposals
 
 
 def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, hog: bool = False,
@@ -146,6 +147,9 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
     for label, kind, table in ms:
         for seed in (seeds if kind not in ("interp", "hog_sort") else seeds[:1]):
             props, spf, n = run_method(take, truth, kind, table, seed)
+            if SAVE and kind != "interp":
+                SAVE[0].mkdir(parents=True, exist_ok=True)
+                props.to_csv(SAVE[0] / f"{name}_{label.replace(' ', '_')}_seed{seed}.csv", index=False)
             rows.append({"clip": name, "method": label, "seed": seed, "ms/frame": 1000 * spf,
                          "cpu ms/frame": 1000 * CPU[-1],
                          **measure(truth, props, n)})
@@ -227,11 +231,13 @@ def main() -> None:
     ap.add_argument("--skip-otb", action="store_true")
     ap.add_argument("--skip-synth", action="store_true")
     ap.add_argument("--csv", type=Path, help="write every run's row here")
+    ap.add_argument("--save-proposals", type=Path, help="write every tracker run's tracks CSV into this folder")
     ap.add_argument("--methods", default="",
                     help="only these methods (comma-separated prefixes, e.g. 'body keys,body auto')")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",") if s]
     ONLY[:] = [m.strip() for m in a.methods.split(",") if m.strip()]
+    SAVE[:] = [a.save_proposals] if a.save_proposals else []
     keys = tuple(int(k) for k in a.keys.split(",") if k)
     tables = []
     if not a.skip_pets:

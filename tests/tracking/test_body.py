@@ -224,3 +224,86 @@ def test_automatic_start_decomposes_the_blob_that_found_the_person():
         assert tracks.track_id.nunique() == 1 and tracks.frame.min() < 20
         rates.append(evaluate(sc.truth, tracks, hota=False).summary.loc["head", "rate_mean"])
     assert np.mean(rates) >= 0.5
+
+
+def test_a_person_found_again_has_its_coasted_rows_bridged_by_a_straight_line():
+    """``occlusion.bridge``: B walks behind A and coasts; once measured again, the rows written while
+    it coasted lie on the straight line from the row before to the row it was found at, for every
+    part and the person box. Off, the coasted rows are the dynamics' (a line of another slope)."""
+    walkers = (dict(x0=90, vx=1.0, shirt=(40, 140, 40), trousers=(60, 60, 60)),      # B, behind
+               dict(x0=170, vx=-1.0, shirt=(40, 40, 160), trousers=(120, 60, 30)))  # A, in front
+    frames, truths = _scene(n=80, walkers=walkers)
+    runs = {}
+    for bridge in (False, True):
+        p = BodyParams().updated({"occlusion.bridge": bridge})
+        tracker = BodyTracker(p, np.random.default_rng(3), init=_init(truths[0], ids=(1, 2)))
+        bgm = BackgroundModel(p)
+        records = []
+        for i, f in enumerate(frames):
+            records.extend(tracker.step(i, f, bgm.apply(f)))
+        runs[bridge] = (records_to_frame(tracker.finish(records)), tracker.bridges)
+    (plain, none), (bridged, spans) = runs[False], runs[True]
+    assert none == [] and spans
+    tid, first, found = max(spans, key=lambda s: s[2] - s[1])
+    assert tid == 1 and found - first >= 5  # B, behind A for a while
+    for part in ("torso", "person"):
+        rows = bridged[(bridged.track_id == 1) & (bridged.part == part)].set_index("frame")
+        xs = rows.loc[first - 1:found, "x"].to_numpy()
+        np.testing.assert_allclose(np.diff(xs, 2), 0.0, atol=1e-6)  # a straight line ...
+        old = plain[(plain.track_id == 1) & (plain.part == part)].set_index("frame")
+        assert xs[0] == pytest.approx(old.loc[first - 1, "x"])    # ... from the row before
+        assert xs[-1] == pytest.approx(old.loc[found, "x"])       # ... to the row it was found at
+        assert np.abs(xs - old.loc[first - 1:found, "x"].to_numpy()).max() > 0.5  # not the rows coasted
+    # nothing else changes
+    inside = np.zeros(len(bridged), bool)
+    for t, a, b in spans:
+        inside |= ((bridged.track_id == t) & bridged.frame.between(a, b - 1)).to_numpy()
+    pd.testing.assert_frame_equal(bridged[~inside], plain[~inside])
+
+
+def _at_the_edge(exit_margin: float, vx: float):
+    """A tracker whose --init walker stands at the right border with velocity ``vx`` and has just
+    had no foreground support for ``lost_frames`` frames, after the background warm-up."""
+    frames, truths = _scene(n=1, walkers=(dict(x0=300, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    p = BodyParams().updated({"detection.exit_margin": exit_margin})
+    tracker = BodyTracker(p, np.random.default_rng(0), init=_init(truths[0]))
+    tracker.step(0, frames[0], None)
+    person = tracker.people[1]
+    for f in person.filters.values():
+        f.set_velocity(np.array([vx, 0.0]))
+    tracker.frames_seen = p.background.warmup + 1
+    person.unsupported = p.detection.lost_frames - 1
+    tracker._end_tracks([person], np.zeros((H, W), np.uint8), W, H, index=100)
+    return tracker
+
+
+def test_a_track_lost_at_the_frame_edge_moving_out_has_walked_out():
+    """``detection.exit_margin``: lost at the border while moving towards it, the track ends and its
+    rows since its support went are withdrawn; moving inwards (or with the margin 0) it goes lost
+    and coasts as before."""
+    lost_frames = BodyParams().detection.lost_frames
+    out = _at_the_edge(0.25, vx=2.0)
+    assert 1 not in out.people and out.withdrawn == [(1, 100 - lost_frames + 1)]
+    for tracker in (_at_the_edge(0.25, vx=-2.0), _at_the_edge(0.0, vx=2.0)):
+        assert tracker.people[1].lost_since == 100 - lost_frames + 1 and tracker.withdrawn == []
+
+
+def test_the_person_box_sides_without_the_head():
+    """``output.head_sets_sides`` False: a head box sticking out sideways beyond the body does not
+    widen the person row (its left and right come from torso and hip-leg); its top still comes from
+    the head. True: the paper's MBR of the three parts."""
+    frames, truths = _scene(n=1)
+    rows = {}
+    for sides in (True, False):
+        p = BodyParams().updated({"output.head_sets_sides": sides})
+        tracker = BodyTracker(p, np.random.default_rng(1), init=_init(truths[0]))
+        tracker.step(0, frames[0], None)
+        tracker.people[1].filters["head"].shift(np.array([-25.0, 0.0]))  # 25 px left of the body
+        rows[sides] = records_to_frame(tracker._records(1, set())).set_index("part")
+    for sides, at in rows.items():
+        body = at.loc[["torso", "hipleg"]]
+        left = at.loc["head", "x"] if sides else body["x"].min()
+        assert at.loc["head", "x"] < body["x"].min() - 10
+        assert at.loc["person", "x"] == pytest.approx(left)
+        assert at.loc["person", "x"] + at.loc["person", "w"] == pytest.approx((body["x"] + body["w"]).max())
+        assert at.loc["person", "y"] == pytest.approx(at.loc["head", "y"])

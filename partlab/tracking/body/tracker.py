@@ -27,7 +27,7 @@ bounding rectangle of the three parts (sec. 5.3). All numbers come from ``BodyPa
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -109,6 +109,7 @@ class Person:
     offsets: dict[str, float] = field(default_factory=dict)  # part Y - torso Y, in torso heights
     lost_since: int | None = None           # frame it went lost (no foreground support), coasting since
     layout: dict[str, tuple] = field(default_factory=dict)  # parts in the person box at its first detection
+    coast_start: int | None = None          # first frame of the coasting stretch it is in (lost or occluded)
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -191,6 +192,7 @@ class BodyTracker:
         self.candidates: list[tuple[Box, int, Box]] = []  # (box, frames seen running, box when first seen)
         self.frames_seen = 0
         self.withdrawn: list[tuple[int, int]] = []  # (track_id, first frame): rows of a lost track that ended
+        self.bridges: list[tuple[int, int, int]] = []  # (track_id, first coasted frame, frame found again)
         self._ycc = LazyYcc()
         self.cue = DetectionCue(self) if self.params.detector.enabled else None
         bg = self.params.background
@@ -339,7 +341,22 @@ class BodyTracker:
             self.cue.step(index, frame, ycc, mask)
         if self.auto and mask is not None and (self.cue is None or self.params.detector.blob_starts):
             self._detect(index, frame, ycc, mask)
+        self._note_coasting(index, new_ids)
         return self._records(index, new_ids)
+
+    def _note_coasting(self, index: int, new_ids: set[int]) -> None:
+        """Keep, per person, where its current coasting stretch (lost, or behind someone) began; a
+        stretch that ended with the person found again this frame is remembered for ``bridge``."""
+        for tid, person in self.people.items():
+            if tid in new_ids:
+                continue
+            if person.lost_since is not None or person.occluded_by is not None:
+                first = person.lost_since if person.lost_since is not None else index
+                person.coast_start = first if person.coast_start is None else min(person.coast_start, first)
+            elif person.coast_start is not None:
+                if self.params.occlusion.bridge and person.coast_start < index:
+                    self.bridges.append((tid, person.coast_start, index))
+                person.coast_start = None
 
     def _follow_camera(self, frame: np.ndarray, foreground: np.ndarray | None) -> np.ndarray | None:
         """The foreground mask to use this frame: None while the camera moves (``camera_motion``).
@@ -569,12 +586,28 @@ class BodyTracker:
         person.failed = tuple(verdict.failed) if verdict.failed else (BODY_PARTS if verdict.multi else ())
         person.adjusted = True
 
+    def _walked_out(self, person: Person, W: int, H: int) -> bool:
+        """The person's reported box lies within ``exit_margin`` of its size from a border of the
+        frame and the person does not move away from that border (``detection.exit_margin``)."""
+        m = self.params.detection.exit_margin
+        if m <= 0:
+            return False
+        box = self._reported_person_box(person).clip(W, H)
+        v = person.velocity()
+        if v is None:
+            v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
+        vx, vy = float(v[0]), float(v[1])
+        return ((box.x <= m * box.w and vx <= 0) or (W - box.x2 <= m * box.w and vx >= 0)
+                or (box.y <= m * box.h and vy <= 0) or (H - box.y2 <= m * box.h and vy >= 0))
+
     def _end_tracks(self, active: list[Person], mask, W: int, H: int, index: int = 0) -> None:
         p = self.params
         frame_box = Box(0, 0, W, H)
         for person in active:
             box = person.box()
             if box.area <= 0 or _overlap_fraction(box, frame_box) < p.detection.leave_fraction:
+                if person.lost_since is not None and p.detection.exit_margin > 0:
+                    self.withdrawn.append((person.track_id, person.lost_since))  # coasted out: those rows too
                 del self.people[person.track_id]
                 continue
             if mask is None or person.occluded_by is not None or person.hidden_parts:
@@ -582,13 +615,19 @@ class BodyTracker:
             if not self.auto and (not p.detection.end_init_tracks or self.frames_seen < p.background.warmup):
                 continue
             if person.lost_since is not None:
-                if index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames:
+                if (index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames
+                        or self._walked_out(person, W, H)):
                     self.withdrawn.append((person.track_id, person.lost_since))
                     del self.people[person.track_id]
                 continue
             support = _support(mask, box)
             person.unsupported = person.unsupported + 1 if support < p.detection.support_min else 0
             if person.unsupported >= p.detection.lost_frames:
+                if self._walked_out(person, W, H):
+                    # left the frame: the rows written since its support went are on background
+                    self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
+                    del self.people[person.track_id]
+                    continue
                 if p.detection.coast_frames <= 0 or self.auto:
                     # found automatically, a track without support ends at once (as before): the
                     # detection starts it again when the person shows; coasting there gave PETS
@@ -607,11 +646,35 @@ class BodyTracker:
     def finish(self, records: list[TrackRecord]) -> list[TrackRecord]:
         """The records without those of tracks that went lost and never came back (written while
         they coasted, then withdrawn), including tracks still lost when the clip ends."""
+        records = self._bridged(records)
         gone = dict(self.withdrawn)
         gone.update({tid: q.lost_since for tid, q in self.people.items() if q.lost_since is not None})
         if not gone:
             return records
         return [r for r in records if r.track_id not in gone or r.frame < gone[r.track_id]]
+
+    def _bridged(self, records: list[TrackRecord]) -> list[TrackRecord]:
+        """``occlusion.bridge``: the rows of each coasting stretch that ended with the person found
+        again replaced by the straight line (centre and size, per part) from the boxes of the frame
+        before the stretch to those of the frame it was found."""
+        if not self.bridges:
+            return records
+        at = {(r.track_id, r.frame, r.part): i for i, r in enumerate(records)}
+        out = list(records)
+        for tid, first, found in self.bridges:
+            before = first - 1
+            for part in dict.fromkeys(("person", *self.parts)):
+                i0, i1 = at.get((tid, before, part)), at.get((tid, found, part))
+                if i0 is None or i1 is None:
+                    continue
+                a = np.array(out[i0].box.as_tuple())
+                b = np.array(out[i1].box.as_tuple())
+                for frame in range(first, found):
+                    i = at.get((tid, frame, part))
+                    if i is not None:
+                        t = (frame - before) / (found - before)
+                        out[i] = replace(out[i], box=Box(*((1 - t) * a + t * b).tolist()))
+        return out
 
     def report_box(self, part: str, box: Box) -> Box:
         """The box written for a part: its tracked inner rectangle widened to the part's extent
@@ -638,7 +701,11 @@ class BodyTracker:
             scores = [person.scores.get(n, 1.0) for n in person.filters]
             boxes = {name: self.report_box(name, f.box) for name, f in person.filters.items()}
             if not self.whole:
-                whole_box = self.report_person(minimum_bounding_rectangle(boxes.values()))
+                mbr = minimum_bounding_rectangle(boxes.values())
+                if not self.params.output.head_sets_sides and "head" in boxes:
+                    body = minimum_bounding_rectangle(b for n, b in boxes.items() if n != "head")
+                    mbr = Box(body.x, mbr.y, body.w, mbr.h)
+                whole_box = self.report_person(mbr)
                 out.append(TrackRecord(index, tid, "person", whole_box, float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
