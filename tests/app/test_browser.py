@@ -232,13 +232,19 @@ def _drag_edit(page, locator, dx: float, dy: float) -> None:
     drag once more if the editor's sequence number did not move within 10 s."""
     page.bring_to_front()
     seq = page.evaluate("() => window.partlabEditor.seq")
-    for attempt in range(3):
-        _drag(page, locator, dx, dy)
+    _until(page, lambda: _drag(page, locator, dx, dy), f"() => window.partlabEditor.seq > {seq}", 3, 10_000)
+
+
+def _until(page, act, done: str, tries: int, timeout: int) -> None:
+    """``act()``, then wait ``timeout`` ms for the page's ``done`` (a JS function) to hold; again
+    up to ``tries`` times (an action the page's own rerun swallowed), failing on the last."""
+    for attempt in range(tries):
+        act()
         try:
-            page.wait_for_function(f"() => window.partlabEditor.seq > {seq}", timeout=10_000)
+            page.wait_for_function(done, timeout=timeout)
             return
         except playwright.TimeoutError:
-            if attempt == 2:
+            if attempt == tries - 1:
                 raise
 
 
@@ -330,15 +336,11 @@ def _show_and_tell(page, frame: int) -> None:
     undo can mount the editor again while its 400 ms sync timer is pending (the old editor's
     message is then dropped, the new one never saw the step: in CI, 2 runs in 2 after a fresh
     clone), so show the frame again until the editor on the page has sent it."""
-    for attempt in range(4):
+    def show():
         _settled(page)
         _editor(page, f"(e.sentFrame = -1, e.show({frame}, true))")
-        try:
-            page.wait_for_function(f"() => window.partlabEditor.sentFrame === {frame}", timeout=15_000)
-            return
-        except playwright.TimeoutError:
-            if attempt == 3:
-                raise
+
+    _until(page, show, f"() => window.partlabEditor.sentFrame === {frame}", 4, 15_000)
 
 
 def _focus_editor(page):
