@@ -20,7 +20,7 @@ Run as a script it is the tuned baseline: HOG once over PETS09-S2L1 (cached in `
 SORT and ByteTrack over a grid of their settings, each scored like ``annotation_effort.py``
 (tuned on the clip it is scored on: the most a user could get from them there).
 
-    nice python benchmarks/hog_sort.py --dets /tmp/pets_hog.npz
+    nice python benchmarks/hog_sort.py --dets pets_hog.npz   # cache file of your choosing
 """
 
 from __future__ import annotations

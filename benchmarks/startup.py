@@ -8,9 +8,9 @@ spread of each wall time, their ratio to ``python -c pass`` (the machine is shar
 says more than the seconds), the CPU seconds (user + system: less shaken by other work on a
 shared machine than the wall time), and the import time of ``partlab track`` by top-level package.
 ``--against DIR`` runs the same cases from another checkout too (e.g. ``git worktree add
-/tmp/old HEAD~3``), interleaved with this one's, so a busy machine slows both alike.
+../old HEAD~3``), interleaved with this one's, so a busy machine slows both alike.
 
-    python benchmarks/startup.py [--repeat 5] [--against /tmp/old]
+    python benchmarks/startup.py [--repeat 5] [--against ../old]
 """
 
 from __future__ import annotations
