@@ -145,7 +145,7 @@ def run(args) -> int:
     finally:
         if bar is not None:
             bar.close()
-    records = getattr(result, "records", None)
+    records = result.records  # a single-view run's rows: written without making the table
     try:
         if records is not None:
             write_track_records(records, args.output)
@@ -153,9 +153,8 @@ def run(args) -> int:
             write_tracks_csv(result.tracks, args.output)
     except OSError as exc:
         raise CommandError(f"{args.output}: cannot write: {describe_os_error(exc)}") from None
-    rows = records if records is not None else result.tracks
-    people = len({r.track_id for r in records}) if records is not None else rows["track_id"].nunique()
-    print(f"wrote {len(rows)} boxes of {people} track(s) to {args.output}")
+    ids = [r.track_id for r in records] if records is not None else result.tracks["track_id"].tolist()
+    print(f"wrote {len(ids)} boxes of {len(set(ids))} track(s) to {args.output}")
     if args.events:
         write_events(result.events, args)
     return 0
