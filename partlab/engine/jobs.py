@@ -135,26 +135,37 @@ def submit(kind: str, label: str, func: Callable[..., Any], *, store_url: str | 
     target = f"{func.__module__}:{func.__qualname__}"
     try:
         c = client(address)
-        fire_and_forget(c.submit(run_job, job_id, store.url, target, kwargs, key=job_id, pure=False))
-        _until_scheduled(c, job_id)
+        future = c.submit(run_job, job_id, store.url, target, kwargs, key=job_id, pure=False)
+        fire_and_forget(future)
+        _until_kept(c, future)
     except Exception as exc:
         _finish(store, job_id, "failed", error=f"could not reach the Dask scheduler: {exc}")
     return job_id
 
 
-def _until_scheduled(c, key: str, wait: float = 10.0) -> None:
-    """Return once the scheduler holds the task, so that a server stopping right after the submit
-    (its client gone) cannot lose it: fire-and-forget tasks then run without any client."""
+def _until_kept(c, future, wait: float = 10.0) -> None:
+    """Return once the scheduler keeps the task for the "fire-and-forget" client, so that a server
+    stopping right after the submit (its client gone) cannot lose it.
+
+    The scheduler handles a graph update asynchronously: a fire-and-forget request that arrives
+    before the task is known is dropped with a warning ("desires key ... but key is unknown"), and
+    the task would then go with the submitting client (measured: a job left queued for ever). So
+    the request is repeated until the scheduler holds it."""
+    from distributed import fire_and_forget
+
     end = time.time() + wait
     while time.time() < end:
-        if c.run_on_scheduler(_knows, key=key):
+        if c.run_on_scheduler(_kept, key=future.key):
             return
         time.sleep(0.05)
-    raise RuntimeError(f"the scheduler did not receive job {key} within {wait:.0f} s")
+        fire_and_forget(future)
+    raise RuntimeError(f"the scheduler did not take job {future.key} within {wait:.0f} s")
 
 
-def _knows(key: str, dask_scheduler=None) -> bool:
-    return key in dask_scheduler.tasks
+def _kept(key: str, dask_scheduler=None) -> bool:
+    """Whether the scheduler holds ``key`` for the fire-and-forget client (runs on the scheduler)."""
+    task = dask_scheduler.tasks.get(key)
+    return task is not None and any(cs.client_key == "fire-and-forget" for cs in task.who_wants or ())
 
 
 def _update(store, job_id: str, **values) -> bool:
