@@ -113,13 +113,11 @@ def records_to_frame(records) -> pd.DataFrame:
 def frame_to_records(df: pd.DataFrame) -> list[TrackRecord]:
     """The rows of a tracks table as :class:`TrackRecord` objects."""
     df = normalise_tracks(df)
+    columns = [df[c].tolist() for c in COLUMNS]  # plain Python values, column by column (fast)
     return [
-        TrackRecord(
-            int(r.frame), int(r.track_id), str(r.part), Box(float(r.x), float(r.y), float(r.w), float(r.h)),
-            float(r.score), bool(r.failure), float(r.occluded), str(r.state), str(r.source),
-            str(r.camera), float(r.X), float(r.Y), float(r.Z),
-        )
-        for r in df.itertuples(index=False)
+        TrackRecord(int(f), int(t), str(p), Box(float(x), float(y), float(w), float(h)), float(s), bool(fa),
+                    float(o), str(st), str(so), str(c), float(X), float(Y), float(Z))
+        for f, t, p, x, y, w, h, s, fa, o, st, so, c, X, Y, Z in zip(*columns, strict=True)
     ]
 
 
@@ -401,43 +399,44 @@ def has_take_columns(df: pd.DataFrame) -> bool:
 
 
 def write_tracks_csv(df: pd.DataFrame, dest: str | PathLike | io.TextIOBase) -> None:
-    """Write a tracks table, sorted by frame, track and part, with every column."""
+    """Write a tracks table to a file or an open text stream, as :func:`write_track_records` does."""
     df = normalise_tracks(df)
+    _write_rows(list(zip(*(df[c].tolist() for c in COLUMNS), strict=True)), dest)
+
+
+def write_track_records(records: list[TrackRecord], dest: str | PathLike | io.TextIOBase) -> None:
+    """Write tracks rows to a file (replaced whole, so a full disk leaves an earlier file as it was)
+    or an open text stream: sorted by frame, track and part (parts in :data:`PART_NAMES` order,
+    others after), ``%.2f`` floats, empty cells for NaN, ``failure`` as 0/1, and the take columns
+    (``camera,X,Y,Z``) only when a row has them. No pandas: a body run writes its rows directly."""
+    _write_rows([(r.frame, r.track_id, r.part, r.box.x, r.box.y, r.box.w, r.box.h, r.score, r.failure, r.occluded,
+                  r.state, r.source, r.camera, r.X, r.Y, r.Z) for r in records], dest)
+
+
+def _write_rows(rows: list[tuple], dest: str | PathLike | io.TextIOBase) -> None:
+    """The one tracks CSV writer: ``rows`` are tuples of plain values in :data:`COLUMNS` order."""
     order = {p: i for i, p in enumerate(PART_NAMES)}
-    df = df.assign(_p=df["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
-    df = df.drop(columns="_p")
-    df = df.assign(failure=df["failure"].astype(int))
-    if not has_take_columns(df):
-        df = df.drop(columns=list(TAKE_COLUMNS))
-    if isinstance(dest, (str, PathLike)):
-        from partlab.files import replacing
-
-        with replacing(dest) as tmp:  # a full disk leaves an earlier file as it was
-            df.to_csv(tmp, index=False, float_format="%.2f", lineterminator="\n")
-    else:
-        df.to_csv(dest, index=False, float_format="%.2f", lineterminator="\n")
-
-
-def write_track_records(records: list[TrackRecord], dest: str | PathLike) -> None:
-    """:func:`write_tracks_csv` of ``records`` without pandas: the same bytes (same order, ``%.2f``
-    floats, empty cells for NaN, ``failure`` as 0/1, the take columns only when a row has them)."""
-    order = {p: i for i, p in enumerate(PART_NAMES)}
-    rows = sorted(records, key=lambda r: (r.frame, r.track_id, order.get(r.part, len(order))))
-    take = any(r.camera != "" or not (math.isnan(r.X) and math.isnan(r.Y) and math.isnan(r.Z)) for r in rows)
+    rows.sort(key=lambda r: (r[0], r[1], order.get(r[2], len(order))))
+    take = any(r[12] != "" or not (math.isnan(r[13]) and math.isnan(r[14]) and math.isnan(r[15])) for r in rows)
     header = [c for c in COLUMNS if take or c not in TAKE_COLUMNS]
 
     def num(v: float) -> str:
         return "" if math.isnan(v) else "%.2f" % v  # noqa: UP031 (pandas' float_format, the same text)
 
+    def write(fh) -> None:
+        out = csv.writer(fh, lineterminator="\n")
+        out.writerow(header)
+        for frame, track_id, part, x, y, w, h, score, failure, occluded, state, source, camera, X, Y, Z in rows:
+            row = [frame, track_id, part, num(x), num(y), num(w), num(h), num(score), int(failure), num(occluded),
+                   state, source]
+            if take:
+                row += [camera, num(X), num(Y), num(Z)]
+            out.writerow(row)
+
+    if not isinstance(dest, (str, PathLike)):
+        write(dest)
+        return
     from partlab.files import replacing
 
     with replacing(dest) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        out = csv.writer(fh, lineterminator="\n")
-        out.writerow(header)
-        for r in rows:
-            b = r.box
-            row = [r.frame, r.track_id, r.part, num(b.x), num(b.y), num(b.w), num(b.h), num(r.score),
-                   int(r.failure), num(r.occluded), r.state, r.source]
-            if take:
-                row += [r.camera, num(r.X), num(r.Y), num(r.Z)]
-            out.writerow(row)
+        write(fh)
