@@ -485,7 +485,8 @@ class BodyParams(Parameters):
     #: fields added after partlab 0.2 (no flat name)
     ADDED: ClassVar[tuple[str, ...]] = (*(f"detector.{f.name}" for f in fields(BodyDetector)), "output.person",
                                         "background.camera_motion", "background.camera_hold",
-                                        "detection.exit_margin", "occlusion.bridge", "output.head_sets_sides")
+                                        "detection.exit_margin", "occlusion.bridge", "output.head_sets_sides",
+                                        "appearance.surround", "appearance.surround_floor")
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {
