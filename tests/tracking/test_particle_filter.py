@@ -102,3 +102,34 @@ def test_tiny_box_is_refused():
     with pytest.raises(ValueError, match="at least 2 x 2"):
         PartFilter(Box(0, 0, 1, 5), np.zeros((10, 10, 3), np.uint8), BodyParams(), PartNoise(),
                    np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("compiled", [True, False], ids=["numba", "numpy"])
+def test_a_background_weighted_model_tells_a_thin_person_in_a_loose_box_from_the_background(compiled, monkeypatch):
+    """A thin red figure (6 px) in a loose 24 px box on grey: the plain model is three quarters grey,
+    so a box of pure background matches it well; weighted against the ring around the person
+    (``appearance.surround``, Comaniciu et al. / Ning et al.) the grey bins count less, and the
+    figure matches far better than the background does. Off (the camera still), the model is the
+    plain one again."""
+    from partlab.tracking.body.part_filter import surround_counts
+    from partlab.tracking.core import kernels
+
+    monkeypatch.setattr(kernels, "HAVE_NUMBA", compiled)
+    rng = np.random.default_rng(3)
+    frame = _frame(rng, 80, 60, size=(6, 24))
+    ycc = to_ycc(frame)
+    box = Box(68, 48, 24, 24)
+    params = BodyParams()
+    noise = PartNoise(x=3, y=3, w=0.5, h=0.5, vx=0.5, vy=0.5, lam=20)
+    ring = surround_counts(ycc, box, params.appearance.surround)
+    assert ring is not None and ring.sum(axis=1).tolist() == [ring.sum() / 3] * 3
+    pf = PartFilter(box, ycc, params, noise, np.random.default_rng(1), surround=ring)
+    on_person = np.array([[80, 60, 24, 24, 0, 0]], np.float32)
+    on_grass = np.array([[30, 60, 24, 24, 0, 0]], np.float32)  # background only
+    plain = pf.similarities(ycc, on_person)[0], pf.similarities(ycc, on_grass)[0]
+    pf.weigh_by_background(True)
+    weighted = pf.similarities(ycc, on_person)[0], pf.similarities(ycc, on_grass)[0]
+    assert plain[1] > 0.85  # the plain model: background scores nearly as well as the person
+    assert weighted[1] < plain[1] - 0.05 and weighted[0] - weighted[1] > 1.5 * (plain[0] - plain[1])
+    pf.weigh_by_background(False)
+    assert pf.similarities(ycc, on_grass)[0] == pytest.approx(plain[1])

@@ -56,13 +56,16 @@ class PartFilter:
     """The particle filter and appearance model of one tracked rectangle."""
 
     def __init__(self, box: Box, ycc: np.ndarray, params: BodyParams, noise: PartNoise,
-                 rng: np.random.Generator, n: int | None = None):
+                 rng: np.random.Generator, n: int | None = None, surround: np.ndarray | None = None):
         if box.w < 2 or box.h < 2:
             raise ValueError(f"a tracked part needs a box of at least 2 x 2 pixels, got {box}")
         self.params = params
         self.noise = noise
         self.rng = rng
         self._sigma = np.array([noise.x, noise.y, noise.w, noise.h, noise.vx, noise.vy], dtype=np.float32)
+        #: 256-level counts ``(3, 256)`` of the ring around the person (``appearance.surround``), or None
+        self.surround = surround
+        self.weighted = False  # the target is background-weighted (while the camera moves)
         self.reseed(box, ycc, n=n)
 
     # -- initialisation -------------------------------------------------------------
@@ -96,6 +99,7 @@ class PartFilter:
             smoothed = _smooth(np.asarray(self.reference, dtype=np.float64), p.appearance.equalization_smoothing)
             self.mapping, self.target, self.sqrt_target = kernels.equalize(
                 smoothed, self.reference, p.appearance.bins_per_channel, p.appearance.equalization_floor)
+            self._weigh_by_surround()
             return
         self.mapping = equalization_map(self.reference, p.appearance.bins_per_channel,
                                         p.appearance.equalization_smoothing,
@@ -105,6 +109,28 @@ class PartFilter:
         per_channel = self.target.reshape(3, -1)
         per_channel = per_channel / np.maximum(per_channel.sum(axis=1, keepdims=True), 1e-12)
         self.sqrt_target = np.sqrt(per_channel).reshape(-1)
+        self._weigh_by_surround()
+
+    def _weigh_by_surround(self) -> None:
+        """The background-weighted target (``appearance.surround``): bins common in the ring
+        around the person count less, ``v_u = min(o* / o_u, 1)``; renormalised per channel."""
+        if self.surround is None or not self.weighted:
+            return
+        b = self.params.appearance.bins_per_channel
+        o = binned_histogram(self.surround, self.mapping, b).reshape(3, b)
+        positive = np.where(o > 0, o, np.inf)
+        v = np.where(o > 0, np.minimum(positive.min(axis=1, keepdims=True) / positive, 1.0), 1.0)
+        v = np.maximum(v, self.params.appearance.surround_floor)
+        target = self.target.reshape(3, b) * v
+        self.target = target.reshape(-1)
+        per_channel = target / np.maximum(target.sum(axis=1, keepdims=True), 1e-12)
+        self.sqrt_target = np.sqrt(per_channel).reshape(-1)
+
+    def weigh_by_background(self, on: bool) -> None:
+        """Turn the background-weighted target on or off (the tracker: while the camera moves)."""
+        if self.surround is not None and on != self.weighted:
+            self.weighted = on
+            self._refresh_map()
 
     def _clip_sizes(self) -> None:
         wh = self.particles[:, 2:4]
@@ -292,6 +318,26 @@ class PartFilter:
         idx = systematic_resample(self.weights, n, self.rng)
         self.particles = self.particles[idx]
         self.weights = np.full(n, 1.0 / n)
+
+
+def surround_counts(ycc: np.ndarray, box: Box, share: float) -> np.ndarray | None:
+    """256-level counts ``(3, 256)`` of the ring around ``box``, ``share`` of its width and height
+    wide on each side (clipped to the frame), or None when ``share`` is 0 or the ring is empty."""
+    if share <= 0:
+        return None
+    H, W = ycc.shape[:2]
+    x, y, w, h = _int_box(box)
+    dx, dy = int(round(share * w)), int(round(share * h))
+    x1, y1, x2, y2 = max(x - dx, 0), max(y - dy, 0), min(x + w + dx, W), min(y + h + dy, H)
+    if x2 <= x1 or y2 <= y1:
+        return None
+    region = np.asarray(ycc[y1:y2, x1:x2])
+    keep = np.ones(region.shape[:2], bool)
+    keep[max(y - y1, 0):max(y + h - y1, 0), max(x - x1, 0):max(x + w - x1, 0)] = False
+    pixels = region[keep]
+    if len(pixels) == 0:
+        return None
+    return np.stack([np.bincount(pixels[:, c], minlength=256) for c in range(3)]).astype(np.float64)
 
 
 def _box_histogram(ycc, box: Box) -> np.ndarray:

@@ -35,7 +35,7 @@ import numpy as np
 from partlab.tracking.body.cue import DetectionCue
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
-from partlab.tracking.body.part_filter import PartFilter
+from partlab.tracking.body.part_filter import PartFilter, surround_counts
 from partlab.tracking.core.box import Box, iou_xywh
 from partlab.tracking.core.camera_motion import CameraMotion, MotionSettings
 from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
@@ -228,11 +228,20 @@ class BodyTracker:
         parts = self._part_boxes_for_start(boxes, ycc, mask)
         H, W = ycc.shape[:2]
         filters = {}
+        around = None
+        if self.params.appearance.surround > 0:  # the ring around the person (background-weighted models)
+            person_box = boxes.get("person")
+            if person_box is None:
+                person_box = parts[self.parts[0]]
+                for n in self.parts[1:]:
+                    person_box = person_box.union_box(parts[n])
+            around = surround_counts(ycc, person_box, self.params.appearance.surround)
         for name in self.parts:
             b = parts[name].clip(W, H)
             if b.w < 2 or b.h < 2:
                 b = Box(b.x, b.y, max(b.w, 2.0), max(b.h, 2.0))
-            filters[name] = PartFilter(b, ycc, self.params, self.params.dynamics.noise[name], self.rng)
+            filters[name] = PartFilter(b, ycc, self.params, self.params.dynamics.noise[name], self.rng,
+                                       surround=around)
         person = Person(track_id, filters, deque(maxlen=self.params.adjustment.history_frames), started=index)
         if "torso" in filters:
             t = filters["torso"].state
@@ -309,12 +318,16 @@ class BodyTracker:
         self.frame_size = (W, H)
         self.frames_seen += 1
         mask = self._follow_camera(frame, foreground)
+        moving = self.camera is not None and self.camera.moving
         new_ids = set()
         if self.pending:
             before = set(self.people)
             self._start_pending(index, ycc, mask)
             new_ids = set(self.people) - before
         active = [self.people[t] for t in sorted(self.people) if t not in new_ids]
+        for person in self.people.values():  # colour models weighted against the background while the camera moves
+            for pf in person.filters.values():
+                pf.weigh_by_background(moving)
 
         # predict every part; decide who is hidden; measure the others
         for person in active:
