@@ -233,6 +233,17 @@ def active(kind: str | None = None, **meta) -> list[Job]:
     return [j for j in jobs(kind, **meta) if j.active]
 
 
+def ended_since(watched: set[str], running: list[Job], ignore: set[str] = frozenset()) -> bool:
+    """Whether a job in ``watched`` (ids seen running before) and not in ``ignore`` is no longer
+    among ``running``; ``watched`` becomes the ids of ``running`` (the sidebar's job list reruns
+    the page once then; ``ignore``: jobs a page's own panel reruns it for)."""
+    now = {j.id for j in running}
+    ended = bool(watched - now - set(ignore))
+    watched.clear()
+    watched.update(now)
+    return ended
+
+
 def wait(job_id: str, timeout: float = 60.0) -> Job:
     """Block until a job ends (tests and scripts)."""
     end = time.time() + timeout

@@ -93,9 +93,14 @@ with st.sidebar:
         """Without sign-in every job; with it, the jobs of the user's projects only."""
         return not auth.enabled() or job_meta.get("project_id") in visible
 
+    watched = st.session_state.setdefault("sidebar_watched_jobs", set())
+
     @st.fragment(run_every=2 if jobs.active() else None)
     def _job_list():
         running = [j for j in jobs.active() if _mine(j.meta)]
+        # a job this session saw running has ended: rerun the page, whose tables (a clip's state,
+        # its runs) were drawn before it ended
+        ended = jobs.ended_since(watched, running, ignore=st.session_state.get("page_jobs", set()))
         recent = [j for j in jobs.jobs() if not j.active and _mine(j.meta)][:3]
         stopped = [e for e in jobs.interrupted() if _mine(e.get("meta") or {})][:3]
         if running or recent or stopped:
@@ -114,6 +119,8 @@ with st.sidebar:
                        "start it again from its page)")
         if recent or stopped:
             st.button("Clear finished jobs", on_click=jobs.clear_finished, type="tertiary")
+        if ended:
+            st.rerun()
 
     _job_list()
     st.caption(f"Data: {data_dir()}")

@@ -53,3 +53,19 @@ def test_jobs_left_unfinished_by_a_stopped_server_are_reported_then_cleared():
 
     assert jobs.clear_finished() >= 2 and jobs.interrupted() == []
     assert "a1" not in path.read_text()
+
+
+def test_the_sidebar_reruns_the_page_once_when_a_job_it_saw_running_ends():
+    gate = threading.Event()
+    job = jobs.submit("test", "wait", lambda progress: gate.wait(5), clip_id=1)
+    watched: set[str] = set()
+    assert not jobs.ended_since(watched, jobs.active()) and watched == {job.id}
+    assert not jobs.ended_since(watched, jobs.active())  # still running
+    gate.set()
+    jobs.wait(job.id, 5)
+    assert jobs.ended_since(watched, jobs.active()) and watched == set()
+    assert not jobs.ended_since(watched, jobs.active())  # once
+    other = jobs.submit("test", "page's own", lambda progress: None)
+    watched.add(other.id)
+    jobs.wait(other.id, 5)
+    assert not jobs.ended_since(watched, jobs.active(), ignore={other.id})  # its page's panel reruns it

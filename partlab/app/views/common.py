@@ -80,6 +80,7 @@ def job_panel(kind: str, limit: int = 5, **meta) -> None:
     watched = st.session_state.setdefault("watched_jobs", set())
     for job in jobs.active(kind, **meta):
         watched.add(job.id)
+    st.session_state.setdefault("page_jobs", set()).update(watched)  # the sidebar leaves these to the panel
 
     @st.fragment(run_every=1 if jobs.active(kind, **meta) else None)
     def panel():
