@@ -222,9 +222,9 @@ def test_what_one_view_shows_all_along_is_told_from_what_every_view_lost():
     assert _one_view_mass({f: [_seen("b", 40, 0.27)] for f in range(10, 20)}, 10, 19, 40, P) == 0.0
 
 
-def _one_hand(kind, start, end, track, hue, part="right_hand", confidence=0.8):
+def _one_hand(kind, start, end, track, hue, part="right_hand", confidence=0.8, at=None):
     return dict(start_frame=start, end_frame=end, kind=kind, track_id_a=track, part_a=part, track_id_b=0,
-                part_b="", ended_by="still", object_colour="#00ff00", confidence=confidence, hue=hue)
+                part_b="", ended_by="still", object_colour="#00ff00", confidence=confidence, hue=hue, at=at)
 
 
 def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
@@ -248,6 +248,13 @@ def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
                  _one_hand("pick", 100, 125, 2, blue), _one_hand("pick", 100, 125, 1, green, part="left_hand")):
         out = handovers([rows[0], pick, shake], P)
         assert sorted(r["kind"] for r in out) == ["handshake", "pick", "place"]
+    # where the hands stood is known: a pick 2 hand sides from the place is the taker's, one 10
+    # sides away (someone at another table taking an object of that colour) is not
+    place = _one_hand("place", 90, 100, 1, green, at=(300.0, 200.0, 20.0))
+    near = _one_hand("pick", 100, 125, 2, green, at=(340.0, 200.0, 20.0))
+    far = _one_hand("pick", 100, 125, 2, green, at=(500.0, 200.0, 20.0))
+    assert [r["kind"] for r in handovers([place, near], P)] == ["exchange"]
+    assert sorted(r["kind"] for r in handovers([place, far], P)) == ["pick", "place"]
     # two picks of the colour: the nearer in time takes it, the other stays a pick
     out = handovers([rows[0], _one_hand("pick", 112, 125, 3, green), _one_hand("pick", 103, 120, 2, green)], P)
     assert sorted((r["kind"], r["track_id_b"]) for r in out) == [("exchange", 2), ("pick", 0)]

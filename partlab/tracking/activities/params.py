@@ -124,6 +124,11 @@ class Decision:
     # frames later (a handover whose hands the tracker never brings together: a short moment where
     # nobody seems to hold it) was given, one exchange; a handshake of the two over it is dropped
     handover_gap: int = number(15, POSITIVE_COUNT)
+    # ... and where the two hands stood still at most this many hand sides apart (the object goes
+    # from hand to hand; a place on one table and a pick by someone else at another are not a
+    # handover). The handovers of the 3-camera handshake takes (limbs3d hands, seeds 0-9): 0.1-1.7
+    # hand sides apart. 0: any distance
+    handover_reach: float = number(4.0)
 
 
 @dataclass(frozen=True)

@@ -493,7 +493,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
-                                 confidence=round(v.margin, 3), hue=v.colour))
+                                 confidence=round(v.margin, 3), hue=v.colour, at=_stood(cs, s0, s1)))
     rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
     rows += other_sides(rows, colours, clothes, params)
     out = pd.DataFrame(handovers(rows, params), columns=list(ACTIVITY_COLUMNS))
@@ -536,7 +536,7 @@ def other_sides(rows: list[dict], colours: Mapping[Key, Mapping[int, list[HandCo
                 continue
             conf = round(min(r["confidence"], 1.0 - gone / max(held, 1e-9)), 3)
             if conf >= d.min_confidence and (best is None or conf > best["confidence"]):
-                best = dict(r, kind=other, track_id_a=key[0], part_a=key[1], confidence=conf)
+                best = dict(r, kind=other, track_id_a=key[0], part_a=key[1], confidence=conf, at=None)
         if best is not None:
             out.append(best)
     return out
@@ -558,6 +558,21 @@ def _one_view_mass(colours: Mapping[int, list[HandColour]], lo: int, hi: int, hu
     return max(_mass_of(colour_masses(fuse(obs), params), hue, params) for obs in views.values())
 
 
+def _stood(centres: Mapping[int, tuple[float, float, float]], s0: int, s1: int) -> tuple[float, float, float] | None:
+    """Where a hand stood still over ``s0..s1``: the median of its centres and sides."""
+    seen = [centres[f] for f in range(s0, s1 + 1) if f in centres]
+    return tuple(float(v) for v in np.median(np.array(seen, float), axis=0)) if seen else None
+
+
+def _stood_near(a: dict, b: dict, reach: float) -> bool:
+    """Whether two one-hand rows' hands stood within ``reach`` hand sides of each other (True when
+    ``reach`` is 0 or a row has no place)."""
+    pa, pb = a.get("at"), b.get("at")
+    if reach <= 0 or pa is None or pb is None:
+        return True
+    return float(np.hypot(pa[0] - pb[0], pa[1] - pb[1])) <= reach * max(pa[2], pb[2], 1.0)
+
+
 def _gap(a: dict, b: dict) -> int:
     """Frames between two rows' spans (0 or less where they overlap), in either order."""
     return max(b["start_frame"] - a["end_frame"], a["start_frame"] - b["end_frame"])
@@ -575,8 +590,9 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
     with the giver's still moment and ends with the later of the two, goes from the placing hand
     (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
-    the two people overlapping it is dropped (the touch of the handover). Each place and each pick
-    gives at most one exchange, the nearest in time first."""
+    the two people overlapping it is dropped (the touch of the handover). The two hands must have
+    stood still within ``handover_reach`` hand sides of each other (rows' ``at``, where known).
+    Each place and each pick gives at most one exchange, the nearest in time first."""
     d = params.decision
     reach = d.same_colour / DEGREES_PER_BIN
 
@@ -588,7 +604,8 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     pairs = sorted((_gap(rows[i], rows[j]), i, j) for i in places for j in picks
                    if rows[j]["track_id_a"] != rows[i]["track_id_a"]
                    and _gap(rows[i], rows[j]) <= d.handover_gap
-                   and same(rows[i].get("hue"), rows[j].get("hue")))
+                   and same(rows[i].get("hue"), rows[j].get("hue"))
+                   and _stood_near(rows[i], rows[j], d.handover_reach))
     used: set[int] = set()
     exchanges = []
     for _, i, j in pairs:
