@@ -256,6 +256,14 @@ class BodyDetection:
     # boxes (seeds 1-4, with ``bridge`` and ``head_sets_sides`` False): edits/100 18.76 -> 16.75,
     # MOTA 0.684 -> 0.716. (A person standing still at the border with no foreground support ends too.)
     exit_margin: float = number(0.25, FRACTION)
+    # ... or that was so (within ``exit_margin`` of a border, not moving away) on a frame with
+    # foreground support at most ``exit_window`` frames before its support went: at the border the
+    # box loses its walker's colours and bounces back into the frame (PETS09: a walker leaving on
+    # the right, the box 3 px from the border, then 2 px a frame back inwards, where the coasting
+    # track re-acquired the next passer-by). 0: the border is judged on the current frame only.
+    # PETS09 from the first boxes (seeds 1-4, with the steering of ``detector.steer_velocity``):
+    # edits/100 17.01 -> 14.10 (seed 2 24.22 -> 12.93), MOTA 0.731 -> 0.769.
+    exit_window: int = number(10, COUNT)
 
 
 @dataclass(frozen=True)
@@ -315,8 +323,19 @@ class BodyDetector:
     velocity_frames: int = number(9, POSITIVE_COUNT)
     # A matched detection moves and re-sizes the track's parts this share of the way to where it
     # puts them (the part boxes keep their places inside the person box): colour likelihoods hardly
-    # constrain a box's size, a detector's window does.
-    steer: float = number(0.5, FRACTION)
+    # constrain a box's size, a detector's window does. 0.7 (was 0.5; what retraining fitted on
+    # PETS09 frames 0-199) with ``steer_velocity`` 0.5: PETS09 automatic, seeds 1-4, MOTA 0.722 ->
+    # 0.781, edits/100 17.00 -> 13.98 (0.7 alone: 0.742, 15.98); docs/measurements/annotation_effort.md.
+    steer: float = number(0.7, FRACTION)
+    # ... and brings the parts' velocity this share of the way to the per-frame motion of the track's
+    # last two detections (at most ``velocity_frames`` apart; 0: off): the colour filters' velocity
+    # lags a walker (PETS09 automatic: 70 % of the boxes off by IoU 0.3-0.5 trail their walker).
+    steer_velocity: float = number(0.5, FRACTION)
+    # Swap guard: a matched detection that overlaps another track at least ``swap_guard`` times as
+    # much as its own (IoU, and at least ``match_iou``) does not steer: where two walkers cross, the
+    # detector's window (or the assignment) may be the other person's, and steering would carry
+    # the track onto them. The match still counts (no re-acquisition). 0: off.
+    swap_guard: float = number(0.0, FRACTION)
     # A steered part's width and height stay within ``layout_tolerance`` times those it would have
     # in the detection's box laid out as the track's parts were when a detection first matched it
     # (a person's proportions do not change as they walk; the first match, not the start, as a
@@ -471,7 +490,8 @@ class BodyParams(Parameters):
     #: fields added after partlab 0.2 (no flat name)
     ADDED: ClassVar[tuple[str, ...]] = (*(f"detector.{f.name}" for f in fields(BodyDetector)), "output.person",
                                         "background.camera_motion", "background.camera_hold",
-                                        "detection.exit_margin", "occlusion.bridge", "output.head_sets_sides")
+                                        "detection.exit_margin", "detection.exit_window", "occlusion.bridge",
+                                        "output.head_sets_sides")
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {
