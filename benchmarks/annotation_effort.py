@@ -108,12 +108,12 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
         props = interpolate_keyframes(table)
         return props, 0.0, len(table)
     if kind == "init":
-        props = track(take, "body", init=table, seed=seed).tracks
+        props = track(take, "body", init=table, seed=seed, model=MODEL[0] if MODEL else None).tracks
         n = n_keys  # one box drawn per track (part rows of a synthetic init count as one person box)
     elif kind == "keys":
         from partlab.tracking.keyframes import track_with_keyframes
 
-        props = track_with_keyframes(take, table, seed=seed).tracks
+        props = track_with_keyframes(take, table, seed=seed, model=MODEL[0] if MODEL else None).tracks
         n = len(table)
     elif kind == "hog_sort":
         sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -122,7 +122,7 @@ def run_method(take, truth: pd.DataFrame, kind: str, table, seed: int) -> tuple[
         props = hog_sort(take)
         n = 0
     else:
-        props = track(take, "body", seed=seed).tracks
+        props = track(take, "body", seed=seed, model=MODEL[0] if MODEL else None).tracks
         n = 0
     CPU[-1] = (time.process_time() - c0) / max(take.frame_count, 1)
     return props, (time.perf_counter() - t0) / max(take.frame_count, 1), n
@@ -132,6 +132,7 @@ CPU: list[float] = []
 PART_RATES = ("head", "torso", "hipleg")
 ONLY: list[str] = []  # --methods
 SAVE: list[Path] = []  # --save-proposals
+MODEL: list = []  # --set: the body parameters with those changes
 
 
 def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, hog: bool = False,
@@ -217,6 +218,24 @@ def synth_suite(n_scenes: int, seeds, keys, frames: int, first: int = 100, cache
     return df
 
 
+def parameter_changes(settings: list[str]):
+    """``BodyParams`` with the ``GROUP.FIELD=VALUE`` changes of ``--set`` (values read as JSON)."""
+    import json
+
+    from partlab.tracking.params import BodyParams
+
+    changes = {}
+    for item in settings:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise SystemExit(f"--set {item!r}: expected GROUP.FIELD=VALUE")
+        try:
+            changes[key.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            changes[key.strip()] = value
+    return BodyParams().updated(changes)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seeds", default="1,2,3,4", help="tracker seeds")
@@ -234,7 +253,12 @@ def main() -> None:
     ap.add_argument("--save-proposals", type=Path, help="write every tracker run's tracks CSV into this folder")
     ap.add_argument("--methods", default="",
                     help="only these methods (comma-separated prefixes, e.g. 'body keys,body auto')")
+    ap.add_argument("--set", action="append", default=[], metavar="GROUP.FIELD=VALUE",
+                    help="run the body tracker with this parameter changed (repeatable; the value is read "
+                         "as JSON, e.g. --set detector.duplicate_iou=0.4 --set occlusion.bridge=false)")
     a = ap.parse_args()
+    if a.set:
+        MODEL[:] = [parameter_changes(a.set)]
     seeds = [int(s) for s in a.seeds.split(",") if s]
     ONLY[:] = [m.strip() for m in a.methods.split(",") if m.strip()]
     SAVE[:] = [a.save_proposals] if a.save_proposals else []

@@ -288,6 +288,32 @@ def test_a_track_lost_at_the_frame_edge_moving_out_has_walked_out():
         assert tracker.people[1].lost_since == 100 - lost_frames + 1 and tracker.withdrawn == []
 
 
+def test_a_track_that_was_at_the_edge_moving_out_before_its_support_went_has_walked_out():
+    """``detection.exit_window``: the box was at the right border moving out on a supported frame,
+    then bounced back inwards (its velocity points away from the border) as its support went: it
+    has walked out all the same. With the window 0 only the last frame counts, and it goes lost."""
+    lost_frames = BodyParams().detection.lost_frames
+    frames, truths = _scene(n=1, walkers=(dict(x0=300, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    for window in (10, 0):
+        p = BodyParams().updated({"detection.exit_window": window})
+        tracker = BodyTracker(p, np.random.default_rng(0), init=_init(truths[0]))
+        tracker.step(0, frames[0], None)
+        person = tracker.people[1]
+        tracker.frames_seen = p.background.warmup + 1
+        for f in person.filters.values():
+            f.set_velocity(np.array([2.0, 0.0]))  # at the border, walking out, still supported
+        tracker._end_tracks([person], np.full((H, W), 255, np.uint8), W, H, index=90)
+        assert 1 in tracker.people and person.unsupported == 0
+        for f in person.filters.values():
+            f.set_velocity(np.array([-2.0, 0.0]))  # the box bounces back inwards
+        person.unsupported = lost_frames - 1
+        tracker._end_tracks([person], np.zeros((H, W), np.uint8), W, H, index=100)
+        if window:
+            assert 1 not in tracker.people and tracker.withdrawn == [(1, 100 - lost_frames + 1)]
+        else:
+            assert tracker.people[1].lost_since == 100 - lost_frames + 1 and tracker.withdrawn == []
+
+
 def test_the_person_box_sides_without_the_head():
     """``output.head_sets_sides`` False: a head box sticking out sideways beyond the body does not
     widen the person row (its left and right come from torso and hip-leg); its top still comes from

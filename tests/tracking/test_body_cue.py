@@ -167,3 +167,64 @@ def test_steering_keeps_the_parts_near_their_proportions_at_the_first_detection(
 def test_layout_tolerance_is_checked():
     with pytest.raises(ValueError, match="detector.layout_tolerance"):
         BodyParams().updated({"detector.layout_tolerance": 0.8})
+
+
+def test_the_swap_guard_does_not_steer_a_track_onto_a_detection_its_neighbour_overlaps_as_much():
+    """Two walkers side by side (crossing): the one detection lies between them, overlapping both
+    tracks about equally; the assignment gives it to one of them. Steered, that track jumps onto the
+    other walker (where two people cross, the window may be the other's); with ``swap_guard`` the
+    contested detection steers nobody, while one that only its own track overlaps still steers."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    frame = np.full((240, 320, 3), 90, np.uint8)
+    frame[60:160, 100:130] = (40, 60, 200)
+    frame[60:160, 124:154] = (200, 60, 40)
+    ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    between = np.array([[110.0, 60.0, 30.0, 100.0, 1.0]])  # overlaps both person boxes about equally
+    own = np.array([[90.0, 60.0, 30.0, 100.0, 1.0]])  # overlaps track 1 only
+    moved = {}
+    for guard in (0.0, 0.7):
+        for name, dets in (("between", between), ("own", own)):
+            t = BodyTracker(BodyParams().updated({"detector.swap_guard": guard}), np.random.default_rng(0))
+            t.frame_size = (320, 240)
+            for tid, x in ((1, 100), (2, 124)):
+                t.start_track(tid, {"person": Box(x, 60, 30, 100)}, ycc, None, 0)
+            before = {k: t._reported_person_box(q).centre[0] for k, q in t.people.items()}
+            t.cue.detector.detect = lambda frame, regions, dets=dets: dets
+            t.cue.step(0, frame, ycc, None)
+            moved[guard, name] = {k: t._reported_person_box(q).centre[0] - before[k] for k, q in t.people.items()}
+    # without the guard the contested detection pulls one track 8 px or more towards the other walker
+    assert max(abs(v) for v in moved[0.0, "between"].values()) > 4
+    assert moved[0.7, "between"] == pytest.approx({1: 0.0, 2: 0.0}, abs=1e-6)
+    # a detection only its own track overlaps steers with the guard on as without it
+    assert moved[0.7, "own"][1] == pytest.approx(moved[0.0, "own"][1])
+    assert moved[0.7, "own"][1] < -1
+
+
+def test_steer_velocity_brings_the_parts_velocity_towards_the_motion_of_the_detections():
+    """A walker moving 4 px a frame whose track's filters think it stands still: two detections
+    three frames apart show the motion; with ``steer_velocity`` 0.5 every part's velocity goes half
+    of the way there, without it the detections move the boxes but not the velocity."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    frame = np.full((240, 320, 3), 90, np.uint8)
+    frame[60:160, 100:130] = (40, 60, 200)
+    ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    velocity = {}
+    for gain in (0.0, 0.5):
+        t = BodyTracker(BodyParams().updated({"detector.steer_velocity": gain}), np.random.default_rng(0))
+        t.frame_size = (320, 240)
+        person = t.start_track(1, {"person": Box(100, 60, 30, 100)}, ycc, None, 0)
+        det = t._reported_person_box(person)
+        for index in (0, 3):  # the cue scans every third frame
+            box = np.array([[det.x + 4.0 * index, det.y, det.w, det.h, 1.0]])
+            t.cue.detector.detect = lambda frame, regions, box=box: box
+            t.cue.step(index, frame, ycc, None)
+        velocity[gain] = {n: tuple(f.state[4:6]) for n, f in person.filters.items()}
+    for name in ("head", "torso", "hipleg"):
+        assert velocity[0.0][name] == pytest.approx((0.0, 0.0), abs=1e-6)
+        assert velocity[0.5][name] == pytest.approx((2.0, 0.0), abs=1e-4)

@@ -111,13 +111,17 @@ class DetectionCue:
         pairs = associate(track_boxes, dets, self.p.match_iou, self._affinity(people, boxes, dets, ycc),
                           self.p.match_similarity, self.p.similarity_weight)
         used = set()
+        contested = self._contested(track_boxes, dets, pairs)
         for i, j in pairs:
             det = Box(*dets[j, :4])
             self._seen(people[i].track_id, index, det)
-            if self.p.steer_coasting > 0 and (people[i].occluded_by is not None or people[i].lost_since is not None):
+            if (i, j) in contested:
+                pass  # another track overlaps the detection about as much: steering could swap them
+            elif self.p.steer_coasting > 0 and (people[i].occluded_by is not None or people[i].lost_since is not None):
                 self._steer_coasting(people[i], boxes[i], det)
             elif det.iou(boxes[i]) < self.p.steer_below:
                 self._steer(people[i], boxes[i], det, self.p.steer)
+                self._steer_motion(people[i])
             self.last_match[people[i].track_id] = index
             if people[i].lost_since is not None:
                 people[i].lost_since = None
@@ -129,6 +133,20 @@ class DetectionCue:
         if t.auto:
             self._confirm(index, dets, free, ycc, mask)
         self._end(index)
+
+    def _contested(self, tracks: np.ndarray, dets: np.ndarray, pairs: list[tuple[int, int]]) -> set[tuple[int, int]]:
+        """``swap_guard``: the pairs whose detection overlaps another track at least ``swap_guard``
+        times as much as its own track (and at least ``match_iou``)."""
+        g = self.p.swap_guard
+        if g <= 0 or len(tracks) < 2 or not pairs:
+            return set()
+        iou = iou_xywh(tracks, dets[:, :4])
+        out = set()
+        for i, j in pairs:
+            others = np.delete(iou[:, j], i)
+            if others.max() >= max(g * iou[i, j], self.p.match_iou):
+                out.add((i, j))
+        return out
 
     def _affinity(self, people: list, boxes: list[Box], dets: np.ndarray, ycc) -> np.ndarray | None:
         """``(tracks, detections)`` Bhattacharyya coefficient of each track's torso model (or only
@@ -164,6 +182,15 @@ class DetectionCue:
         else:
             self.velocity.pop(track_id, None)
         self.last_seen[track_id] = (index, cx, cy)
+
+    def _steer_motion(self, person) -> None:
+        """``steer_velocity``: every part's velocity goes that share of the way to the motion its
+        detections show."""
+        v = self.velocity.get(person.track_id)
+        if self.p.steer_velocity <= 0 or v is None:
+            return
+        for f in person.filters.values():
+            f.nudge_velocity(v, self.p.steer_velocity)
 
     def _steer_coasting(self, person, reported: Box, det: Box) -> None:
         """A track coasting on its dynamics (behind someone, or lost) that a detection sees (its

@@ -291,6 +291,13 @@ class PartFilter:
         self.state[4:6] = velocity
         self.particles[:, 4:6] = np.asarray(velocity, dtype=np.float32)
 
+    def nudge_velocity(self, velocity: np.ndarray, gain: float) -> None:
+        """Move the velocity of the estimate and of every particle ``gain`` of the way to
+        ``velocity`` (the particles keep their spread)."""
+        delta = gain * (np.asarray(velocity, dtype=np.float64) - self.state[4:6])
+        self.state[4:6] += delta
+        self.particles[:, 4:6] += delta.astype(np.float32)
+
     def appearance(self, ycc: np.ndarray) -> np.ndarray:
         """``Q_t``: the 256-level histogram ``(3, 256)`` of the current estimate's rectangle."""
         return _box_histogram(ycc, self.box)

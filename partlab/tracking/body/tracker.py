@@ -110,6 +110,7 @@ class Person:
     lost_since: int | None = None           # frame it went lost (no foreground support), coasting since
     layout: dict[str, tuple] = field(default_factory=dict)  # parts in the person box at its first detection
     coast_start: int | None = None          # first frame of the coasting stretch it is in (lost or occluded)
+    at_border: int | None = None            # last supported frame its box was at a border, not moving away
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -599,9 +600,19 @@ class BodyTracker:
         person.failed = tuple(verdict.failed) if verdict.failed else (BODY_PARTS if verdict.multi else ())
         person.adjusted = True
 
-    def _walked_out(self, person: Person, W: int, H: int) -> bool:
+    def _walked_out(self, person: Person, W: int, H: int, went: int) -> bool:
         """The person's reported box lies within ``exit_margin`` of its size from a border of the
-        frame and the person does not move away from that border (``detection.exit_margin``)."""
+        frame and the person does not move away from that border (``detection.exit_margin``), or
+        did so on a supported frame at most ``exit_window`` frames before its support went (frame
+        ``went``)."""
+        if self._at_border(person, W, H):
+            return True
+        d = self.params.detection
+        return d.exit_window > 0 and person.at_border is not None and person.at_border >= went - d.exit_window
+
+    def _at_border(self, person: Person, W: int, H: int) -> bool:
+        """The person's reported box lies within ``exit_margin`` of its size from a border of the
+        frame and the person does not move away from that border."""
         m = self.params.detection.exit_margin
         if m <= 0:
             return False
@@ -629,14 +640,16 @@ class BodyTracker:
                 continue
             if person.lost_since is not None:
                 if (index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames
-                        or self._walked_out(person, W, H)):
+                        or self._walked_out(person, W, H, person.lost_since)):
                     self.withdrawn.append((person.track_id, person.lost_since))
                     del self.people[person.track_id]
                 continue
             support = _support(mask, box)
             person.unsupported = person.unsupported + 1 if support < p.detection.support_min else 0
+            if not person.unsupported and p.detection.exit_window > 0 and self._at_border(person, W, H):
+                person.at_border = index
             if person.unsupported >= p.detection.lost_frames:
-                if self._walked_out(person, W, H):
+                if self._walked_out(person, W, H, index - p.detection.lost_frames + 1):
                     # left the frame: the rows written since its support went are on background
                     self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
                     del self.people[person.track_id]
