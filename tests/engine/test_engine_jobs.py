@@ -17,6 +17,7 @@ from partlab.engine import jobs as engine
 from partlab.labelling.store import Store
 
 ROOT = Path(__file__).resolve().parents[2]
+LONG = 2000  # frames of the job that is cancelled while it runs
 
 SERVER = """
 from partlab.app import runs
@@ -41,7 +42,9 @@ def service(monkeypatch, tmp_path):
 
 
 def test_a_track_job_outlives_its_server_shows_progress_and_cancels(service, tmp_path):
-    for name, frames in (("short", 40), ("long", 400)):
+    # the long clip takes the worker well over the test's polling of the job list (a 400-frame one
+    # was tracked to its end between two polls of a loaded PostgreSQL pass)
+    for name, frames in (("short", 40), ("long", LONG)):
         assert main(["synth", str(tmp_path / name), "--scenario", "single", "--seed", "2", "--frames", str(frames),
                      "--size", "320x240"]) == 0
     store = Store()
@@ -63,11 +66,11 @@ def test_a_track_job_outlives_its_server_shows_progress_and_cancels(service, tmp
         if job.status == "running" and job.done >= 5:
             break
         time.sleep(0.1)
-    assert job.active and job.total == 400 and 0 < job.fraction < 1
+    assert job.active and job.total == LONG and 0 < job.fraction < 1
     assert [j.id for j in jobs.active("track", clip_id=long.id)] == [long_id]
     jobs.cancel(long_id)
     ended = jobs.wait(long_id, timeout=60)
-    assert ended.status == "cancelled" and ended.done < 400
+    assert ended.status == "cancelled" and ended.done < LONG
     assert store.runs(long.id).empty  # nothing half-stored
     # the first finished and was stored
     done = jobs.wait(short_id, timeout=300)
