@@ -294,3 +294,16 @@ def test_one_camera_of_a_2_camera_take_hidden_for_30_frames_loses_fewer_targets(
         if not ((df["frame"] >= 60) & (df["state"] == "lost")).any() and len(err) == 3 and err.max() < 60:
             kept.append(rng)  # nothing lost, and all three back on their parts once the camera is back
     assert len(kept) >= 3  # before: none of the six
+
+
+def test_a_wider_gate_lets_the_filter_reach_a_candidate_beyond_the_default_one():
+    def reach(gate):
+        out = []
+        for seed in range(10):
+            f = TargetFilter(np.array([0.0, 0, 1000]), Limbs3DDynamics(), np.random.default_rng(seed))
+            f.predict()  # its only candidate is 270 mm off, beyond the 250 mm candidate_gate
+            out.append(f.update(np.array([[0.0, 270, 1000]]), np.array([0.99]), gate)[1])
+        return float(np.mean(out))
+
+    assert reach(None) < 40  # 10 mm of the 270: the particles only diffuse towards it
+    assert reach(375.0) > 150  # 233 mm: one missed frame with dynamics.gate_growth 0.5

@@ -61,6 +61,7 @@ class _Target:
     position: np.ndarray | None = None
     labelled: bool = True
     waiting: int = 0  # frames an automatically started target has waited for a label
+    missed: int = 0  # frames in a row without confidence (dynamics.gate_growth)
     history: list = field(default_factory=list)
 
 
@@ -252,12 +253,14 @@ class Limbs3DTracker:
             mine = self._usable(t, points, None if few else dist[:, a], None if few else dist[:, rivals],
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
+            gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
             if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
-                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < p.dynamics.candidate_gate).any()):
+                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
                 single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
                 use = np.vstack([use.reshape(-1, 3), single])
                 use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
-            est = t.filter.update(use, use_w)
+            est = t.filter.update(use, use_w, gate)
+            t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
             else:
