@@ -45,7 +45,7 @@ class TargetFilter:
         self.particles[:, :3] += v + self.rng.normal(0, p.noise_xyz * scale, (n, 3))
         self.particles[:, 3:] = v
 
-    def propose(self, candidates: np.ndarray, prior: np.ndarray) -> np.ndarray:
+    def propose(self, candidates: np.ndarray, prior: np.ndarray, gate: float | None = None) -> np.ndarray:
         """Redraw ``candidate_mix`` of the particles around the gated candidates (sec. 4.2's
         "further steps"); the others keep their predicted state. Returns every particle's
         importance factor ``f / q`` (ICONDENSATION, Isard & Blake): ``f`` the dynamics' density
@@ -59,7 +59,7 @@ class TargetFilter:
         if len(candidates) == 0 or p.candidate_mix <= 0:
             return ones
         mean = self.particles[:, :3].mean(axis=0)
-        near = np.linalg.norm(candidates - mean, axis=1) < p.candidate_gate
+        near = np.linalg.norm(candidates - mean, axis=1) < (p.candidate_gate if gate is None else gate)
         if not near.any():
             return ones
         c, w = candidates[near], prior[near] / prior[near].sum()
@@ -86,9 +86,10 @@ class TargetFilter:
         d2 = ((self.particles[:, None, :3] - candidates[None]) ** 2).sum(-1)
         return np.exp(-d2 / (2 * p.sigma_x**2)) @ prior + p.weight_floor
 
-    def update(self, candidates: np.ndarray, prior: np.ndarray) -> np.ndarray:
-        """Propose, weigh, estimate, resample; returns the estimate (mm)."""
-        w = self.propose(candidates, prior) * self.weigh(candidates, prior)
+    def update(self, candidates: np.ndarray, prior: np.ndarray, gate: float | None = None) -> np.ndarray:
+        """Propose (within ``gate`` mm, default ``candidate_gate``), weigh, estimate, resample;
+        returns the estimate (mm)."""
+        w = self.propose(candidates, prior, gate) * self.weigh(candidates, prior)
         w = w / w.sum()
         est = (self.particles[:, :3] * w[:, None]).sum(0)
         idx = systematic_resample(w, len(w), self.rng)

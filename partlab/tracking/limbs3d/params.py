@@ -105,6 +105,16 @@ class Limbs3DPriors:
     # of the lines of sight of two different limbs, priors.suppress_ghosts; our addition): its
     # prior is scaled by this (0 drops it, 1 = off)
     ghost_factor: float = number(0.0, FRACTION)
+    # which of the candidates sharing blobs is the ghost (our addition): they claim their blobs in
+    # order of the number of views their pairs span, then of prior * (1 - w + w exp(-d^2 / 2
+    # ghost_anchor^2)), w = ghost_anchor_weight, d the distance (mm) to the nearest tracked
+    # target's prediction: with two views the true pairs and the ghosts of two hands often all have
+    # prior ~1, and the pair the dynamics expect should own its blobs (standing, camera 0 of 3
+    # hidden, seed 0: hands 150-220 mm off on ghosts -> 34 mm). A small weight, a tie-breaker: with
+    # 1 a false pair the filter sat on kept out-ranking the true one that came back 250 mm away
+    # (standing seed 5, 3 cameras: left hand 22 -> 56 mm). 0 = by prior alone (before 2026-12-03)
+    ghost_anchor: float = number(150.0)
+    ghost_anchor_weight: float = number(0.1, FRACTION)
     # the kept candidate moves to the prior-weighted mean of those it absorbs (the paper keeps the
     # stronger point; the mean of the pairs of 3-4 cameras is a better estimate of the centre)
     merge_average: bool = flag(True)
@@ -131,6 +141,13 @@ class Limbs3DDynamics:
     # faster than the dynamics expect is not left behind; their weights are eq. 17's like any other
     candidate_mix: float = number(0.3, FRACTION)
     candidate_gate: float = number(250.0, POSITIVE)
+    # the gate grows by this fraction of itself per frame in a row the target had no confidence
+    # (up to states.lost_frames; our addition): a clapping hand whose candidates vanished for one
+    # frame is ~270 mm from its next one (standing seed 5, camera 0 of 3 hidden: lost at 69). Off
+    # (0): 0.5 (2026-12-03, seeds 0-9) loses no target with a camera hidden at 3 cameras (standing
+    # 1 -> 0 lost) and moves the 3-camera handshake 78.8 -> 76.7 mm, but the 4-camera one 69.9 ->
+    # 71.5 and the 2-camera one 91.4 -> 91.7 mm with one more swap
+    gate_growth: float = number(0.0)
     # the dynamics' density in the importance weights f / q is a mixture: (1 - jump_mix) the
     # predicted cloud's Gaussian, jump_mix one jump_scale times wider (our addition). A clap starts
     # in 2-3 frames (a hand at ~3 m/s, 120 mm a frame): with the Gaussian alone the filter fell
@@ -155,6 +172,13 @@ class Limbs3DDynamics:
     # tracked but never bring a lost one back (one view cannot tell its depth). 0 = off
     single_view_prior: float = number(0.2, FRACTION)
     single_view_gate: float = number(100.0, POSITIVE)
+    # the gate when only one view sees skin blobs at all (a camera of two hidden): nothing can be
+    # triangulated, every target is single-view and a hand that starts a clap (~150 mm a frame)
+    # leaves the 100 mm gate in one frame, is lost and held there (2026-12-03: camera 0 of 2
+    # hidden for 30 frames, seeds 0-9, targets lost standing 14 -> 2, seated 8 -> 0). Wider for
+    # every frame was worse with two views left (seated 3 cameras, camera 0 hidden: lost 0 -> 2
+    # with 150 or 250 mm): a hand whose pair merged with the other's for a frame took a wrong blob
+    single_view_gate_alone: float = number(250.0, POSITIVE)
     # a single-view candidate's depth (our addition): a hand that no other view sees as a blob is
     # hidden there, so it lies where its line of sight projects onto a silhouette (within this
     # many pixels) in every other view that sees people; of those points of the line (within

@@ -139,13 +139,17 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
 
 
 def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams,
-                    blobs: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    blobs: np.ndarray | None = None,
+                    anchors: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Drop candidates below ``prior_threshold`` or outside the room, then merge close ones (sec.
     6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
     ``merge_boost`` times its prior to the one that absorbs it (capped at 1). With ``blobs (C, 2)``
     (each candidate's two blobs as view-blob keys, see :func:`blob_keys`), a merged candidate all
-    of whose blobs are already used by stronger ones is a ghost (:func:`suppress_ghosts`).
-    Returns ``points (K, 3)`` and ``prior (K,)``, strongest first."""
+    of whose blobs are already used by stronger ones is a ghost (:func:`suppress_ghosts`); with
+    ``anchors (T, 3)`` (the tracked targets' predictions), "stronger" is by prior times nearness to
+    the nearest prediction (``priors.ghost_anchor``), after the number of views a candidate's
+    pairs span (a point seen by three views outranks a pair of two). Returns ``points (K, 3)``
+    and ``prior (K,)``, strongest first."""
     keep = (prior >= params.priors.prior_threshold) & np.isfinite(points).all(axis=1)
     keep &= (points[:, 2] > 0) & (points[:, 2] < params.priors.max_height)
     pts, pr = points[keep], prior[keep]
@@ -173,28 +177,50 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
         out_w.append(value)
         if keys is not None:
             out_k.append(set(keys[idx].ravel().tolist()))
-    if not out_p:
-        return np.zeros((0, 3)), np.zeros(0)
-    out_p, out_w = np.array(out_p), np.array(out_w)
-    if keys is not None and params.priors.ghost_factor < 1:
-        out_p, out_w = suppress_ghosts(out_p, out_w, out_k, params.priors.ghost_factor)
+    out_p, out_w = np.array(out_p).reshape(-1, 3), np.array(out_w)
+    if not out_k:
+        out_k = [set() for _ in out_w]
+    if keys is not None and params.priors.ghost_factor < 1 and len(out_w):
+        out_p, out_w, _ = suppress_ghosts(out_p, out_w, out_k, params.priors.ghost_factor,
+                                          _ghost_rank(out_p, out_w, out_k, params, anchors))
     return out_p, out_w
+
+
+def _ghost_rank(points: np.ndarray, prior: np.ndarray, members: list[set], params: Limbs3DParams,
+                anchors: np.ndarray | None) -> np.ndarray:
+    """The order in which merged candidates claim their blobs (:func:`suppress_ghosts`): by prior,
+    or with ``anchors`` by the number of views, then prior times nearness to a prediction."""
+    if anchors is None or not len(anchors) or params.priors.ghost_anchor <= 0:
+        return prior
+    d = np.linalg.norm(points[:, None] - np.asarray(anchors, float).reshape(-1, 3)[None], axis=-1).min(axis=1)
+    views = np.array([len({k // _VIEW_KEY for k in m}) for m in members], float)
+    w = params.priors.ghost_anchor_weight
+    return views + prior * (1 - w + w * np.exp(-0.5 * (d / params.priors.ghost_anchor) ** 2))
 
 
 def blob_keys(views: np.ndarray, blobs: np.ndarray) -> np.ndarray:
     """``(C, 2)`` integer keys of each candidate's two blobs (view and blob index in one number)."""
-    return np.asarray(views, np.int64) * 100000 + np.asarray(blobs, np.int64)
+    return np.asarray(views, np.int64) * _VIEW_KEY + np.asarray(blobs, np.int64)
 
 
-def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], factor: float):
+_VIEW_KEY = 100000
+
+
+def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], factor: float,
+                    rank: np.ndarray | None = None):
     """Every skin blob is the image of one head or hand (our addition, not the paper's): from the
     strongest merged candidate down, one whose blobs (``members``: the view-blob keys of the pairs
     it merged) are all already used by stronger candidates is a ghost, the crossing of two lines of
     sight through two different limbs (a left hand in one view paired with the right hand in
     another), and its prior is scaled by ``factor`` (0 drops it). A true point seen by three views
     merges three pairs and owns blobs no other point uses; two hands that are one blob in one view
-    still each own their blobs in the other views. Returns points and priors, strongest first."""
-    order = np.argsort(-prior, kind="stable")
+    still each own their blobs in the other views. ``rank`` (default the prior) orders the
+    candidates. With two views, a ghost pair and a true pair can have the same prior (both 1): the
+    order then picks one of two crossings of the same four blobs, and ranked by prior alone a
+    clapping hand's true pairs were dropped for ghosts 200 mm away (standing seed 0 with camera 0
+    of 3 hidden); ranked by nearness to the targets' predictions as well, the pair the dynamics
+    expect owns its blobs first. Returns points, priors and members, strongest first."""
+    order = np.argsort(-(prior if rank is None else rank), kind="stable")
     used: set = set()
     value = prior.copy()
     for i in order:
@@ -202,7 +228,6 @@ def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], f
             value[i] *= factor
         else:
             used |= members[i]
-    keep = value >= 1e-9
-    points, value = points[keep], value[keep]
-    order = np.argsort(-value, kind="stable")
-    return points[order], value[order]
+    keep = np.flatnonzero(value >= 1e-9)
+    order = keep[np.argsort(-value[keep], kind="stable")]
+    return points[order], value[order], [members[i] for i in order]

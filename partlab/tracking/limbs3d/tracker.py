@@ -61,6 +61,7 @@ class _Target:
     position: np.ndarray | None = None
     labelled: bool = True
     waiting: int = 0  # frames an automatically started target has waited for a label
+    missed: int = 0  # frames in a row without confidence (dynamics.gate_growth)
     history: list = field(default_factory=list)
 
 
@@ -206,10 +207,13 @@ class Limbs3DTracker:
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
-    def candidates(self, centres, views):
+    def candidates(self, centres, views, anchors: np.ndarray | None = None):
+        """Merged candidates ``(K, 3)`` and their priors; ``anchors``: the tracked targets'
+        predictions, which decide which of the pairs sharing blobs are ghosts."""
         cands = pair_candidates(self.cameras, centres)
         prior, raw = candidate_prior(cands, self.cameras, views, self.params)
-        points, weights = prune_and_merge(cands.points, prior.value, self.params, blob_keys(cands.views, cands.blobs))
+        points, weights = prune_and_merge(cands.points, prior.value, self.params, blob_keys(cands.views, cands.blobs),
+                                          anchors)
         self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights}
         return points, weights
 
@@ -218,7 +222,6 @@ class Limbs3DTracker:
         p = self.params
         index = frames.index
         centres, views = self.observe(frames, foreground)
-        points, weights = self.candidates(centres, views)
         m = self.machine
         # targets whose init frame is now come alive
         for key, t in self.targets.items():
@@ -237,11 +240,12 @@ class Limbs3DTracker:
         # exclusive use of candidates: each goes to the nearest predicted target (a combined pair
         # counts as one), unless it is about as near to several
         preds = np.array([self.targets[k].filter.estimate for k in active]).reshape(-1, 3)
+        lost = np.array([m.state(k) == LimbState.LOST for k in active], bool)
+        points, weights = self.candidates(centres, views, preds[~lost])
         if len(points) and len(active):
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
-        lost = np.array([m.state(k) == LimbState.LOST for k in active], bool)
         for a, k in enumerate(active):
             t = self.targets[k]
             rivals = self._rivals(a, lost)
@@ -249,12 +253,14 @@ class Limbs3DTracker:
             mine = self._usable(t, points, None if few else dist[:, a], None if few else dist[:, rivals],
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
+            gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
             if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
-                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < p.dynamics.candidate_gate).any()):
+                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
                 single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
                 use = np.vstack([use.reshape(-1, 3), single])
                 use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
-            est = t.filter.update(use, use_w)
+            est = t.filter.update(use, use_w, gate)
+            t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
             else:
@@ -294,23 +300,22 @@ class Limbs3DTracker:
                      views: list | None = None) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
         ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
-        within ``single_view_gate`` mm that is nearer to it than to every other target's projection
-        (``others (M, 3)``), at the point of the blob's line of sight nearest ``pred`` (with
-        ``dynamics.single_view_support`` and ``views``, the silhouette measures of every view, the
-        nearest such point hidden by a silhouette in every other view, :meth:`_hidden_depth`)."""
+        within ``single_view_gate`` mm (``single_view_gate_alone`` when only one view has blobs)
+        that is nearer to it than to every other target's projection (``others (M, 3)``), at the
+        point of the blob's line of sight nearest ``pred`` (with ``dynamics.single_view_support``
+        and ``views``, the silhouette measures of every view, the nearest such point hidden by a
+        silhouette in every other view, :meth:`_hidden_depth`)."""
         out = []
         for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
             cen = np.asarray(cen, float).reshape(-1, 2)
             depth = cam.to_camera(pred[None])[0, 2]
             if not len(cen) or depth <= 0:
                 continue
-            uv = cam.project(pred[None])[0]
-            d = np.linalg.norm(cen - uv, axis=1)
-            if len(others):
-                d_other = np.linalg.norm(cen[:, None] - cam.project(others)[None], axis=-1).min(axis=1)
-                d = np.where(d < d_other, d, np.inf)
-            j = int(np.argmin(d))
-            if d[j] > cam.K[0, 0] * self.params.dynamics.single_view_gate / depth:
+            gate = self.params.dynamics.single_view_gate
+            if sum(len(c) > 0 for c in centres) < 2:  # one view sees skin: nothing is triangulated
+                gate = max(gate, self.params.dynamics.single_view_gate_alone)
+            j = self._single_view_blob(cam, pred, cen, others, cam.K[0, 0] * gate / depth)
+            if j < 0:
                 continue
             v = cam.rays(cen[j:j + 1])[0]
             s = float(v @ (pred - cam.centre))
@@ -318,6 +323,19 @@ class Limbs3DTracker:
                 s = self._hidden_depth(m, v, s, views)
             out.append(cam.centre + v * s)
         return np.array(out).reshape(-1, 3)
+
+    @staticmethod
+    def _single_view_blob(cam: Camera, pred: np.ndarray, cen: np.ndarray, others: np.ndarray, gate: float) -> int:
+        """The blob (index, -1 for none) of ``cen (K, 2)`` a target predicted at ``pred`` takes in one
+        view: the nearest its projection within ``gate`` pixels that is nearer to it than to every
+        other target's projection."""
+        dist = np.linalg.norm(cen - cam.project(pred[None])[0], axis=1)
+        mine = dist
+        if len(others):
+            d_other = np.linalg.norm(cen[:, None] - cam.project(others)[None], axis=-1).min(axis=1)
+            mine = np.where(dist < d_other, dist, np.inf)
+        j = int(np.argmin(mine))
+        return j if mine[j] <= gate else -1
 
     def _hidden_depth(self, m: int, v: np.ndarray, s: float, views: list) -> float:
         """The distance along view ``m``'s line of sight ``v`` (from its centre), within
