@@ -185,4 +185,29 @@ def run(args) -> int:
     env["PARTLAB_JOBS"] = args.jobs
     if args.scheduler:
         env["PARTLAB_SCHEDULER"] = args.scheduler
-    return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=env)
+    try:
+        return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=env)
+    finally:
+        said = job_service_note() if args.jobs == "engine" and not args.scheduler else None
+        if said:
+            print(said, flush=True)
+
+
+def job_service_note() -> str | None:
+    """What the user should know when the server stops: partlab's local job service (started on
+    the first job, :mod:`partlab.engine.service`) keeps running, with any queued or running job;
+    None when there is none."""
+    import json
+
+    from partlab.engine import jobs
+
+    path = jobs.service_file()
+    try:
+        known = json.loads(path.read_text(encoding="utf-8"))
+        pid = int(known["pid"])
+        if not jobs.reachable(known["address"]):
+            return None
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return (f"partlab app: the job service (pid {pid}) keeps running, with any job still queued or running; "
+            f"the next `partlab app` uses it again. To stop it: kill {pid}")

@@ -60,7 +60,7 @@ def service_file() -> Path:
     return data_dir() / "engine.json"
 
 
-def _reachable(address: str, timeout: float = 1.0) -> bool:
+def reachable(address: str, timeout: float = 1.0) -> bool:
     host_port = address.split("://", 1)[-1]
     host, _, port = host_port.rpartition(":")
     try:
@@ -78,7 +78,7 @@ def scheduler_address(workers: int | None = None, wait: float = 120.0) -> str:
     path = service_file()
     try:
         known = json.loads(path.read_text(encoding="utf-8"))
-        if _reachable(known["address"]):
+        if reachable(known["address"]):
             return known["address"]
     except (OSError, ValueError, KeyError):
         pass

@@ -73,3 +73,21 @@ def test_a_page_on_another_host_cannot_drive_the_app(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=30)
+
+
+def test_when_the_server_stops_it_says_the_job_service_runs_on_and_how_to_stop_it(tmp_path, monkeypatch):
+    import json
+    import socket
+
+    from partlab.commands.app import job_service_note
+    from partlab.engine import jobs
+
+    assert job_service_note() is None  # no job was ever run: nothing left behind
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen()
+        port = listener.getsockname()[1]
+        jobs.service_file().write_text(json.dumps({"address": f"tcp://127.0.0.1:{port}", "pid": 4242}))
+        said = job_service_note()
+        assert "keeps running" in said and said.endswith("kill 4242")
+    assert job_service_note() is None  # its address no longer answers: it has stopped
