@@ -113,7 +113,8 @@ class PartFilter:
 
     def _weigh_by_surround(self) -> None:
         """The background-weighted target (``appearance.surround``): bins common in the ring
-        around the person count less, ``v_u = min(o* / o_u, 1)``; renormalised per channel."""
+        around the person count less, ``v_u = max(min(o* / o_u, 1), surround_floor)``; renormalised
+        per channel."""
         if self.surround is None or not self.weighted:
             return
         b = self.params.appearance.bins_per_channel

@@ -231,11 +231,7 @@ class BodyTracker:
         filters = {}
         around = None
         if self.params.appearance.surround > 0:  # the ring around the person (background-weighted models)
-            person_box = boxes.get("person")
-            if person_box is None:
-                person_box = parts[self.parts[0]]
-                for n in self.parts[1:]:
-                    person_box = person_box.union_box(parts[n])
+            person_box = boxes.get("person") or minimum_bounding_rectangle(parts[n] for n in self.parts)
             around = surround_counts(ycc, person_box, self.params.appearance.surround)
         for name in self.parts:
             b = parts[name].clip(W, H)
