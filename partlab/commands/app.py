@@ -197,17 +197,14 @@ def job_service_note() -> str | None:
     """What the user should know when the server stops: partlab's local job service (started on
     the first job, :mod:`partlab.engine.service`) keeps running, with any queued or running job;
     None when there is none."""
-    import json
-
     from partlab.engine import jobs
 
-    path = jobs.service_file()
+    known = jobs.running_service()
+    if known is None:
+        return None
     try:
-        known = json.loads(path.read_text(encoding="utf-8"))
         pid = int(known["pid"])
-        if not jobs.reachable(known["address"]):
-            return None
-    except (OSError, ValueError, KeyError, TypeError):
+    except (KeyError, TypeError, ValueError):
         return None
     return (f"partlab app: the job service (pid {pid}) keeps running, with any job still queued or running; "
             f"the next `partlab app` uses it again. To stop it: kill {pid}")

@@ -60,7 +60,7 @@ def service_file() -> Path:
     return data_dir() / "engine.json"
 
 
-def reachable(address: str, timeout: float = 1.0) -> bool:
+def _reachable(address: str, timeout: float = 1.0) -> bool:
     host_port = address.split("://", 1)[-1]
     host, _, port = host_port.rpartition(":")
     try:
@@ -70,18 +70,25 @@ def reachable(address: str, timeout: float = 1.0) -> bool:
         return False
 
 
+def running_service() -> dict | None:
+    """The local service's address file (``address``, ``pid``, ...) when its scheduler answers;
+    None when none was started or it has stopped."""
+    try:
+        known = json.loads(service_file().read_text(encoding="utf-8"))
+        return known if _reachable(known["address"]) else None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+
+
 def scheduler_address(workers: int | None = None, wait: float = 120.0) -> str:
     """The scheduler jobs go to: ``PARTLAB_SCHEDULER``, or the local service (started if needed)."""
     given = os.environ.get("PARTLAB_SCHEDULER")
     if given:
         return given
+    known = running_service()
+    if known is not None:
+        return known["address"]
     path = service_file()
-    try:
-        known = json.loads(path.read_text(encoding="utf-8"))
-        if reachable(known["address"]):
-            return known["address"]
-    except (OSError, ValueError, KeyError):
-        pass
     workers = workers or int(os.environ.get("PARTLAB_WORKERS", "0") or 0) or (os.cpu_count() or 1)
     path.unlink(missing_ok=True)
     log = path.with_suffix(".log")
