@@ -30,6 +30,7 @@ from collections import deque
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
+import cv2
 import numpy as np
 
 from partlab.tracking.body.cue import DetectionCue
@@ -160,6 +161,21 @@ def _support(mask: np.ndarray, box: Box) -> float:
     return float((region > 0).mean()) if region.size else 0.0
 
 
+def _supports(mask: np.ndarray, states: np.ndarray) -> np.ndarray:
+    """Share of foreground pixels in each of ``states``' boxes ``(N, >=4)`` (centre, size), by
+    one integral image."""
+    H, W = mask.shape[:2]
+    ii = cv2.integral((mask > 0).astype(np.uint8))
+    s = np.asarray(states, dtype=np.float64)
+    x1 = np.clip(np.round(s[:, 0] - s[:, 2] / 2), 0, W).astype(int)
+    x2 = np.clip(np.round(s[:, 0] + s[:, 2] / 2), 0, W).astype(int)
+    y1 = np.clip(np.round(s[:, 1] - s[:, 3] / 2), 0, H).astype(int)
+    y2 = np.clip(np.round(s[:, 1] + s[:, 3] / 2), 0, H).astype(int)
+    area = (x2 - x1) * (y2 - y1)
+    inside = ii[y2, x2] - ii[y1, x2] - ii[y2, x1] + ii[y1, x1]
+    return np.where(area > 0, inside / np.maximum(area, 1), 0.0)
+
+
 def _overlap_fraction(a: Box, b: Box) -> float:
     """Share of ``a``'s area covered by ``b``."""
     return a.intersection(b) / a.area if a.area > 0 else 0.0
@@ -197,8 +213,10 @@ class BodyTracker:
         self._ycc = LazyYcc()
         self.cue = DetectionCue(self) if self.params.detector.enabled else None
         bg = self.params.background
-        self.camera = (CameraMotion(MotionSettings(threshold=bg.camera_motion, hold=bg.camera_hold))
+        self.camera = (CameraMotion(MotionSettings(threshold=bg.camera_motion, hold=bg.camera_hold,
+                                                   residual=bg.camera_residual))
                        if bg.camera_motion > 0 else None)
+        self.moving_mask: np.ndarray | None = None  # while the camera moves: what moves in the scene
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -315,6 +333,7 @@ class BodyTracker:
         self.frame_size = (W, H)
         self.frames_seen += 1
         mask = self._follow_camera(frame, foreground)
+        support = mask if mask is not None else self.moving_mask  # foreground support of tracks
         moving = self.camera is not None and self.camera.moving
         new_ids = set()
         if self.pending:
@@ -336,7 +355,7 @@ class BodyTracker:
                 f.predict()
         for person in active:
             self._update_person_occlusion(person)
-            self._measure(person, ycc, mask)
+            self._measure(person, ycc, support)
         self._resolve_inter_person_occlusion(active)
 
         if not self.whole:
@@ -346,7 +365,7 @@ class BodyTracker:
         for person in active:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
                 person.centres.append((index, *person.box().centre))
-        self._end_tracks(active, mask, W, H, index)
+        self._end_tracks(active, support, W, H, index)
         if self.cue is not None:
             self.cue.step(index, frame, ycc, mask)
         if self.auto and mask is not None and (self.cue is None or self.params.detector.blob_starts):
@@ -376,6 +395,7 @@ class BodyTracker:
         if self.camera is None:
             return foreground
         self.camera.update(frame)
+        self.moving_mask = self.camera.moving_mask() if self.camera.moving else None
         return None if self.camera.moving else foreground
 
     def _detect_failures(self, active: list[Person], ycc, mask: np.ndarray | None) -> None:
@@ -470,7 +490,7 @@ class BodyTracker:
             if not visible:
                 self._probe_hidden(person, ycc)
 
-    def _probe_anchor(self, person: Person, ycc: np.ndarray):
+    def _probe_anchor(self, person: Person, ycc: np.ndarray, mask: np.ndarray | None = None):
         """The person's torso (or only part) model searched for around its state: ``(filter,
         state, box)`` of a clear match (similarity at least ``release_similarity`` within
         ``release_search`` widths), or None."""
@@ -478,7 +498,14 @@ class BodyTracker:
         if p.occlusion.release_similarity <= 0:
             return None
         f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
-        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]))
+        spread = p.occlusion.release_search * float(f.state[2])
+        if mask is None:
+            state, rho = f.probe(ycc, spread)
+        else:  # only where something moves: a still object of the same colours is not the person
+            cand = f.candidates(spread)
+            sims = f.similarities(ycc, cand) * (_supports(mask, cand) >= 2 * p.detection.support_min)
+            k = int(np.argmax(sims))
+            state, rho = cand[k].astype(np.float64), float(sims[k])
         if rho < p.occlusion.release_similarity:
             return None
         return f, state, Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
@@ -503,7 +530,7 @@ class BodyTracker:
         for near the coasting prediction by the torso's model; a clear match (similarity at least
         ``release_similarity``) on foreground brings every part there and ends the loss."""
         p = self.params
-        probed = self._probe_anchor(person, ycc)
+        probed = self._probe_anchor(person, ycc, mask if self._rewinds(mask) else None)
         if probed is None:
             return
         f, state, found = probed
@@ -632,7 +659,8 @@ class BodyTracker:
                 continue
             if mask is None or person.occluded_by is not None or person.hidden_parts:
                 continue
-            if not self.auto and (not p.detection.end_init_tracks or self.frames_seen < p.background.warmup):
+            learning = self.frames_seen < p.background.warmup and mask is not self.moving_mask  # MOG2 warming up
+            if not self.auto and (not p.detection.end_init_tracks or learning):
                 continue
             if person.lost_since is not None:
                 if (index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames
@@ -656,14 +684,38 @@ class BodyTracker:
                     # more ghost and duplicate tracks (seed 1: 24 -> 29 tracks, MOTA 0.25 -> 0.06)
                     del self.people[person.track_id]
                     continue
-                # lost: from now on every part coasts on the person's recent velocity
-                person.lost_since = index - p.detection.lost_frames + 1
-                v = person.velocity()
-                for f in person.filters.values():
-                    f.set_velocity(v if v is not None else np.zeros(2))
+                self._go_lost(person, index, mask)
         for q in list(self.people.values()):
             if q.occluded_by is not None and q.occluded_by not in self.people:
                 q.occluded_by = None
+
+    def _go_lost(self, person: Person, index: int, mask: np.ndarray) -> None:
+        """From now on every part coasts on the person's recent velocity."""
+        person.lost_since = index - self.params.detection.lost_frames + 1
+        v = self._rewind(person, index) if self._rewinds(mask) else person.velocity()
+        for f in person.filters.values():
+            f.set_velocity(v if v is not None else np.zeros(2))
+
+    def _rewinds(self, mask: np.ndarray | None) -> bool:
+        """``background.camera_rewind`` applies: the support is the moving camera's scene motion."""
+        return self.params.background.camera_rewind and mask is not None and mask is self.moving_mask
+
+    def _rewind(self, person: Person, index: int) -> np.ndarray:
+        """``background.camera_rewind``: a person that just went lost coasts on from where it was
+        when its support went (frame ``lost_since``), at the velocity it had up to then (zero
+        when too few frames tell), rather than from wherever the frames since took it (a still
+        object of its colours). Moves every part there; returns the velocity."""
+        before = [c for c in person.centres if c[0] < person.lost_since]
+        v = np.zeros(2)
+        if len(before) >= 3:
+            c = np.asarray(before, dtype=np.float64)
+            v = np.median(np.diff(c[:, 1:], axis=0) / np.diff(c[:, 0])[:, None], axis=0)
+        if before:
+            frame, cx, cy = before[-1]
+            delta = np.array([cx, cy]) + v * (index - frame) - np.array(person.box().centre)
+            for f in person.filters.values():
+                f.shift(delta)
+        return v
 
     def finish(self, records: list[TrackRecord]) -> list[TrackRecord]:
         """The records without those of tracks that went lost and never came back (written while

@@ -14,6 +14,12 @@ median 48 px net shift over 25 frames of a static camera.) Measured per frame, f
 PETS09-S2L1 (static) at most 0.02, OTB Crossing (static) at most 0.14, OTB Human3 (panning) median
 2.1. ``moving`` says the shift reached ``threshold`` in one of the last ``hold`` frames: after a pan
 stops, the background model still holds the old view until it relearns the scene.
+
+While the camera moves, :meth:`CameraMotion.moving_mask` stands in for the foreground: the grey
+frame against the previous one shifted by the global shift (blurred, thresholded, closed), so what
+moves in the scene shows and what the pan only carries along does not. On OTB Human3 (panning) it
+covers a median 0.55 of the walker's box (0.15 at least, behind a sign) and 0.04 of a litter bin a
+track had taken for him; 0.03 of the whole frame.
 """
 
 from __future__ import annotations
@@ -36,6 +42,9 @@ class MotionSettings:
     grid: tuple[int, int] = (12, 10)
     threshold: float = 0.5
     hold: int = 60
+    residual: float = 0.0   # grey levels a pixel must change by to move in the scene (0: no moving_mask)
+    blur: int = 5           # Gaussian blur (pixels) before the difference: sub-pixel shifts, JPEG noise
+    close: int = 9          # closing (pixels) of the moving pixels into bodies
 
 
 class CameraMotion:
@@ -48,6 +57,8 @@ class CameraMotion:
         self._scale = 1.0
         self.since_motion: int | None = None  # frames since the last camera motion (None: never)
         self.shift = np.zeros(2)
+        self._frames: tuple[np.ndarray | None, np.ndarray | None] = (None, None)  # previous, current
+        self._greys: dict[int, np.ndarray] = {}
 
     def _small(self, frame: np.ndarray) -> np.ndarray:
         H, W = frame.shape[:2]
@@ -65,6 +76,9 @@ class CameraMotion:
         return np.stack([xs.ravel(), ys.ravel()], axis=1).astype(np.float32).reshape(-1, 1, 2)
 
     def update(self, frame: np.ndarray) -> np.ndarray:
+        if self.s.residual > 0:  # kept for moving_mask (grey only when asked)
+            self._frames = (self._frames[1], frame)
+            self._greys = {k: v for k, v in self._greys.items() if k == id(self._frames[0])}
         small = self._small(frame)
         shift = np.zeros(2)
         if self._prev is not None and self._prev.shape == small.shape:
@@ -85,3 +99,28 @@ class CameraMotion:
     def moving(self) -> bool:
         """The camera moved in one of the last ``hold`` frames."""
         return self.since_motion is not None and self.since_motion < self.s.hold
+
+    def _grey(self, frame: np.ndarray) -> np.ndarray:
+        key = id(frame)
+        if key not in self._greys:
+            grey = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+            k = self.s.blur | 1
+            self._greys[key] = cv2.GaussianBlur(grey, (k, k), 0) if k > 1 else grey
+        return self._greys[key]
+
+    def moving_mask(self) -> np.ndarray | None:
+        """``(H, W) uint8``, 255 where the last frame differs by more than ``residual`` grey levels
+        from the one before shifted by the camera's shift: what moves in the scene. None when
+        ``residual`` is 0 or there is no previous frame of the same size."""
+        before, now = self._frames
+        if self.s.residual <= 0 or before is None or before.shape != now.shape:
+            return None
+        g0, g1 = self._grey(before), self._grey(now)
+        H, W = g1.shape
+        M = np.float32([[1, 0, self.shift[0]], [0, 1, self.shift[1]]])
+        carried = cv2.warpAffine(g0, M, (W, H), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        _, mask = cv2.threshold(cv2.absdiff(g1, carried), self.s.residual, 255, cv2.THRESH_BINARY)
+        if self.s.close >= 2:
+            mask = cv2.morphologyEx(mask, cv2.MORPH_CLOSE,
+                                    cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (self.s.close, self.s.close)))
+        return mask
