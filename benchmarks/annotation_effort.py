@@ -67,14 +67,15 @@ def load_frames(folder: Path, stop: int | None = None) -> tuple[list[np.ndarray]
     return [cv2.imread(str(f)) for f in files], 25.0
 
 
-def measure(truth: pd.DataFrame, proposals: pd.DataFrame, keyframes: int) -> dict:
-    """Person rate over truth boxes, MOTA, IDF1 and edits/100 of person ``proposals``."""
+def measure(truth: pd.DataFrame, proposals: pd.DataFrame, keyframes: int, matching: str = "auto") -> dict:
+    """Person rate over truth boxes, MOTA, IDF1 and edits/100 of person ``proposals``; ``matching``
+    as :func:`partlab.labelling.evaluation.evaluate`'s ("id" for runs whose ids are the truth's)."""
     props = proposals[proposals["part"] == "person"]
     edits = count_edits(truth, props, "person", keyframes=keyframes)
     row = {"edits/100": edits.per_100, "moved": edits.moved, "drawn": edits.drawn, "deleted": edits.deleted}
     if props.empty:
         return {**row, "rate": 0.0, "mota": float("nan"), "idf1": 0.0, "tracks": 0}
-    rep = evaluate(truth, props, hota=False)
+    rep = evaluate(truth, props, hota=False, matching=matching)
     c, r = rep.counts["person"], rep.rates["person"]
     row["rate"] = float((r * c).sum() / max(c.sum(), 1))
     row["mota"] = float(rep.mot.loc["person", "mota"])
@@ -153,9 +154,9 @@ def clip_table(name: str, take, truth: pd.DataFrame, seeds, auto: bool, keys, ho
                 props.to_csv(SAVE[0] / f"{name}_{label.replace(' ', '_')}_seed{seed}.csv", index=False)
             rows.append({"clip": name, "method": label, "seed": seed, "ms/frame": 1000 * spf,
                          "cpu ms/frame": 1000 * CPU[-1],
-                         **measure(truth, props, n)})
+                         **measure(truth, props, n, "auto" if kind in ("auto", "hog_sort") else "id")})
             if part_truth is not None and kind == "init":
-                rep = evaluate(part_truth, props, hota=False)
+                rep = evaluate(part_truth, props, hota=False, matching="id")
                 for part in PART_RATES:
                     rows[-1][f"{part}@105"] = rep.rate_at(part)
                     rows[-1][f"{part}@105 n"] = int(rep.counts[part].get(105, 0)) if part in rep.counts else 0
@@ -230,7 +231,8 @@ def parameter_changes(settings: list[str]):
         if not sep:
             raise SystemExit(f"--set {item!r}: expected GROUP.FIELD=VALUE")
         try:
-            changes[key.strip()] = json.loads(value)
+            value = json.loads(value)
+            changes[key.strip()] = tuple(value) if isinstance(value, list) else value  # pairs, boxes
         except json.JSONDecodeError:
             changes[key.strip()] = value
     return BodyParams().updated(changes)

@@ -333,3 +333,18 @@ def test_the_person_box_sides_without_the_head():
         assert at.loc["person", "x"] == pytest.approx(left)
         assert at.loc["person", "x"] + at.loc["person", "w"] == pytest.approx((body["x"] + body["w"]).max())
         assert at.loc["person", "y"] == pytest.approx(at.loc["head", "y"])
+
+
+def test_a_track_started_from_a_drawn_box_writes_that_box_on_its_first_frame():
+    """The box a person drew (--init) is the proposal on its own frame, to the pixel; later frames
+    are the tracker's (the decomposed parts' box). Automatic starts write the tracker's box."""
+    frames, truths = _scene(n=6)
+    drawn = truths[0][1]["person"]
+    given = Box(drawn.x - 3, drawn.y - 2, drawn.w + 9, drawn.h + 4)  # a loose box, as people draw
+    init = pd.DataFrame([dict(frame=0, track_id=1, part="person", x=given.x, y=given.y, w=given.w, h=given.h)])
+    tracks = _run(BodyTracker(BodyParams(), np.random.default_rng(0), init=init), frames)
+    person = tracks[(tracks.track_id == 1) & (tracks.part == "person")].set_index("frame")
+    assert tuple(person.loc[0, ["x", "y", "w", "h"]]) == pytest.approx(given.as_tuple())
+    assert person.loc[0, "state"] == "init"
+    later = Box(*person.loc[1, ["x", "y", "w", "h"]])
+    assert later.w < given.w - 4  # the tracker's own box from the next frame on

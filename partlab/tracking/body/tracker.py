@@ -112,6 +112,7 @@ class Person:
     layout: dict[str, tuple] = field(default_factory=dict)  # parts in the person box at its first detection
     coast_start: int | None = None          # first frame of the coasting stretch it is in (lost or occluded)
     at_border: int | None = None            # last supported frame its box was at a border, not moving away
+    given: dict[str, Box] = field(default_factory=dict)  # boxes it was started from (--init, keyframes), as drawn
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -270,7 +271,7 @@ class BodyTracker:
             start = self.pending[tid]
             if start.frame <= index:
                 del self.pending[tid]
-                self.start_track(tid, start.boxes, ycc, mask, index)
+                self.start_track(tid, start.boxes, ycc, mask, index).given = dict(start.boxes)
 
     def _detect(self, index: int, frame: np.ndarray, ycc, mask) -> None:
         """Start tracks on person-size blobs of the foreground no tracked person covers, once
@@ -774,12 +775,14 @@ class BodyTracker:
                 state = "tracked"
             scores = [person.scores.get(n, 1.0) for n in person.filters]
             boxes = {name: self.report_box(name, f.box) for name, f in person.filters.items()}
+            drawn = person.given if tid in new_ids else {}  # on its first frame a given track is what was drawn
+            boxes.update({name: b for name, b in drawn.items() if name in boxes})
             if not self.whole:
                 mbr = minimum_bounding_rectangle(boxes.values())
                 if not self.params.output.head_sets_sides and "head" in boxes:
                     body = minimum_bounding_rectangle(b for n, b in boxes.items() if n != "head")
                     mbr = Box(body.x, mbr.y, body.w, mbr.h)
-                whole_box = self.report_person(mbr)
+                whole_box = drawn.get("person") or self.report_person(mbr)
                 out.append(TrackRecord(index, tid, "person", whole_box, float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
