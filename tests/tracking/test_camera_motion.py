@@ -134,3 +134,31 @@ def test_a_track_a_still_figure_took_while_the_camera_panned_comes_back_to_the_w
         assert _torso_right_after_the_sign(BodyParams(), frames, truths, seed) >= 0.9
     blind = BodyParams().updated({"background.camera_residual": 0.0})
     assert _torso_right_after_the_sign(blind, frames, truths, 0) < 0.3
+
+
+def test_while_the_camera_pans_people_are_looked_for_where_the_scene_moves():
+    """Found automatically, a panning camera gave nobody: the detector scanned only the foreground
+    mask's regions, which a moving camera does not have. Now it scans the regions where the scene
+    moves (``moving_mask``): here the walker's."""
+    frames, truths = _panning_scene(n=40)
+    tracker = BodyTracker(BodyParams(), np.random.default_rng(0))
+    scanned = []
+    detect = tracker.cue.detector.detect
+
+    def recording(frame, regions):
+        scanned.append((len(scanned), list(regions)))
+        return detect(frame, regions)
+
+    tracker.cue.detector.detect = recording
+    from partlab.tracking.core.background import BackgroundModel
+
+    model = BackgroundModel(tracker.params)
+    seen = []
+    for i, f in enumerate(frames):
+        n = len(scanned)
+        tracker.step(i, f, model.apply(f))
+        if len(scanned) > n and i >= 3:
+            walker = truths[i]["person"]
+            seen.append(any(r.intersection(walker) >= 0.5 * walker.area for r in scanned[-1][1]))
+    assert tracker.camera.moving and len(seen) >= 10
+    assert np.mean(seen) >= 0.8

@@ -94,8 +94,12 @@ class DetectionCue:
         self.scans = 0
         self.detections = np.zeros((0, 5))
 
-    def step(self, index: int, frame: np.ndarray, ycc, mask: np.ndarray | None) -> None:
-        """One frame: scan (every ``every`` frames), then assign, re-acquire, start and end."""
+    def step(self, index: int, frame: np.ndarray, ycc, mask: np.ndarray | None,
+             scan: np.ndarray | None = None) -> None:
+        """One frame: scan (every ``every`` frames), then assign, re-acquire, start and end.
+        ``scan``: where things move when there is no foreground ``mask`` (a moving camera's
+        :meth:`~partlab.tracking.core.camera_motion.CameraMotion.moving_mask`): its regions are
+        scanned too, so people are found while the camera pans."""
         t = self.tracker
         for tid, person in t.people.items():
             self.last_match.setdefault(tid, person.started)
@@ -104,7 +108,7 @@ class DetectionCue:
         self.scans += 1
         people = [t.people[k] for k in sorted(t.people)]
         boxes = [t._reported_person_box(q) for q in people]
-        regions = _blob_regions(mask, self.p.min_region_height) + boxes
+        regions = _blob_regions(mask if mask is not None else scan, self.p.min_region_height) + boxes
         dets = self.detector.detect(frame, regions)
         self.detections = dets
         track_boxes = np.array([b.as_tuple() for b in boxes]).reshape(-1, 4)

@@ -368,7 +368,7 @@ class BodyTracker:
                 person.centres.append((index, *person.box().centre))
         self._end_tracks(active, support, W, H, index)
         if self.cue is not None:
-            self.cue.step(index, frame, ycc, mask)
+            self.cue.step(index, frame, ycc, mask, scan=self.moving_mask if self.auto else None)
         if self.auto and mask is not None and (self.cue is None or self.params.detector.blob_starts):
             self._detect(index, frame, ycc, mask)
         self._note_coasting(index, new_ids)
