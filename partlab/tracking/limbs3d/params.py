@@ -185,6 +185,8 @@ class Limbs3DDynamics:
     # single_view_depth mm of the prediction's), the one nearest the prediction, so the hand hidden
     # behind its own body is not pushed off it along the line. 0 = the point nearest the prediction
     single_view_support: float = number(0.0)
+    # LINE OF SIGHT DOC
+    line_of_sight: bool = flag(True)
     single_view_depth: float = number(600.0, POSITIVE)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,

@@ -40,6 +40,7 @@ from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.priors import (
+    _VIEW_KEY,
     blob_keys,
     candidate_prior,
     observe_view,
@@ -62,6 +63,13 @@ class _Target:
     labelled: bool = True
     waiting: int = 0  # frames an automatically started target has waited for a label
     missed: int = 0  # frames in a row without confidence (dynamics.gate_growth)
+    # a candidate on the lines of sight of its single-view blobs (dynamics.line_of_sight): where it
+    # was last frame and for how many frames in a row one has been there
+    sight: np.ndarray | None = None
+    sight_frames: int = 0
+    # its position minus its person's head's when it was last tracked from pairs of views with no
+    # other target near (dynamics.line_of_sight: where a hand seen by one view goes back to)
+    home: np.ndarray | None = None
     history: list = field(default_factory=list)
 
 
@@ -204,6 +212,7 @@ class Limbs3DTracker:
             centres.append(blobs.centres)
             views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
                                       either=p.priors.fragment_either))
+        self._centres = centres
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
@@ -212,9 +221,10 @@ class Limbs3DTracker:
         predictions, which decide which of the pairs sharing blobs are ghosts."""
         cands = pair_candidates(self.cameras, centres)
         prior, raw = candidate_prior(cands, self.cameras, views, self.params)
-        points, weights = prune_and_merge(cands.points, prior.value, self.params, blob_keys(cands.views, cands.blobs),
-                                          anchors)
-        self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights}
+        points, weights, members = prune_and_merge(cands.points, prior.value, self.params,
+                                                   blob_keys(cands.views, cands.blobs), anchors, with_members=True)
+        self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights,
+                     "members": members}
         return points, weights
 
     # -- 3-4. one frame -------------------------------------------------------------------------
@@ -222,11 +232,15 @@ class Limbs3DTracker:
         p = self.params
         index = frames.index
         centres, views = self.observe(frames, foreground)
+        self._sight_modes: list = []  # this frame's modes seen by a single view (_single_view_mode)
         m = self.machine
         # targets whose init frame is now come alive
         for key, t in self.targets.items():
             if t.filter is None and t.start_frame <= index and m.state(key) == LimbState.NORMAL:
                 t.filter = TargetFilter(t.position, p.dynamics, self.rng)
+                head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
+                if head and head[0] is not None:  # an init point is a fix (two views or 3D)
+                    t.home = t.position - head[0]
         active = [k for k, t in self.targets.items() if t.filter is not None and m.is_leader(k)
                   and m.state(k) != LimbState.UNINITIALIZED]
         # predict
@@ -254,12 +268,32 @@ class Limbs3DTracker:
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
             gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
-            if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
+            state = m.state(k)
+            alone_pairs = False
+            if state != LimbState.UNLABELLED and p.dynamics.single_view_prior > 0 and not (
                     len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
                 single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
-                use = np.vstack([use.reshape(-1, 3), single])
-                use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
+                j = -1 if state == LimbState.COMBINED else self._through_own_blob(t, preds[a], centres, points,
+                                                                                  weights, heads.get(t.track_id))
+                if j >= 0:  # another view tells the depth along its line of sight
+                    same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < p.dynamics.candidate_gate
+                    t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
+                else:
+                    t.sight, t.sight_frames = None, 0
+                if j >= 0 and t.sight_frames >= p.states.start_frames:
+                    t.filter.reset(points[j])
+                    use, use_w = points[j:j + 1], weights[j:j + 1]
+                elif state != LimbState.LOST:
+                    use = np.vstack([use.reshape(-1, 3), single])
+                    use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
+            else:
+                t.sight, t.sight_frames = None, 0
+                others = np.delete(preds, a, axis=0)
+                alone_pairs = state == LimbState.NORMAL and t.part != "head" and not (
+                    len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
             est = t.filter.update(use, use_w, gate)
+            if alone_pairs and heads.get(t.track_id) is not None:
+                t.home = est - heads[t.track_id]
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
@@ -267,7 +301,11 @@ class Limbs3DTracker:
                 est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
-                obs["modes"] = self._modes(est, points[mine], weights[mine])
+                idx = np.flatnonzero(mine)
+                obs["modes"] = self._modes(est, points[idx], weights[idx])
+                if len(obs["modes"]) < 2 and p.dynamics.line_of_sight:
+                    obs["modes"] = self._single_view_mode(est, obs["modes"], points[idx], idx, centres,
+                                                          np.delete(preds, a, axis=0))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -277,7 +315,7 @@ class Limbs3DTracker:
         for tr in m.update(index, observations):
             t = self.targets[tr.tracker]
             if tr.new == LimbState.UNLABELLED and tr.reason == "split":
-                t.position = np.asarray(tr.position, float)
+                t.position = self._split_position(t, tr.position, heads.get(t.track_id))
                 if t.filter is None:
                     t.filter = TargetFilter(t.position, p.dynamics, self.rng)
                 else:
@@ -324,6 +362,56 @@ class Limbs3DTracker:
             out.append(cam.centre + v * s)
         return np.array(out).reshape(-1, 3)
 
+    def _through_own_blob(self, t: _Target, pred: np.ndarray, centres: list[np.ndarray], points: np.ndarray,
+                          weights: np.ndarray, head) -> int:
+        """The merged candidate (index, -1 for none) that a target predicted at ``pred`` with no
+        candidate from pairs of views in its gate takes wherever it lies along its line of sight
+        (``dynamics.line_of_sight``): in each view, the blob nearest its projection within
+        ``single_view_gate`` mm (at its depth) is its own, and of the candidates of prior at least
+        ``states.start_prior`` made from one of those and a blob of another view, within
+        ``hand_reach`` of its person's head for a hand, none of whose blobs is another target's
+        image (:meth:`_explained`), the strongest."""
+        d = self.params.dynamics
+        members = self.last.get("members")
+        if not d.line_of_sight or members is None or not len(points):
+            return -1
+        mine = set()
+        for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
+            cen = np.asarray(cen, float).reshape(-1, 2)
+            depth = cam.to_camera(pred[None])[0, 2]
+            if len(cen) and depth > 0:
+                j = self._single_view_blob(cam, pred, cen, np.zeros((0, 3)), cam.K[0, 0] * d.single_view_gate / depth)
+                if j >= 0:
+                    mine.add(int(blob_keys(np.array([m]), np.array([j]))[0]))
+        ok = np.array([bool(mine & ms) for ms in members]) & (weights >= self.params.states.start_prior)
+        if d.hand_reach > 0 and t.part != "head" and head is not None:
+            ok &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        for i in np.flatnonzero(ok):
+            ok[i] = not self._explained(t, points[i], members[i])
+        if not ok.any():
+            return -1
+        return int(np.flatnonzero(ok)[np.argmax(weights[ok])])
+
+    def _explained(self, t: _Target, point: np.ndarray, keys: set) -> bool:
+        """Whether one of the blobs ``keys`` (view-blob keys) is another target's image: the
+        projection nearest it is another target's, whose estimate is more than ``split_distance``
+        from ``point`` (a target there shares the blob: two hands that touch)."""
+        others = [o for o in self.targets.values() if o is not t and o.position is not None and o.filter is not None]
+        if not others:
+            return False
+        pos = np.array([o.position for o in others])
+        far = np.linalg.norm(pos - point, axis=1) > self.params.states.split_distance
+        for key in keys:
+            m, j = divmod(int(key), _VIEW_KEY)
+            cam = self.cameras[m]
+            blob = self._centres[m][j]
+            d_other = np.linalg.norm(cam.project(pos) - blob, axis=1)
+            d_own = np.linalg.norm(cam.project(t.position[None])[0] - blob)
+            i = int(np.argmin(d_other))
+            if d_other[i] < d_own and far[i]:
+                return True
+        return False
+
     @staticmethod
     def _single_view_blob(cam: Camera, pred: np.ndarray, cen: np.ndarray, others: np.ndarray, gate: float) -> int:
         """The blob (index, -1 for none) of ``cen (K, 2)`` a target predicted at ``pred`` takes in one
@@ -367,6 +455,60 @@ class Limbs3DTracker:
         if d.hand_reach > 0 and t.part != "head" and head is not None and len(points):
             use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
         return use
+
+    def _single_view_mode(self, est, modes: tuple, points: np.ndarray, idx: np.ndarray, centres,
+                          others: np.ndarray) -> tuple:
+        """``modes`` (at most one, from pairs of views) and a second one seen by a single view: a
+        combined pair whose hands part where one of them is hidden from all views but one shows
+        one mode of pairs and, in that view, a second blob (``dynamics.line_of_sight``). Of the
+        blobs within ``mode_search`` split distances of the estimate's projection (at its depth),
+        not one of the first mode's and nearer to it than to every other target's projection
+        (``others``), the one whose line of sight passes nearest the estimate, at the point of that
+        line nearest the estimate, if that is ``combine_distance`` or more from the first mode."""
+        p = self.params
+        members = self.last.get("members") or []
+        first = np.asarray(modes[0], float) if modes else np.asarray(est, float)
+        taken: set = set()
+        if modes and len(points):
+            near = idx[int(np.argmin(np.linalg.norm(points - first, axis=1)))]
+            taken = set(members[near]) if near < len(members) else set()
+        best, best_d = None, np.inf
+        for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
+            cen = np.asarray(cen, float).reshape(-1, 2)
+            depth = cam.to_camera(np.asarray(est, float)[None])[0, 2]
+            if not len(cen) or depth <= 0:
+                continue
+            keys = blob_keys(np.full(len(cen), m), np.arange(len(cen)))
+            free = np.array([int(key) not in taken for key in keys])
+            if not free.any():
+                continue
+            gate = cam.K[0, 0] * p.states.mode_search * p.states.split_distance / depth
+            j = self._single_view_blob(cam, np.asarray(est, float), np.where(free[:, None], cen, np.inf), others,
+                                       gate)
+            if j < 0:
+                continue
+            v = cam.rays(cen[j:j + 1])[0]
+            point = cam.centre + v * float(v @ (np.asarray(est, float) - cam.centre))
+            d = float(np.linalg.norm(point - np.asarray(est, float)))
+            if d < best_d and np.linalg.norm(point - first) >= p.states.combine_distance:
+                best, best_d = (point, m, v), d
+        if best is None:
+            return modes
+        self._sight_modes.append((np.asarray(best[0], float), best[1], best[2]))
+        return (tuple(first), tuple(best[0]))
+
+    def _split_position(self, t: _Target, mode, head) -> np.ndarray:
+        """Where a target that leaves a combined pair with ``mode`` starts: the mode, or for the mode
+        seen by a single view (:meth:`_single_view_mode`), the point of its line of sight nearest
+        where the target was, relative to its person's head, when last tracked alone from pairs of
+        views (``home``): one view cannot tell how far back the hand goes, and after a handshake or a
+        clap it goes back where it came from (the direction cue of sec. 7.1 on the depth)."""
+        mode = np.asarray(mode, float)
+        sight = [s for s in self._sight_modes if np.allclose(mode, s[0])]
+        if not sight or t.home is None or head is None:
+            return mode
+        cam, v = self.cameras[sight[0][1]], sight[0][2]
+        return cam.centre + v * float(v @ (np.asarray(head, float) + t.home - cam.centre))
 
     def _modes(self, est, points, weights) -> tuple:
         """The combined posterior's two strongest modes: the strongest candidate near the filter,
