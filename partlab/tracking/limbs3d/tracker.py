@@ -70,6 +70,8 @@ class _Target:
     # its position minus its person's head's when it was last tracked from pairs of views with no
     # other target near (dynamics.line_of_sight: where a hand seen by one view goes back to)
     home: np.ndarray | None = None
+    returning: bool = False  # it left a combined pair and has not been tracked alone from pairs since
+    parting: list = field(default_factory=list)  # distances of a combined pair's single-view mode, frame by frame
     history: list = field(default_factory=list)
 
 
@@ -272,7 +274,9 @@ class Limbs3DTracker:
             alone_pairs = False
             if state != LimbState.UNLABELLED and p.dynamics.single_view_prior > 0 and not (
                     len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
-                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
+                head = heads.get(t.track_id)
+                toward = head + t.home if t.returning and t.home is not None and head is not None else None
+                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward)
                 j = -1 if state == LimbState.COMBINED else self._through_own_blob(t, preds[a], centres, points,
                                                                                   weights, heads.get(t.track_id))
                 if j >= 0:  # another view tells the depth along its line of sight
@@ -293,19 +297,21 @@ class Limbs3DTracker:
                     len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
             est = t.filter.update(use, use_w, gate)
             if alone_pairs and heads.get(t.track_id) is not None:
-                t.home = est - heads[t.track_id]
+                t.home, t.returning = est - heads[t.track_id], False
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
             else:
+                if t.returning and t.home is not None and heads.get(t.track_id) is not None:
+                    t.position = heads[t.track_id] + t.home  # ... or, leaving a pair, where it came from
                 est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
                 idx = np.flatnonzero(mine)
                 obs["modes"] = self._modes(est, points[idx], weights[idx])
                 if len(obs["modes"]) < 2 and p.dynamics.line_of_sight:
-                    obs["modes"] = self._single_view_mode(est, obs["modes"], points[idx], idx, centres,
-                                                          np.delete(preds, a, axis=0))
+                    obs["modes"] = self._parting(t, self._single_view_mode(est, obs["modes"], points[idx], idx,
+                                                                           centres, np.delete(preds, a, axis=0)))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -321,6 +327,7 @@ class Limbs3DTracker:
                 else:
                     t.filter.reset(t.position)
                 t.labelled = True  # the direction cue (sec. 7.1) keeps its label
+                t.returning = True
             elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
                 pass  # the leader's filter tracks both
         return self._records(index)
@@ -335,14 +342,15 @@ class Limbs3DTracker:
         return rivals
 
     def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray,
-                     views: list | None = None) -> np.ndarray:
+                     views: list | None = None, toward: np.ndarray | None = None) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
         ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
         within ``single_view_gate`` mm (``single_view_gate_alone`` when only one view has blobs)
         that is nearer to it than to every other target's projection (``others (M, 3)``), at the
         point of the blob's line of sight nearest ``pred`` (with ``dynamics.single_view_support``
         and ``views``, the silhouette measures of every view, the nearest such point hidden by a
-        silhouette in every other view, :meth:`_hidden_depth`)."""
+        silhouette in every other view, :meth:`_hidden_depth`); with ``toward``, the point of the
+        line nearest that point instead of the prediction."""
         out = []
         for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
             cen = np.asarray(cen, float).reshape(-1, 2)
@@ -356,7 +364,7 @@ class Limbs3DTracker:
             if j < 0:
                 continue
             v = cam.rays(cen[j:j + 1])[0]
-            s = float(v @ (pred - cam.centre))
+            s = float(v @ ((pred if toward is None else toward) - cam.centre))
             if self.params.dynamics.single_view_support > 0 and views is not None:
                 s = self._hidden_depth(m, v, s, views)
             out.append(cam.centre + v * s)
@@ -496,6 +504,18 @@ class Limbs3DTracker:
             return modes
         self._sight_modes.append((np.asarray(best[0], float), best[1], best[2]))
         return (tuple(first), tuple(best[0]))
+
+    def _parting(self, t: _Target, modes: tuple) -> tuple:
+        """``modes`` with a second one seen by a single view only once it has moved away from the
+        first for ``states.start_frames`` frames in a row (sec. 5.2: the modes "move apart when the
+        targets move away from each other"; a blob of a sleeve or an object next to two hands that
+        touch is one frame's mode and does not move away)."""
+        if len(modes) < 2:
+            t.parting = []
+            return modes
+        d = float(np.linalg.norm(np.subtract(modes[1], modes[0])))
+        t.parting = t.parting + [d] if t.parting and d >= t.parting[-1] else [d]
+        return modes if len(t.parting) >= self.params.states.start_frames else modes[:1]
 
     def _split_position(self, t: _Target, mode, head) -> np.ndarray:
         """Where a target that leaves a combined pair with ``mode`` starts: the mode, or for the mode
