@@ -272,7 +272,9 @@ class Limbs3DTracker:
             gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
             alone_pairs = False
-            if state != LimbState.UNLABELLED and p.dynamics.single_view_prior > 0 and not (
+            single_states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if p.dynamics.line_of_sight \
+                else (LimbState.NORMAL,)
+            if state in single_states and p.dynamics.single_view_prior > 0 and not (
                     len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
                 head = heads.get(t.track_id)
                 toward = head + t.home if t.returning and t.home is not None and head is not None else None
@@ -327,7 +329,7 @@ class Limbs3DTracker:
                 else:
                     t.filter.reset(t.position)
                 t.labelled = True  # the direction cue (sec. 7.1) keeps its label
-                t.returning = True
+                t.returning = p.dynamics.line_of_sight
             elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
                 pass  # the leader's filter tracks both
         return self._records(index)
