@@ -207,6 +207,12 @@ def blob_keys(views: np.ndarray, blobs: np.ndarray) -> np.ndarray:
 _VIEW_KEY = 100000
 
 
+def split_key(key: int) -> tuple[int, int]:
+    """The view and blob index of a key of :func:`blob_keys`."""
+    m, j = divmod(int(key), _VIEW_KEY)
+    return m, j
+
+
 def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], factor: float,
                     rank: np.ndarray | None = None):
     """Every skin blob is the image of one head or hand (our addition, not the paper's): from the

@@ -40,12 +40,12 @@ from partlab.tracking.limbs3d.filter import TargetFilter
 from partlab.tracking.limbs3d.geometry import pair_candidates
 from partlab.tracking.limbs3d.params import Limbs3DParams
 from partlab.tracking.limbs3d.priors import (
-    _VIEW_KEY,
     blob_keys,
     candidate_prior,
     observe_view,
     prune_and_merge,
     silhouette_distance,
+    split_key,
 )
 from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
@@ -236,13 +236,7 @@ class Limbs3DTracker:
         centres, views = self.observe(frames, foreground)
         self._sight_modes: list = []  # this frame's modes seen by a single view (_single_view_mode)
         m = self.machine
-        # targets whose init frame is now come alive
-        for key, t in self.targets.items():
-            if t.filter is None and t.start_frame <= index and m.state(key) == LimbState.NORMAL:
-                t.filter = TargetFilter(t.position, p.dynamics, self.rng)
-                head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
-                if head and head[0] is not None:  # an init point is a fix (two views or 3D)
-                    t.home = t.position - head[0]
+        self._come_alive(index)
         active = [k for k, t in self.targets.items() if t.filter is not None and m.is_leader(k)
                   and m.state(k) != LimbState.UNINITIALIZED]
         # predict
@@ -271,34 +265,10 @@ class Limbs3DTracker:
             use, use_w = points[mine], weights[mine]
             gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
-            alone_pairs = False
-            single_states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if p.dynamics.line_of_sight \
-                else (LimbState.NORMAL,)
-            if state in single_states and p.dynamics.single_view_prior > 0 and not (
-                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
-                head = heads.get(t.track_id)
-                toward = head + t.home if t.returning and t.home is not None and head is not None else None
-                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward)
-                j = -1 if state == LimbState.COMBINED else self._through_own_blob(t, preds[a], centres, points,
-                                                                                  weights, heads.get(t.track_id))
-                if j >= 0:  # another view tells the depth along its line of sight
-                    same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < p.dynamics.candidate_gate
-                    t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
-                else:
-                    t.sight, t.sight_frames = None, 0
-                if j >= 0 and t.sight_frames >= p.states.start_frames:
-                    t.filter.reset(points[j])
-                    use, use_w = points[j:j + 1], weights[j:j + 1]
-                elif state != LimbState.LOST:
-                    use = np.vstack([use.reshape(-1, 3), single])
-                    use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
-            else:
-                t.sight, t.sight_frames = None, 0
-                others = np.delete(preds, a, axis=0)
-                alone_pairs = state == LimbState.NORMAL and t.part != "head" and not (
-                    len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
+            use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
+                                                    weights, heads.get(t.track_id))
             est = t.filter.update(use, use_w, gate)
-            if alone_pairs and heads.get(t.track_id) is not None:
+            if alone and heads.get(t.track_id) is not None:
                 t.home, t.returning = est - heads[t.track_id], False
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
@@ -309,11 +279,8 @@ class Limbs3DTracker:
                 est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
-                idx = np.flatnonzero(mine)
-                obs["modes"] = self._modes(est, points[idx], weights[idx])
-                if len(obs["modes"]) < 2 and p.dynamics.line_of_sight:
-                    obs["modes"] = self._parting(t, self._single_view_mode(est, obs["modes"], points[idx], idx,
-                                                                           centres, np.delete(preds, a, axis=0)))
+                obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
+                                                    np.delete(preds, a, axis=0))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -323,16 +290,63 @@ class Limbs3DTracker:
         for tr in m.update(index, observations):
             t = self.targets[tr.tracker]
             if tr.new == LimbState.UNLABELLED and tr.reason == "split":
-                t.position = self._split_position(t, tr.position, heads.get(t.track_id))
-                if t.filter is None:
-                    t.filter = TargetFilter(t.position, p.dynamics, self.rng)
-                else:
-                    t.filter.reset(t.position)
-                t.labelled = True  # the direction cue (sec. 7.1) keeps its label
-                t.returning = p.dynamics.line_of_sight
-            elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
-                pass  # the leader's filter tracks both
+                self._split(t, tr.position, heads.get(t.track_id))
+            # (a target that becomes combined and is not its pair's leader: the leader's filter tracks both)
         return self._records(index)
+
+    def _come_alive(self, index: int) -> None:
+        """Targets whose init frame is ``index`` get their filter (and their ``home``: an init point
+        is a fix, from two views or in 3D)."""
+        for key, t in self.targets.items():
+            if t.filter is None and t.start_frame <= index and self.machine.state(key) == LimbState.NORMAL:
+                t.filter = TargetFilter(t.position, self.params.dynamics, self.rng)
+                head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
+                if head and head[0] is not None:
+                    t.home = t.position - head[0]
+
+    def _split(self, t: _Target, mode, head) -> None:
+        """``t`` leaves its combined pair with ``mode`` (:meth:`_split_position`)."""
+        t.position = self._split_position(t, mode, head)
+        if t.filter is None:
+            t.filter = TargetFilter(t.position, self.params.dynamics, self.rng)
+        else:
+            t.filter.reset(t.position)
+        t.labelled = True  # the direction cue (sec. 7.1) keeps its label
+        t.returning = self.params.dynamics.line_of_sight
+
+    def _without_pairs(self, t: _Target, state: LimbState, a: int, use: np.ndarray, use_w: np.ndarray, gate: float,
+                       preds: np.ndarray, centres: list, views: list, points: np.ndarray, weights: np.ndarray,
+                       head) -> tuple[np.ndarray, np.ndarray, bool]:
+        """The candidates (and priors) target ``t`` (``a``: its index in ``preds``) is weighed with,
+        from ``use``: with no candidate from pairs of views within ``gate`` of its prediction, its
+        single-view candidates (``dynamics.single_view_prior``), or, with ``dynamics.line_of_sight``,
+        the candidate on its line of sight another view gives it (:meth:`_through_own_blob`, the
+        filter put there); also whether it is tracked alone from pairs of views (its ``home``)."""
+        p = self.params
+        d = p.dynamics
+        states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if d.line_of_sight else (LimbState.NORMAL,)
+        if not (state in states and d.single_view_prior > 0) or (
+                len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
+            t.sight, t.sight_frames = None, 0
+            others = np.delete(preds, a, axis=0)
+            alone = state == LimbState.NORMAL and t.part != "head" and len(use) > 0 and not (
+                len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
+            return use, use_w, alone
+        toward = head + t.home if t.returning and t.home is not None and head is not None else None
+        single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward)
+        j = -1 if state == LimbState.COMBINED else self._through_own_blob(t, preds[a], centres, points, weights, head)
+        if j >= 0:  # another view tells the depth along its line of sight
+            same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < d.candidate_gate
+            t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
+            if t.sight_frames >= p.states.start_frames:
+                t.filter.reset(points[j])
+                return points[j:j + 1], weights[j:j + 1], False
+        else:
+            t.sight, t.sight_frames = None, 0
+        if state == LimbState.LOST:
+            return use, use_w, False
+        return (np.vstack([use.reshape(-1, 3), single]),
+                np.concatenate([use_w, np.full(len(single), d.single_view_prior)]), False)
 
     def _rivals(self, a: int, lost: np.ndarray) -> np.ndarray:
         """The active targets (indices) whose predictions compete with target ``a``'s for candidates:
@@ -412,7 +426,7 @@ class Limbs3DTracker:
         pos = np.array([o.position for o in others])
         far = np.linalg.norm(pos - point, axis=1) > self.params.states.split_distance
         for key in keys:
-            m, j = divmod(int(key), _VIEW_KEY)
+            m, j = split_key(key)
             cam = self.cameras[m]
             blob = self._centres[m][j]
             d_other = np.linalg.norm(cam.project(pos) - blob, axis=1)
@@ -506,6 +520,17 @@ class Limbs3DTracker:
             return modes
         self._sight_modes.append((np.asarray(best[0], float), best[1], best[2]))
         return (tuple(first), tuple(best[0]))
+
+    def _combined_modes(self, t: _Target, est, idx: np.ndarray, points: np.ndarray, weights: np.ndarray, centres,
+                        others: np.ndarray) -> tuple:
+        """The modes of combined target ``t`` (the pair's leader) from the candidates ``idx`` it may
+        use (:meth:`_modes`) and, with ``dynamics.line_of_sight`` and one mode of pairs, a second
+        seen by a single view once it parts (:meth:`_single_view_mode`, :meth:`_parting`)."""
+        modes = self._modes(est, points[idx], weights[idx])
+        if len(modes) >= 2 or not self.params.dynamics.line_of_sight:
+            t.parting = []
+            return modes
+        return self._parting(t, self._single_view_mode(est, modes, points[idx], idx, centres, others))
 
     def _parting(self, t: _Target, modes: tuple) -> tuple:
         """``modes`` with a second one seen by a single view only once it has moved away from the
