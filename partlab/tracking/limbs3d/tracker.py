@@ -67,6 +67,10 @@ class _Target:
     # was last frame and for how many frames in a row one has been there
     sight: np.ndarray | None = None
     sight_frames: int = 0
+    alone_frames: int = 0  # frames in a row with no candidate from pairs of views in its gate
+    # while so: per view, where its own blob (nearer its projection than any other target's) was
+    # last seen and the frame (the blob a hand seen by one view follows, dynamics.line_of_sight)
+    own: dict = field(default_factory=dict)
     # its position minus its person's head's when it was last tracked from pairs of views with no
     # other target near (dynamics.line_of_sight: where a hand seen by one view goes back to)
     home: np.ndarray | None = None
@@ -327,14 +331,21 @@ class Limbs3DTracker:
         states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if d.line_of_sight else (LimbState.NORMAL,)
         if not (state in states and d.single_view_prior > 0) or (
                 len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
-            t.sight, t.sight_frames = None, 0
+            t.sight, t.sight_frames, t.alone_frames, t.own = None, 0, 0, {}
             others = np.delete(preds, a, axis=0)
             alone = state == LimbState.NORMAL and t.part != "head" and len(use) > 0 and not (
                 len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
             return use, use_w, alone
         toward = head + t.home if t.returning and t.home is not None and head is not None else None
-        single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward)
-        j = -1 if state == LimbState.COMBINED else self._through_own_blob(t, preds[a], centres, points, weights, head)
+        picks: dict = {}
+        single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward, picks)
+        t.alone_frames += 1
+        t.own = {m: (uv, age + 1) for m, (uv, age) in t.own.items() if age < p.states.lost_frames}
+        t.own.update({m: (uv, 0) for m, uv in picks.items()})
+        j = -1  # a target that just lost its pairs is not yet one seen by a single view (two hands that
+        # part: the other's blob is nearest its projection)
+        if state != LimbState.COMBINED and t.part != "head" and t.alone_frames > p.states.lost_frames:
+            j = self._through_own_blob(t, preds[a], centres, points, weights, head)
         if j >= 0:  # another view tells the depth along its line of sight
             same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < d.candidate_gate
             t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
@@ -358,7 +369,8 @@ class Limbs3DTracker:
         return rivals
 
     def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray,
-                     views: list | None = None, toward: np.ndarray | None = None) -> np.ndarray:
+                     views: list | None = None, toward: np.ndarray | None = None,
+                     picks: dict | None = None) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
         ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
         within ``single_view_gate`` mm (``single_view_gate_alone`` when only one view has blobs)
@@ -366,7 +378,8 @@ class Limbs3DTracker:
         point of the blob's line of sight nearest ``pred`` (with ``dynamics.single_view_support``
         and ``views``, the silhouette measures of every view, the nearest such point hidden by a
         silhouette in every other view, :meth:`_hidden_depth`); with ``toward``, the point of the
-        line nearest that point instead of the prediction."""
+        line nearest that point instead of the prediction; ``picks`` gets each view's blob taken
+        (view -> its centre)."""
         out = []
         for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
             cen = np.asarray(cen, float).reshape(-1, 2)
@@ -379,6 +392,8 @@ class Limbs3DTracker:
             j = self._single_view_blob(cam, pred, cen, others, cam.K[0, 0] * gate / depth)
             if j < 0:
                 continue
+            if picks is not None:
+                picks[m] = cen[j].copy()
             v = cam.rays(cen[j:j + 1])[0]
             s = float(v @ ((pred if toward is None else toward) - cam.centre))
             if self.params.dynamics.single_view_support > 0 and views is not None:
@@ -390,8 +405,10 @@ class Limbs3DTracker:
                           weights: np.ndarray, head) -> int:
         """The merged candidate (index, -1 for none) that a target predicted at ``pred`` with no
         candidate from pairs of views in its gate takes wherever it lies along its line of sight
-        (``dynamics.line_of_sight``): in each view, the blob nearest its projection within
-        ``single_view_gate`` mm (at its depth) is its own, and of the candidates of prior at least
+        (``dynamics.line_of_sight``): in each view, the blob nearest where its own blob was last seen
+        (``own``, up to ``states.lost_frames`` frames ago) within ``single_view_gate`` mm (at its
+        depth) is its own (two hands that touch make one blob, nearer the other's projection), and
+        of the candidates of prior at least
         ``states.start_prior`` made from one of those and a blob of another view, within
         ``hand_reach`` of its person's head for a hand, none of whose blobs is another target's
         image (:meth:`_explained`), the strongest."""
@@ -400,12 +417,13 @@ class Limbs3DTracker:
         if not d.line_of_sight or members is None or not len(points):
             return -1
         mine = set()
-        for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
-            cen = np.asarray(cen, float).reshape(-1, 2)
+        for m, (uv, _) in t.own.items():
+            cam, cen = self.cameras[m], np.asarray(centres[m], float).reshape(-1, 2)
             depth = cam.to_camera(pred[None])[0, 2]
             if len(cen) and depth > 0:
-                j = self._single_view_blob(cam, pred, cen, np.zeros((0, 3)), cam.K[0, 0] * d.single_view_gate / depth)
-                if j >= 0:
+                dist = np.linalg.norm(cen - uv, axis=1)
+                j = int(np.argmin(dist))
+                if dist[j] <= cam.K[0, 0] * d.single_view_gate / depth:
                     mine.add(int(blob_keys(np.array([m]), np.array([j]))[0]))
         ok = np.array([bool(mine & ms) for ms in members]) & (weights >= self.params.states.start_prior)
         if d.hand_reach > 0 and t.part != "head" and head is not None:
@@ -418,13 +436,16 @@ class Limbs3DTracker:
 
     def _explained(self, t: _Target, point: np.ndarray, keys: set) -> bool:
         """Whether one of the blobs ``keys`` (view-blob keys) is another target's image: the
-        projection nearest it is another target's, whose estimate is more than ``split_distance``
-        from ``point`` (a target there shares the blob: two hands that touch)."""
+        projection nearest it is another target's, of the same person or whose estimate is more
+        than ``split_distance`` from ``point`` (another person's hand there shares the blob: two
+        people's hands that touch; a person's two hands on one line of sight in one view do not
+        tell that they touch: handshake seed 7, 3 cameras, the right hand went to the left's)."""
         others = [o for o in self.targets.values() if o is not t and o.position is not None and o.filter is not None]
         if not others:
             return False
         pos = np.array([o.position for o in others])
         far = np.linalg.norm(pos - point, axis=1) > self.params.states.split_distance
+        far |= np.array([o.track_id == t.track_id for o in others])
         for key in keys:
             m, j = split_key(key)
             cam = self.cameras[m]
