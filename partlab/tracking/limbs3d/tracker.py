@@ -316,7 +316,14 @@ class Limbs3DTracker:
         else:
             t.filter.reset(t.position)
         t.labelled = True  # the direction cue (sec. 7.1) keeps its label
-        t.returning = self.params.dynamics.line_of_sight
+        t.returning = self._line_of_sight
+
+    @property
+    def _line_of_sight(self) -> bool:
+        """``dynamics.line_of_sight``, with three views or more: with two, ``p_b`` says nothing (a
+        pair's projections lie on both silhouettes by construction), a pair through a hand's blob is
+        anybody's, and the 2-camera handshake got worse (docs/measurements/limbs3d.md)."""
+        return self.params.dynamics.line_of_sight and len(self.cameras) >= 3
 
     def _without_pairs(self, t: _Target, state: LimbState, a: int, use: np.ndarray, use_w: np.ndarray, gate: float,
                        preds: np.ndarray, centres: list, views: list, points: np.ndarray, weights: np.ndarray,
@@ -328,7 +335,7 @@ class Limbs3DTracker:
         filter put there); also whether it is tracked alone from pairs of views (its ``home``)."""
         p = self.params
         d = p.dynamics
-        states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if d.line_of_sight else (LimbState.NORMAL,)
+        states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if self._line_of_sight else (LimbState.NORMAL,)
         if not (state in states and d.single_view_prior > 0) or (
                 len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
             t.sight, t.sight_frames, t.alone_frames, t.own = None, 0, 0, {}
@@ -414,7 +421,7 @@ class Limbs3DTracker:
         image (:meth:`_explained`), the strongest."""
         d = self.params.dynamics
         members = self.last.get("members")
-        if not d.line_of_sight or members is None or not len(points):
+        if not self._line_of_sight or members is None or not len(points):
             return -1
         mine = set()
         for m, (uv, _) in t.own.items():
@@ -548,7 +555,7 @@ class Limbs3DTracker:
         use (:meth:`_modes`) and, with ``dynamics.line_of_sight`` and one mode of pairs, a second
         seen by a single view once it parts (:meth:`_single_view_mode`, :meth:`_parting`)."""
         modes = self._modes(est, points[idx], weights[idx])
-        if len(modes) >= 2 or not self.params.dynamics.line_of_sight:
+        if len(modes) >= 2 or not self._line_of_sight:
             t.parting = []
             return modes
         return self._parting(t, self._single_view_mode(est, modes, points[idx], idx, centres, others))
