@@ -332,7 +332,7 @@ def test_the_hand_seen_by_one_camera_meets_the_other_in_a_handshake():
     of the two touching hands went to the other's, nearer, prediction). With ``dynamics.line_of_sight``
     it takes the candidate another view makes with the blob it follows, the two combine, and the
     tracked hands are within the recognition's contact distance (135 mm) during the grasp."""
-    scene = make_multiview_scene("handshake", 3, seed=SEED, n_frames=FRAMES)
+    scene = make_multiview_scene("handshake", 3, seed=3, n_frames=50)
     before = _handshake_distance(scene, Limbs3DParams().updated({"dynamics.line_of_sight": False}))
     after = _handshake_distance(scene, Limbs3DParams())
     assert np.median(before) > 300  # main before the change: apart all along

@@ -352,7 +352,7 @@ class Limbs3DTracker:
         j = -1  # a target that just lost its pairs is not yet one seen by a single view (two hands that
         # part: the other's blob is nearest its projection)
         if state != LimbState.COMBINED and t.part != "head" and t.alone_frames > p.states.lost_frames:
-            j = self._through_own_blob(t, preds[a], centres, points, weights, head)
+            j = self._through_own_blob(t, preds[a], centres, points, weights, head, state != LimbState.LOST)
         if j >= 0:  # another view tells the depth along its line of sight
             same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < d.candidate_gate
             t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
@@ -409,7 +409,7 @@ class Limbs3DTracker:
         return np.array(out).reshape(-1, 3)
 
     def _through_own_blob(self, t: _Target, pred: np.ndarray, centres: list[np.ndarray], points: np.ndarray,
-                          weights: np.ndarray, head) -> int:
+                          weights: np.ndarray, head, share: bool = True) -> int:
         """The merged candidate (index, -1 for none) that a target predicted at ``pred`` with no
         candidate from pairs of views in its gate takes wherever it lies along its line of sight
         (``dynamics.line_of_sight``): in each view, the blob nearest where its own blob was last seen
@@ -418,7 +418,8 @@ class Limbs3DTracker:
         of the candidates of prior at least
         ``states.start_prior`` made from one of those and a blob of another view, within
         ``hand_reach`` of its person's head for a hand, none of whose blobs is another target's
-        image (:meth:`_explained`), the strongest."""
+        image (:meth:`_explained`; for a lost one, ``share`` False, none shared with anybody), the
+        strongest."""
         d = self.params.dynamics
         members = self.last.get("members")
         if not self._line_of_sight or members is None or not len(points):
@@ -436,23 +437,24 @@ class Limbs3DTracker:
         if d.hand_reach > 0 and t.part != "head" and head is not None:
             ok &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
         for i in np.flatnonzero(ok):
-            ok[i] = not self._explained(t, points[i], members[i])
+            ok[i] = not self._explained(t, points[i], members[i], share)
         if not ok.any():
             return -1
         return int(np.flatnonzero(ok)[np.argmax(weights[ok])])
 
-    def _explained(self, t: _Target, point: np.ndarray, keys: set) -> bool:
+    def _explained(self, t: _Target, point: np.ndarray, keys: set, share: bool = True) -> bool:
         """Whether one of the blobs ``keys`` (view-blob keys) is another target's image: the
         projection nearest it is another target's, of the same person or whose estimate is more
         than ``split_distance`` from ``point`` (another person's hand there shares the blob: two
         people's hands that touch; a person's two hands on one line of sight in one view do not
-        tell that they touch: handshake seed 7, 3 cameras, the right hand went to the left's)."""
+        tell that they touch: handshake seed 7, 3 cameras, the right hand went to the left's).
+        ``share`` False (a lost target): no blob is shared."""
         others = [o for o in self.targets.values() if o is not t and o.position is not None and o.filter is not None]
         if not others:
             return False
         pos = np.array([o.position for o in others])
         far = np.linalg.norm(pos - point, axis=1) > self.params.states.split_distance
-        far |= np.array([o.track_id == t.track_id for o in others])
+        far |= np.array([o.track_id == t.track_id or not share for o in others])
         for key in keys:
             m, j = split_key(key)
             cam = self.cameras[m]
