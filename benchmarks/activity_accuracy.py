@@ -16,7 +16,7 @@ tracker's (what the recognition gets right when the hands are right); ``--hands 
 which separates the recognition's errors from the hand tracker's.
 
     python benchmarks/activity_accuracy.py [--seeds 0-9] [--size 720x480] [--frames 150] [--hands tracked|truth|both]
-                                           [--cameras 3]
+                                           [--cameras 3] [--set GROUP.NAME=VALUE ...]
 """
 
 from __future__ import annotations
@@ -78,8 +78,10 @@ class TruthHands:
         return records_to_frame(records)
 
 
-def run_take(name: str, seed: int, frames: int, cameras: int, hands: str) -> tuple[pd.DataFrame, pd.DataFrame, float]:
-    """One 3-camera take (640x480, in memory): activities from limbs3d's heads and hands, or the truth's."""
+def run_take(name: str, seed: int, frames: int, cameras: int, hands: str,
+             changes: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
+    """One 3-camera take (640x480, in memory): activities from limbs3d's heads and hands (its
+    parameters with ``changes``, ``{"group.field": value}``), or the truth's."""
     from partlab.labelling.synth.multiview import make_multiview_scene
     from partlab.tracking.activities import with_activities
     from partlab.tracking.frame import Frame
@@ -92,13 +94,22 @@ def run_take(name: str, seed: int, frames: int, cameras: int, hands: str) -> tup
     else:
         from partlab.tracking.limbs3d.tracker import Limbs3DTracker
 
-        inner = Limbs3DTracker(model_params(None, "limbs3d"), np.random.default_rng(seed), cams, init=scene.init,
+        limbs3d = model_params(None, "limbs3d")
+        if changes:
+            limbs3d = limbs3d.updated({k: _value(limbs3d.get(k), v) for k, v in changes.items()})
+        inner = Limbs3DTracker(limbs3d, np.random.default_rng(seed), cams, init=scene.init,
                                backgrounds=scene.backgrounds)
         tracker = with_activities(inner, params)
     t0 = time.perf_counter()
     sets = (FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}) for i in range(frames))
     run_frames(tracker, sets, None)
     return scene.events, tracker.events, (time.perf_counter() - t0) / frames
+
+
+def _value(default, text: str):
+    if isinstance(default, bool):
+        return text.lower() in ("1", "true", "yes")
+    return type(default)(float(text))
 
 
 def run_one(name: str, seed: int, frames: int, width: int, height: int,
@@ -155,6 +166,9 @@ def main() -> int:
                     help="1: the one-camera activity scenes; 2 or more: the multi-camera takes with limbs3d")
     ap.add_argument("--hands", choices=("tracked", "truth", "both"), default="tracked",
                     help="the hands the recognition reads: the limb tracker's, the scene's truth, or both runs")
+    ap.add_argument("--set", nargs="*", default=[], metavar="GROUP.NAME=VALUE",
+                    help="limbs3d parameters other than the defaults (multi-camera takes; e.g. "
+                         "dynamics.line_of_sight=0)")
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
     for hands in (("tracked", "truth") if args.hands == "both" else (args.hands,)):
@@ -170,7 +184,8 @@ def report(args, w: int, h: int, hands: str) -> None:
             if args.cameras == 1:
                 truth, pred, s = run_one(name, seed, args.frames, w, h, hands)
             else:
-                truth, pred, s = run_take(name, seed, args.frames, args.cameras, hands)
+                truth, pred, s = run_take(name, seed, args.frames, args.cameras, hands,
+                                          dict(a.split("=", 1) for a in args.set))
             spf.append(s)
             truth = truth.assign(clip=f"{name}/{seed}")
             pred = pred.assign(clip=f"{name}/{seed}")

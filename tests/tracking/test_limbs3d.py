@@ -307,3 +307,33 @@ def test_a_wider_gate_lets_the_filter_reach_a_candidate_beyond_the_default_one()
 
     assert reach(None) < 40  # 10 mm of the 270: the particles only diffuse towards it
     assert reach(375.0) > 150  # 233 mm: one missed frame with dynamics.gate_growth 0.5
+
+
+def _handshake_distance(scene, params: Limbs3DParams) -> np.ndarray:
+    """The two people's tracked right hands' 3D distance (mm) at every frame of the scene's handshake."""
+    cams = {c.name: c for c in scene.cameras}
+    tr = Limbs3DTracker(params, np.random.default_rng(0), cams, init=scene.init, backgrounds=scene.backgrounds)
+    recs = []
+    for i in range(len(scene.frames["cam0"])):
+        recs += tr.step(FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}),
+                        {c: None for c in cams})
+    pos = tr.table(recs).drop_duplicates(["frame", "track_id", "part"]).set_index(["frame", "track_id", "part"])
+    ev = scene.events[scene.events["kind"] == "handshake"].iloc[0]
+    frames = range(int(ev.start_frame), int(ev.end_frame) + 1)
+    a = pos.reindex([(f, 1, "right_hand") for f in frames])[["X", "Y", "Z"]].to_numpy(float)
+    b = pos.reindex([(f, 2, "right_hand") for f in frames])[["X", "Y", "Z"]].to_numpy(float)
+    return np.linalg.norm(a - b, axis=1)
+
+
+def test_the_hand_seen_by_one_camera_meets_the_other_in_a_handshake():
+    """Handshake, 3 cameras: one person's right hand, in front of its own body, is seen by one camera
+    only while it reaches out, mostly along that camera's line of sight, so its depth stays where it
+    was (before 2026-12-03 it ended ~450 mm behind and never met the other hand: the one candidate
+    of the two touching hands went to the other's, nearer, prediction). With ``dynamics.line_of_sight``
+    it takes the candidate another view makes with the blob it follows, the two combine, and the
+    tracked hands are within the recognition's contact distance (135 mm) during the grasp."""
+    scene = make_multiview_scene("handshake", 3, seed=3, n_frames=50)
+    before = _handshake_distance(scene, Limbs3DParams().updated({"dynamics.line_of_sight": False}))
+    after = _handshake_distance(scene, Limbs3DParams())
+    assert np.median(before) > 300  # main before the change: apart all along
+    assert np.median(after) < 60 and (after < 135).mean() > 0.8

@@ -185,6 +185,21 @@ class Limbs3DDynamics:
     # single_view_depth mm of the prediction's), the one nearest the prediction, so the hand hidden
     # behind its own body is not pushed off it along the line. 0 = the point nearest the prediction
     single_view_support: float = number(0.0)
+    # a hand seen by one view has the depth another view tells (our addition; the paper calls such
+    # a target lost, sec. 5.2, and finds it again from "prior information of the target position",
+    # here its line of sight; with three views or more): a hand with no pair candidate in its gate
+    # for more than states.lost_frames frames takes, once one has been there states.start_frames
+    # frames in a row, a candidate of prior >= states.start_prior made from the blob it follows in
+    # one view and another view's blob, none of whose blobs is another target's image (a blob is
+    # shared only with another person's hand near the candidate, and not by a lost hand), wherever
+    # it lies along the line. A combined pair with one mode from pairs takes as its second a blob of
+    # one view beside it once that has moved away for start_frames frames (sec. 5.2, the modes
+    # parting); the member given it, and any member of a split pair while seen by one view or lost,
+    # is put on its line of sight (or held) where it was, relative to its head, when last tracked
+    # alone from pairs (hands go back after a handshake). 2026-12-03, docs/measurements/limbs3d.md,
+    # seeds 0-9: handshake 3 cameras 78.8 -> 72.6 mm, hands meet in 0.20 -> 0.63 of the handshake;
+    # 4 cameras 69.9 -> 69.4 mm (0.34 -> 0.46); standing and seated unchanged. False = main before
+    line_of_sight: bool = flag(True)
     single_view_depth: float = number(600.0, POSITIVE)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,

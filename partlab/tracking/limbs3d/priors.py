@@ -140,7 +140,7 @@ def candidate_prior(cands: PairCandidates, cameras: list[Camera], views: list[Vi
 
 def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams,
                     blobs: np.ndarray | None = None,
-                    anchors: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                    anchors: np.ndarray | None = None, with_members: bool = False):
     """Drop candidates below ``prior_threshold`` or outside the room, then merge close ones (sec.
     6.4): strongest first, every weaker candidate within ``merge_distance`` is eliminated and adds
     ``merge_boost`` times its prior to the one that absorbs it (capped at 1). With ``blobs (C, 2)``
@@ -149,7 +149,8 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     ``anchors (T, 3)`` (the tracked targets' predictions), "stronger" is by prior times nearness to
     the nearest prediction (``priors.ghost_anchor``), after the number of views a candidate's
     pairs span (a point seen by three views outranks a pair of two). Returns ``points (K, 3)``
-    and ``prior (K,)``, strongest first."""
+    and ``prior (K,)``, strongest first; ``with_members``: also the view-blob keys each merged
+    candidate's pairs came from (``K`` sets, empty without ``blobs``)."""
     keep = (prior >= params.priors.prior_threshold) & np.isfinite(points).all(axis=1)
     keep &= (points[:, 2] > 0) & (points[:, 2] < params.priors.max_height)
     pts, pr = points[keep], prior[keep]
@@ -181,9 +182,9 @@ def prune_and_merge(points: np.ndarray, prior: np.ndarray, params: Limbs3DParams
     if not out_k:
         out_k = [set() for _ in out_w]
     if keys is not None and params.priors.ghost_factor < 1 and len(out_w):
-        out_p, out_w, _ = suppress_ghosts(out_p, out_w, out_k, params.priors.ghost_factor,
-                                          _ghost_rank(out_p, out_w, out_k, params, anchors))
-    return out_p, out_w
+        out_p, out_w, out_k = suppress_ghosts(out_p, out_w, out_k, params.priors.ghost_factor,
+                                              _ghost_rank(out_p, out_w, out_k, params, anchors))
+    return (out_p, out_w, out_k) if with_members else (out_p, out_w)
 
 
 def _ghost_rank(points: np.ndarray, prior: np.ndarray, members: list[set], params: Limbs3DParams,
@@ -204,6 +205,12 @@ def blob_keys(views: np.ndarray, blobs: np.ndarray) -> np.ndarray:
 
 
 _VIEW_KEY = 100000
+
+
+def split_key(key: int) -> tuple[int, int]:
+    """The view and blob index of a key of :func:`blob_keys`."""
+    m, j = divmod(int(key), _VIEW_KEY)
+    return m, j
 
 
 def suppress_ghosts(points: np.ndarray, prior: np.ndarray, members: list[set], factor: float,

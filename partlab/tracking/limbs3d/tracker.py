@@ -45,6 +45,7 @@ from partlab.tracking.limbs3d.priors import (
     observe_view,
     prune_and_merge,
     silhouette_distance,
+    split_key,
 )
 from partlab.tracking.multiview import triangulate
 from partlab.tracking.tracks import TrackRecord, empty_tracks, records_to_frame
@@ -62,6 +63,19 @@ class _Target:
     labelled: bool = True
     waiting: int = 0  # frames an automatically started target has waited for a label
     missed: int = 0  # frames in a row without confidence (dynamics.gate_growth)
+    # a candidate on the lines of sight of its single-view blobs (dynamics.line_of_sight): where it
+    # was last frame and for how many frames in a row one has been there
+    sight: np.ndarray | None = None
+    sight_frames: int = 0
+    alone_frames: int = 0  # frames in a row with no candidate from pairs of views in its gate
+    # while so: per view, where its own blob (nearer its projection than any other target's) was
+    # last seen and the frame (the blob a hand seen by one view follows, dynamics.line_of_sight)
+    own: dict = field(default_factory=dict)
+    # its position minus its person's head's when it was last tracked from pairs of views with no
+    # other target near (dynamics.line_of_sight: where a hand seen by one view goes back to)
+    home: np.ndarray | None = None
+    returning: bool = False  # it left a combined pair and has not been tracked alone from pairs since
+    parting: list = field(default_factory=list)  # distances of a combined pair's single-view mode, frame by frame
     history: list = field(default_factory=list)
 
 
@@ -204,6 +218,7 @@ class Limbs3DTracker:
             centres.append(blobs.centres)
             views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
                                       either=p.priors.fragment_either))
+        self._centres = centres
         return centres, views
 
     # -- 2. candidates and their priors (sec. 6.3-6.4) -----------------------------------------
@@ -212,9 +227,10 @@ class Limbs3DTracker:
         predictions, which decide which of the pairs sharing blobs are ghosts."""
         cands = pair_candidates(self.cameras, centres)
         prior, raw = candidate_prior(cands, self.cameras, views, self.params)
-        points, weights = prune_and_merge(cands.points, prior.value, self.params, blob_keys(cands.views, cands.blobs),
-                                          anchors)
-        self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights}
+        points, weights, members = prune_and_merge(cands.points, prior.value, self.params,
+                                                   blob_keys(cands.views, cands.blobs), anchors, with_members=True)
+        self.last = {"candidates": cands, "prior": prior, "raw": raw, "points": points, "weights": weights,
+                     "members": members}
         return points, weights
 
     # -- 3-4. one frame -------------------------------------------------------------------------
@@ -222,11 +238,9 @@ class Limbs3DTracker:
         p = self.params
         index = frames.index
         centres, views = self.observe(frames, foreground)
+        self._sight_modes: list = []  # this frame's modes seen by a single view (_single_view_mode)
         m = self.machine
-        # targets whose init frame is now come alive
-        for key, t in self.targets.items():
-            if t.filter is None and t.start_frame <= index and m.state(key) == LimbState.NORMAL:
-                t.filter = TargetFilter(t.position, p.dynamics, self.rng)
+        self._come_alive(index)
         active = [k for k, t in self.targets.items() if t.filter is not None and m.is_leader(k)
                   and m.state(k) != LimbState.UNINITIALIZED]
         # predict
@@ -254,20 +268,23 @@ class Limbs3DTracker:
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
             gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
-            if m.state(k) == LimbState.NORMAL and p.dynamics.single_view_prior > 0 and not (
-                    len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
-                single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views)
-                use = np.vstack([use.reshape(-1, 3), single])
-                use_w = np.concatenate([use_w, np.full(len(single), p.dynamics.single_view_prior)])
+            state = m.state(k)
+            use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
+                                                    weights, heads.get(t.track_id))
             est = t.filter.update(use, use_w, gate)
+            if alone and heads.get(t.track_id) is not None:
+                t.home, t.returning = est - heads[t.track_id], False
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
                 t.position = est  # a lost target stays where it was lost until something is found there
             else:
+                if t.returning and t.home is not None and heads.get(t.track_id) is not None:
+                    t.position = heads[t.track_id] + t.home  # ... or, leaving a pair, where it came from
                 est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
             if m.state(k) == LimbState.COMBINED:
-                obs["modes"] = self._modes(est, points[mine], weights[mine])
+                obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
+                                                    np.delete(preds, a, axis=0))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -277,15 +294,77 @@ class Limbs3DTracker:
         for tr in m.update(index, observations):
             t = self.targets[tr.tracker]
             if tr.new == LimbState.UNLABELLED and tr.reason == "split":
-                t.position = np.asarray(tr.position, float)
-                if t.filter is None:
-                    t.filter = TargetFilter(t.position, p.dynamics, self.rng)
-                else:
-                    t.filter.reset(t.position)
-                t.labelled = True  # the direction cue (sec. 7.1) keeps its label
-            elif tr.new == LimbState.COMBINED and not m.is_leader(tr.tracker):
-                pass  # the leader's filter tracks both
+                self._split(t, tr.position, heads.get(t.track_id))
+            # (a target that becomes combined and is not its pair's leader: the leader's filter tracks both)
         return self._records(index)
+
+    def _come_alive(self, index: int) -> None:
+        """Targets whose init frame is ``index`` get their filter (and their ``home``: an init point
+        is a fix, from two views or in 3D)."""
+        for key, t in self.targets.items():
+            if t.filter is None and t.start_frame <= index and self.machine.state(key) == LimbState.NORMAL:
+                t.filter = TargetFilter(t.position, self.params.dynamics, self.rng)
+                head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
+                if head and head[0] is not None:
+                    t.home = t.position - head[0]
+
+    def _split(self, t: _Target, mode, head) -> None:
+        """``t`` leaves its combined pair with ``mode`` (:meth:`_split_position`)."""
+        t.position = self._split_position(t, mode, head)
+        if t.filter is None:
+            t.filter = TargetFilter(t.position, self.params.dynamics, self.rng)
+        else:
+            t.filter.reset(t.position)
+        t.labelled = True  # the direction cue (sec. 7.1) keeps its label
+        t.returning = self._line_of_sight
+
+    @property
+    def _line_of_sight(self) -> bool:
+        """``dynamics.line_of_sight``, with three views or more: with two, ``p_b`` says nothing (a
+        pair's projections lie on both silhouettes by construction), a pair through a hand's blob is
+        anybody's, and the 2-camera handshake got worse (docs/measurements/limbs3d.md)."""
+        return self.params.dynamics.line_of_sight and len(self.cameras) >= 3
+
+    def _without_pairs(self, t: _Target, state: LimbState, a: int, use: np.ndarray, use_w: np.ndarray, gate: float,
+                       preds: np.ndarray, centres: list, views: list, points: np.ndarray, weights: np.ndarray,
+                       head) -> tuple[np.ndarray, np.ndarray, bool]:
+        """The candidates (and priors) target ``t`` (``a``: its index in ``preds``) is weighed with,
+        from ``use``: with no candidate from pairs of views within ``gate`` of its prediction, its
+        single-view candidates (``dynamics.single_view_prior``), or, with ``dynamics.line_of_sight``,
+        the candidate on its line of sight another view gives it (:meth:`_through_own_blob`, the
+        filter put there); also whether it is tracked alone from pairs of views (its ``home``)."""
+        p = self.params
+        d = p.dynamics
+        states = (LimbState.NORMAL, LimbState.LOST, LimbState.COMBINED) if self._line_of_sight else (LimbState.NORMAL,)
+        if not (state in states and d.single_view_prior > 0) or (
+                len(use) and (np.linalg.norm(use - preds[a], axis=1) < gate).any()):
+            t.sight, t.sight_frames, t.alone_frames, t.own = None, 0, 0, {}
+            others = np.delete(preds, a, axis=0)
+            alone = state == LimbState.NORMAL and t.part != "head" and len(use) > 0 and not (
+                len(others) and np.linalg.norm(others - preds[a], axis=1).min() < p.states.split_distance)
+            return use, use_w, alone
+        toward = head + t.home if t.returning and t.home is not None and head is not None else None
+        picks: dict = {}
+        single = self._single_view(preds[a], centres, np.delete(preds, a, axis=0), views, toward, picks)
+        t.alone_frames += 1
+        t.own = {m: (uv, age + 1) for m, (uv, age) in t.own.items() if age < p.states.lost_frames}
+        t.own.update({m: (uv, 0) for m, uv in picks.items()})
+        j = -1  # a target that just lost its pairs is not yet one seen by a single view (two hands that
+        # part: the other's blob is nearest its projection)
+        if state != LimbState.COMBINED and t.part != "head" and t.alone_frames > p.states.lost_frames:
+            j = self._through_own_blob(t, preds[a], centres, points, weights, head, state != LimbState.LOST)
+        if j >= 0:  # another view tells the depth along its line of sight
+            same = t.sight is not None and np.linalg.norm(points[j] - t.sight) < d.candidate_gate
+            t.sight, t.sight_frames = points[j], (t.sight_frames + 1 if same else 1)
+            if t.sight_frames >= p.states.start_frames:
+                t.filter.reset(points[j])
+                return points[j:j + 1], weights[j:j + 1], False
+        else:
+            t.sight, t.sight_frames = None, 0
+        if state == LimbState.LOST:
+            return use, use_w, False
+        return (np.vstack([use.reshape(-1, 3), single]),
+                np.concatenate([use_w, np.full(len(single), d.single_view_prior)]), False)
 
     def _rivals(self, a: int, lost: np.ndarray) -> np.ndarray:
         """The active targets (indices) whose predictions compete with target ``a``'s for candidates:
@@ -297,14 +376,17 @@ class Limbs3DTracker:
         return rivals
 
     def _single_view(self, pred: np.ndarray, centres: list[np.ndarray], others: np.ndarray,
-                     views: list | None = None) -> np.ndarray:
+                     views: list | None = None, toward: np.ndarray | None = None,
+                     picks: dict | None = None) -> np.ndarray:
         """Single-view candidates ``(K, 3)`` of a target predicted at ``pred`` (see
         ``dynamics.single_view_prior``): per view, the blob nearest the prediction's projection
         within ``single_view_gate`` mm (``single_view_gate_alone`` when only one view has blobs)
         that is nearer to it than to every other target's projection (``others (M, 3)``), at the
         point of the blob's line of sight nearest ``pred`` (with ``dynamics.single_view_support``
         and ``views``, the silhouette measures of every view, the nearest such point hidden by a
-        silhouette in every other view, :meth:`_hidden_depth`)."""
+        silhouette in every other view, :meth:`_hidden_depth`); with ``toward``, the point of the
+        line nearest that point instead of the prediction; ``picks`` gets each view's blob taken
+        (view -> its centre)."""
         out = []
         for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
             cen = np.asarray(cen, float).reshape(-1, 2)
@@ -317,12 +399,72 @@ class Limbs3DTracker:
             j = self._single_view_blob(cam, pred, cen, others, cam.K[0, 0] * gate / depth)
             if j < 0:
                 continue
+            if picks is not None:
+                picks[m] = cen[j].copy()
             v = cam.rays(cen[j:j + 1])[0]
-            s = float(v @ (pred - cam.centre))
+            s = float(v @ ((pred if toward is None else toward) - cam.centre))
             if self.params.dynamics.single_view_support > 0 and views is not None:
                 s = self._hidden_depth(m, v, s, views)
             out.append(cam.centre + v * s)
         return np.array(out).reshape(-1, 3)
+
+    def _through_own_blob(self, t: _Target, pred: np.ndarray, centres: list[np.ndarray], points: np.ndarray,
+                          weights: np.ndarray, head, share: bool = True) -> int:
+        """The merged candidate (index, -1 for none) that a target predicted at ``pred`` with no
+        candidate from pairs of views in its gate takes wherever it lies along its line of sight
+        (``dynamics.line_of_sight``): in each view, the blob nearest where its own blob was last seen
+        (``own``, up to ``states.lost_frames`` frames ago) within ``single_view_gate`` mm (at its
+        depth) is its own (two hands that touch make one blob, nearer the other's projection), and
+        of the candidates of prior at least
+        ``states.start_prior`` made from one of those and a blob of another view, within
+        ``hand_reach`` of its person's head for a hand, none of whose blobs is another target's
+        image (:meth:`_explained`; for a lost one, ``share`` False, none shared with anybody), the
+        strongest."""
+        d = self.params.dynamics
+        members = self.last.get("members")
+        if not self._line_of_sight or members is None or not len(points):
+            return -1
+        mine = set()
+        for m, (uv, _) in t.own.items():
+            cam, cen = self.cameras[m], np.asarray(centres[m], float).reshape(-1, 2)
+            depth = cam.to_camera(pred[None])[0, 2]
+            if len(cen) and depth > 0:
+                dist = np.linalg.norm(cen - uv, axis=1)
+                j = int(np.argmin(dist))
+                if dist[j] <= cam.K[0, 0] * d.single_view_gate / depth:
+                    mine.add(int(blob_keys(np.array([m]), np.array([j]))[0]))
+        ok = np.array([bool(mine & ms) for ms in members]) & (weights >= self.params.states.start_prior)
+        if d.hand_reach > 0 and t.part != "head" and head is not None:
+            ok &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        for i in np.flatnonzero(ok):
+            ok[i] = not self._explained(t, points[i], members[i], share)
+        if not ok.any():
+            return -1
+        return int(np.flatnonzero(ok)[np.argmax(weights[ok])])
+
+    def _explained(self, t: _Target, point: np.ndarray, keys: set, share: bool = True) -> bool:
+        """Whether one of the blobs ``keys`` (view-blob keys) is another target's image: the
+        projection nearest it is another target's, of the same person or whose estimate is more
+        than ``split_distance`` from ``point`` (another person's hand there shares the blob: two
+        people's hands that touch; a person's two hands on one line of sight in one view do not
+        tell that they touch: handshake seed 7, 3 cameras, the right hand went to the left's).
+        ``share`` False (a lost target): no blob is shared."""
+        others = [o for o in self.targets.values() if o is not t and o.position is not None and o.filter is not None]
+        if not others:
+            return False
+        pos = np.array([o.position for o in others])
+        far = np.linalg.norm(pos - point, axis=1) > self.params.states.split_distance
+        far |= np.array([o.track_id == t.track_id or not share for o in others])
+        for key in keys:
+            m, j = split_key(key)
+            cam = self.cameras[m]
+            blob = self._centres[m][j]
+            d_other = np.linalg.norm(cam.project(pos) - blob, axis=1)
+            d_own = np.linalg.norm(cam.project(t.position[None])[0] - blob)
+            i = int(np.argmin(d_other))
+            if d_other[i] < d_own and far[i]:
+                return True
+        return False
 
     @staticmethod
     def _single_view_blob(cam: Camera, pred: np.ndarray, cen: np.ndarray, others: np.ndarray, gate: float) -> int:
@@ -367,6 +509,83 @@ class Limbs3DTracker:
         if d.hand_reach > 0 and t.part != "head" and head is not None and len(points):
             use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
         return use
+
+    def _single_view_mode(self, est, modes: tuple, points: np.ndarray, idx: np.ndarray, centres,
+                          others: np.ndarray) -> tuple:
+        """``modes`` (at most one, from pairs of views) and a second one seen by a single view: a
+        combined pair whose hands part where one of them is hidden from all views but one shows
+        one mode of pairs and, in that view, a second blob (``dynamics.line_of_sight``). Of the
+        blobs within ``mode_search`` split distances of the estimate's projection (at its depth),
+        not one of the first mode's and nearer to it than to every other target's projection
+        (``others``), the one whose line of sight passes nearest the estimate, at the point of that
+        line nearest the estimate, if that is ``combine_distance`` or more from the first mode."""
+        p = self.params
+        members = self.last.get("members") or []
+        first = np.asarray(modes[0], float) if modes else np.asarray(est, float)
+        taken: set = set()
+        if modes and len(points):
+            near = idx[int(np.argmin(np.linalg.norm(points - first, axis=1)))]
+            taken = set(members[near]) if near < len(members) else set()
+        best, best_d = None, np.inf
+        for m, (cam, cen) in enumerate(zip(self.cameras, centres)):
+            cen = np.asarray(cen, float).reshape(-1, 2)
+            depth = cam.to_camera(np.asarray(est, float)[None])[0, 2]
+            if not len(cen) or depth <= 0:
+                continue
+            keys = blob_keys(np.full(len(cen), m), np.arange(len(cen)))
+            free = np.array([int(key) not in taken for key in keys])
+            if not free.any():
+                continue
+            gate = cam.K[0, 0] * p.states.mode_search * p.states.split_distance / depth
+            j = self._single_view_blob(cam, np.asarray(est, float), np.where(free[:, None], cen, np.inf), others,
+                                       gate)
+            if j < 0:
+                continue
+            v = cam.rays(cen[j:j + 1])[0]
+            point = cam.centre + v * float(v @ (np.asarray(est, float) - cam.centre))
+            d = float(np.linalg.norm(point - np.asarray(est, float)))
+            if d < best_d and np.linalg.norm(point - first) >= p.states.combine_distance:
+                best, best_d = (point, m, v), d
+        if best is None:
+            return modes
+        self._sight_modes.append((np.asarray(best[0], float), best[1], best[2]))
+        return (tuple(first), tuple(best[0]))
+
+    def _combined_modes(self, t: _Target, est, idx: np.ndarray, points: np.ndarray, weights: np.ndarray, centres,
+                        others: np.ndarray) -> tuple:
+        """The modes of combined target ``t`` (the pair's leader) from the candidates ``idx`` it may
+        use (:meth:`_modes`) and, with ``dynamics.line_of_sight`` and one mode of pairs, a second
+        seen by a single view once it parts (:meth:`_single_view_mode`, :meth:`_parting`)."""
+        modes = self._modes(est, points[idx], weights[idx])
+        if len(modes) >= 2 or not self._line_of_sight:
+            t.parting = []
+            return modes
+        return self._parting(t, self._single_view_mode(est, modes, points[idx], idx, centres, others))
+
+    def _parting(self, t: _Target, modes: tuple) -> tuple:
+        """``modes`` with a second one seen by a single view only once it has moved away from the
+        first for ``states.start_frames`` frames in a row (sec. 5.2: the modes "move apart when the
+        targets move away from each other"; a blob of a sleeve or an object next to two hands that
+        touch is one frame's mode and does not move away)."""
+        if len(modes) < 2:
+            t.parting = []
+            return modes
+        d = float(np.linalg.norm(np.subtract(modes[1], modes[0])))
+        t.parting = t.parting + [d] if t.parting and d >= t.parting[-1] else [d]
+        return modes if len(t.parting) >= self.params.states.start_frames else modes[:1]
+
+    def _split_position(self, t: _Target, mode, head) -> np.ndarray:
+        """Where a target that leaves a combined pair with ``mode`` starts: the mode, or for the mode
+        seen by a single view (:meth:`_single_view_mode`), the point of its line of sight nearest
+        where the target was, relative to its person's head, when last tracked alone from pairs of
+        views (``home``): one view cannot tell how far back the hand goes, and after a handshake or a
+        clap it goes back where it came from (the direction cue of sec. 7.1 on the depth)."""
+        mode = np.asarray(mode, float)
+        sight = [s for s in self._sight_modes if np.allclose(mode, s[0])]
+        if not sight or t.home is None or head is None:
+            return mode
+        cam, v = self.cameras[sight[0][1]], sight[0][2]
+        return cam.centre + v * float(v @ (np.asarray(head, float) + t.home - cam.centre))
 
     def _modes(self, est, points, weights) -> tuple:
         """The combined posterior's two strongest modes: the strongest candidate near the filter,
