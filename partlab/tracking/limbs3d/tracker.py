@@ -307,7 +307,7 @@ class Limbs3DTracker:
         handshake the hands go back where they came from (the direction cue of sec. 7.1, as
         :meth:`_split_position`). 3-camera handshake seed 8: the right hand that got the other mode
         had nothing there, drifted 230 -> 390 mm off while its home point was 16-42 mm from it."""
-        if not t.missed or not t.returning or t.home is None or head is None:
+        if t.missed < 2 or not t.returning or t.home is None or head is None:
             return est
         est = np.asarray(head, float) + t.home
         t.filter.reset(est, self.params.dynamics.lost_search)
