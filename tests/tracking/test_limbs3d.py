@@ -343,8 +343,8 @@ def test_a_hand_that_finds_nothing_after_a_split_goes_back_where_it_came_from():
     """Handshake, 3 cameras (the first three of the benchmark's 4-camera render of seed 8): the
     combined right hands split at frame 63 on a second mode where neither hand is; person 1's right
     hand, given it, had nothing there and drifted with its particles 300-390 mm off in frames 64-67
-    (before 2026-12-03) until it was lost. It is now put at once where it came from relative to its
-    head (``home``), 13-25 mm from its truth."""
+    (before 2026-12-03) until it was lost. Having found nothing for two frames, it is now put where
+    it came from relative to its head (``home``), 13-25 mm from its truth."""
     scene = make_multiview_scene("handshake", 4, seed=8, n_frames=150)
     cams = {c.name: c for c in scene.cameras[:3]}
     tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(8), cams, init=scene.init,

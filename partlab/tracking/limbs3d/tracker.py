@@ -300,13 +300,14 @@ class Limbs3DTracker:
         return self._records(index)
 
     def _back_home(self, t: _Target, est: np.ndarray, head) -> np.ndarray:
-        """A hand that left a combined pair (``returning``) and found nothing this frame (its
-        likelihood below ``states.lost_likelihood``) is at once put back where it came from, relative
+        """A hand that left a combined pair (``returning``) and found nothing for a second frame in a
+        row (its likelihood below ``states.lost_likelihood``) is put back where it came from, relative
         to its head (``home``), its particles spread ``dynamics.lost_search`` about it, instead of
         drifting with its particles for ``states.lost_frames`` frames until it is lost: after a
         handshake the hands go back where they came from (the direction cue of sec. 7.1, as
         :meth:`_split_position`). 3-camera handshake seed 8: the right hand that got the other mode
-        had nothing there, drifted 230 -> 390 mm off while its home point was 16-42 mm from it."""
+        had nothing there, drifted 230 -> 390 mm off while its home point was 16-42 mm from it. From
+        the first missed frame, one miss right after seed 4's good split sent a hand to a stale home."""
         if t.missed < 2 or not t.returning or t.home is None or head is None:
             return est
         est = np.asarray(head, float) + t.home
