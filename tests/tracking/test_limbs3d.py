@@ -337,3 +337,24 @@ def test_the_hand_seen_by_one_camera_meets_the_other_in_a_handshake():
     after = _handshake_distance(scene, Limbs3DParams())
     assert np.median(before) > 300  # main before the change: apart all along
     assert np.median(after) < 60 and (after < 135).mean() > 0.8
+
+
+def test_a_hand_that_finds_nothing_after_a_split_goes_back_where_it_came_from():
+    """Handshake, 3 cameras (the first three of the benchmark's 4-camera render of seed 8): the
+    combined right hands split at frame 63 on a second mode where neither hand is; person 1's right
+    hand, given it, had nothing there and drifted with its particles 300-390 mm off in frames 64-67
+    (before 2026-12-03) until it was lost. Having found nothing for two frames, it is now put where
+    it came from relative to its head (``home``), 13-25 mm from its truth."""
+    scene = make_multiview_scene("handshake", 4, seed=8, n_frames=150)
+    cams = {c.name: c for c in scene.cameras[:3]}
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(8), cams, init=scene.init,
+                        backgrounds=scene.backgrounds)
+    recs = []
+    for i in range(69):
+        recs += tr.step(FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}),
+                        {c: None for c in cams})
+    e = tr.table(recs).drop_duplicates(["frame", "track_id", "part"]).merge(
+        scene.truth3d, on=["frame", "track_id", "part"], suffixes=("", "_t"))
+    e = e[(e["track_id"] == 1) & (e["part"] == "right_hand") & e["frame"].between(64, 68)]
+    err = np.linalg.norm(e[["X", "Y", "Z"]].to_numpy(float) - e[["X_t", "Y_t", "Z_t"]].to_numpy(float), axis=1)
+    assert len(err) == 5 and err.max() < 60  # main before: 301, 360, 390, 388, 260 mm
