@@ -198,14 +198,17 @@ class PartFilter:
         self.state = (self.weights[:, None] * self.particles.astype(np.float64)).sum(axis=0)
 
     def probe(self, ycc: np.ndarray, spread: float, n: int = 200,
-              centre: tuple[float, float] | None = None) -> tuple[np.ndarray, float]:
+              centre: tuple[float, float] | None = None, allowed=None) -> tuple[np.ndarray, float]:
         """Look for the part around the current estimate (or around ``centre``) without
         changing the filter: ``n`` candidate centres within ``spread`` pixels (Gaussian), the
         one whose histogram matches the (frozen) model best. Returns ``(state (6,), rho)``; used
         to end an occlusion when the hidden person shows again away from where its dynamics
-        put it, and by the adjustment to find a lost part on its body (``partlab.tracking.body.adjustment``)."""
+        put it (``allowed``: which candidates may be it), and by the adjustment to find a lost
+        part on its body (``partlab.tracking.body.adjustment``)."""
         cand = self.candidates(spread, n, centre)
         rho = self.similarities(ycc, cand)
+        if allowed is not None:  # ``allowed(cand) -> (n,) bool``: the others count as no match
+            rho = rho * allowed(cand)
         k = int(np.argmax(rho))
         return cand[k].astype(np.float64), float(rho[k])
 

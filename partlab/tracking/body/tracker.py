@@ -118,17 +118,21 @@ class Person:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
         (not touching anyone, not occluded: another person passing in front drags the
         estimate before the occlusion is decided); None if too few."""
-        if len(self.centres) < 3:
-            return None
-        c = np.asarray(self.centres, dtype=np.float64)
-        dt = np.diff(c[:, 0])
-        return np.median(np.diff(c[:, 1:], axis=0) / dt[:, None], axis=0)
+        return _median_velocity(self.centres)
 
     def part_boxes(self) -> dict[str, Box]:
         return {name: f.box for name, f in self.filters.items()}
 
     def box(self) -> Box:
         return minimum_bounding_rectangle(f.box for f in self.filters.values())
+
+
+def _median_velocity(centres) -> np.ndarray | None:
+    """Median per-frame motion of ``(frame, cx, cy)`` entries; None if fewer than three."""
+    if len(centres) < 3:
+        return None
+    c = np.asarray(centres, dtype=np.float64)
+    return np.median(np.diff(c[:, 1:], axis=0) / np.diff(c[:, 0])[:, None], axis=0)
 
 
 def _moved(first: Box, now: Box, by: float) -> bool:
@@ -499,14 +503,9 @@ class BodyTracker:
         if p.occlusion.release_similarity <= 0:
             return None
         f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
-        spread = p.occlusion.release_search * float(f.state[2])
-        if mask is None:
-            state, rho = f.probe(ycc, spread)
-        else:  # only where something moves: a still object of the same colours is not the person
-            cand = f.candidates(spread)
-            sims = f.similarities(ycc, cand) * (_supports(mask, cand) >= 2 * p.detection.support_min)
-            k = int(np.argmax(sims))
-            state, rho = cand[k].astype(np.float64), float(sims[k])
+        # with a mask, only where something moves: a still object of the same colours is not the person
+        allowed = None if mask is None else (lambda cand: _supports(mask, cand) >= 2 * p.detection.support_min)
+        state, rho = f.probe(ycc, p.occlusion.release_search * float(f.state[2]), allowed=allowed)
         if rho < p.occlusion.release_similarity:
             return None
         return f, state, Box(state[0] - state[2] / 2, state[1] - state[3] / 2, state[2], state[3])
@@ -707,10 +706,8 @@ class BodyTracker:
         when too few frames tell), rather than from wherever the frames since took it (a still
         object of its colours). Moves every part there; returns the velocity."""
         before = [c for c in person.centres if c[0] < person.lost_since]
-        v = np.zeros(2)
-        if len(before) >= 3:
-            c = np.asarray(before, dtype=np.float64)
-            v = np.median(np.diff(c[:, 1:], axis=0) / np.diff(c[:, 0])[:, None], axis=0)
+        v = _median_velocity(before)
+        v = np.zeros(2) if v is None else v
         if before:
             frame, cx, cy = before[-1]
             delta = np.array([cx, cy]) + v * (index - frame) - np.array(person.box().centre)
@@ -782,7 +779,7 @@ class BodyTracker:
                 if not self.params.output.head_sets_sides and "head" in boxes:
                     body = minimum_bounding_rectangle(b for n, b in boxes.items() if n != "head")
                     mbr = Box(body.x, mbr.y, body.w, mbr.h)
-                whole_box = drawn.get("person") or self.report_person(mbr)
+                whole_box = drawn["person"] if "person" in drawn else self.report_person(mbr)
                 out.append(TrackRecord(index, tid, "person", whole_box, float(np.mean(scores)),
                                        bool(person.failed), 1.0 if person.occluded_by is not None else 0.0,
                                        state))
