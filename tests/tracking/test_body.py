@@ -261,8 +261,8 @@ def test_a_person_found_again_has_its_coasted_rows_bridged_by_a_straight_line():
     pd.testing.assert_frame_equal(bridged[~inside], plain[~inside])
 
 
-def _at_the_edge(exit_margin: float, vx: float):
-    """A tracker whose --init walker stands at the right border with velocity ``vx`` and has just
+def _at_the_edge(exit_margin: float, vx: float, vy: float = 0.0):
+    """A tracker whose --init walker stands at the right border with velocity ``(vx, vy)`` and has just
     had no foreground support for ``lost_frames`` frames, after the background warm-up."""
     frames, truths = _scene(n=1, walkers=(dict(x0=300, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
     p = BodyParams().updated({"detection.exit_margin": exit_margin})
@@ -270,7 +270,7 @@ def _at_the_edge(exit_margin: float, vx: float):
     tracker.step(0, frames[0], None)
     person = tracker.people[1]
     for f in person.filters.values():
-        f.set_velocity(np.array([vx, 0.0]))
+        f.set_velocity(np.array([vx, vy]))
     tracker.frames_seen = p.background.warmup + 1
     person.unsupported = p.detection.lost_frames - 1
     tracker._end_tracks([person], np.zeros((H, W), np.uint8), W, H, index=100)
@@ -286,6 +286,16 @@ def test_a_track_lost_at_the_frame_edge_moving_out_has_walked_out():
     assert 1 not in out.people and out.withdrawn == [(1, 100 - lost_frames + 1)]
     for tracker in (_at_the_edge(0.25, vx=-2.0), _at_the_edge(0.0, vx=2.0)):
         assert tracker.people[1].lost_since == 100 - lost_frames + 1 and tracker.withdrawn == []
+
+
+def test_a_track_lost_while_walking_along_the_frame_edge_has_not_walked_out():
+    """Walking along the border (here down the right edge, a little outwards) is not walking out of
+    the frame: the track goes lost and coasts; standing still there, it has walked out as before."""
+    lost_frames = BodyParams().detection.lost_frames
+    along = _at_the_edge(0.25, vx=0.5, vy=4.0)
+    assert along.people[1].lost_since == 100 - lost_frames + 1 and along.withdrawn == []
+    still = _at_the_edge(0.25, vx=0.0, vy=0.0)
+    assert 1 not in still.people and still.withdrawn == [(1, 100 - lost_frames + 1)]
 
 
 def test_a_track_that_was_at_the_edge_moving_out_before_its_support_went_has_walked_out():

@@ -48,6 +48,9 @@ from partlab.tracking.tracks import TrackRecord, frame_to_records
 if TYPE_CHECKING:
     import pandas as pd
 
+#: a person moving less than this share of its box height a frame stands still (at a border: leaving)
+STILL = 0.01
+
 
 @dataclass
 class TrackStart:
@@ -644,8 +647,12 @@ class BodyTracker:
         if v is None:
             v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
         vx, vy = float(v[0]), float(v[1])
-        return ((box.x <= m * box.w and vx <= 0) or (W - box.x2 <= m * box.w and vx >= 0)
-                or (box.y <= m * box.h and vy <= 0) or (H - box.y2 <= m * box.h and vy >= 0))
+        # walking along a border is not walking out of it (PETS09: walkers at the bottom edge, their
+        # feet cut off, going sideways at 14 px a frame ended as "out" when their support lagged)
+        along_x = abs(vx) > max(abs(vy), STILL * box.h)  # moves sideways: along the top or bottom border
+        along_y = abs(vy) > max(abs(vx), STILL * box.h)
+        side = not along_y and ((box.x <= m * box.w and vx <= 0) or (W - box.x2 <= m * box.w and vx >= 0))
+        return side or (not along_x and ((box.y <= m * box.h and vy <= 0) or (H - box.y2 <= m * box.h and vy >= 0)))
 
     def _end_tracks(self, active: list[Person], mask, W: int, H: int, index: int = 0) -> None:
         p = self.params
