@@ -264,7 +264,8 @@ LEARNED_LIMB_FIELDS: tuple[str, ...] = ("priors.sigma_v", "priors.sigma_d", "pri
 #: bundle's summary lists them as learnt (``summary["person"]["fields"]``), so a bundle that did
 #: not learn them follows the installed defaults like every other hand-set tunable.
 PERSON_BODY_FIELDS: tuple[str, ...] = ("output.person", "detector.min_score", "detector.shrink",
-                                       "detector.steer", "detector.undetected_frames", "detection.leave_fraction")
+                                       "detector.steer", "detector.steer_velocity", "detector.undetected_frames",
+                                       "detection.leave_fraction")
 
 
 def learned_body_params(saved: BodyParams, person_fields=()) -> BodyParams:

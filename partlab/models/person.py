@@ -212,8 +212,9 @@ def fit_steer(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[p
     box at IoU >= 0.3 (what the cue matches). To 0.05 in [0.1, 1]; None with fewer than
     :data:`MIN_PAIRS` of either."""
     det = samples[samples["score"].notna() & (samples["iou"] >= 0.3) & (samples["score"] >= min_score)]
-    truth_rows = samples[samples["score"].isna()][["frame", "truth", *XYWH]]
-    d = det.merge(truth_rows, on=["frame", "truth"], suffixes=("", "_t"))
+    key = ["clip", "frame", "truth"] if "clip" in samples else ["frame", "truth"]  # clips share frame numbers
+    truth_rows = samples[samples["score"].isna()][[*key, *XYWH]]
+    d = det.merge(truth_rows, on=key, suffixes=("", "_t"))
     m = _person_pairs(tracked, truths, pd.DataFrame(columns=["x", "x_t"]))
     if len(m):
         cx, cy = m.x + m.w / 2, m.y + m.h / 2
@@ -225,6 +226,87 @@ def fit_steer(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[p
     record.update(tracker_error=round(e_t, 5), detector_error=round(e_d, 5))
     gain = e_t / max(e_t + e_d, 1e-12)
     return float(np.clip(round(gain * 20) / 20, 0.1, 1.0)), record
+
+
+# -- 2b. how far a detection's motion moves a track's velocity -------------------------------------
+
+def _centres(df: pd.DataFrame) -> pd.DataFrame:
+    return df.assign(cx=df.x + df.w / 2, cy=df.y + df.h / 2)[["frame", "track_id", "cx", "cy", "h"]]
+
+
+def _detection_velocities(det: pd.DataFrame, window: int) -> pd.DataFrame:
+    """Per matched detection, the velocity the detection cue keeps for its person
+    (:meth:`partlab.tracking.body.cue.DetectionCue._seen`: the motion since the person's previous
+    detection at most ``window`` frames before, averaged with the previous estimate)."""
+    rows = []
+    for tid, g in det.sort_values("frame").groupby("truth"):
+        prev, old = None, None
+        for r in g.itertuples():
+            cx, cy = r.x + r.w / 2, r.y + r.h / 2
+            if prev is not None and 0 < r.frame - prev[0] <= window:
+                v = np.array([cx - prev[1], cy - prev[2]]) / (r.frame - prev[0])
+                old = v if old is None else 0.5 * (v + old)
+                rows.append((r.frame, tid, *old))
+            else:
+                old = None
+            prev = (r.frame, cx, cy)
+    return pd.DataFrame(rows, columns=["frame", "track_id", "vx", "vy"])
+
+
+def _tracker_velocities(tracked: pd.DataFrame, window: int) -> pd.DataFrame:
+    """Per frame and track, the velocity the tracker coasts on (:func:`partlab.tracking.body.tracker
+    ._median_velocity`: the median per-frame motion of its person box over the last ``window`` frames)."""
+    c = _centres(tracked[tracked["part"] == "person"])
+    rows = []
+    for tid, g in c.sort_values("frame").groupby("track_id"):
+        f, xy = g["frame"].to_numpy(), g[["cx", "cy"]].to_numpy()
+        for k in range(window, len(g)):
+            seg_f, seg = f[k - window:k + 1], xy[k - window:k + 1]
+            if seg_f[-1] - seg_f[0] != window:
+                continue  # a gap: the tracker's history restarts
+            rows.append((f[k], tid, *np.median(np.diff(seg, axis=0), axis=0)))
+    return pd.DataFrame(rows, columns=["frame", "track_id", "vx", "vy"])
+
+
+def _truth_velocities(truth: pd.DataFrame, ahead: int) -> pd.DataFrame:
+    """Per frame and person, the corrected box's per-frame motion over the next ``ahead`` frames
+    (what a velocity set at a scan should predict until the next scan), and its height."""
+    c = _centres(truth[truth["part"] == "person"])
+    later = c.assign(frame=c["frame"] - ahead)
+    m = c.merge(later, on=["frame", "track_id"], suffixes=("", "_n"))
+    return m.assign(tx=(m.cx_n - m.cx) / ahead, ty=(m.cy_n - m.cy) / ahead)[["frame", "track_id", "tx", "ty", "h"]]
+
+
+def fit_steer_velocity(samples: pd.DataFrame, tracked: list[pd.DataFrame], truths: list[pd.DataFrame],
+                       min_score: float, every: int, window: int) -> tuple[float | None, dict]:
+    """``detector.steer_velocity``, the share of the way a matched detection moves a track's
+    velocity to the motion its detections show, as the blend of two noisy estimates of one velocity
+    that errs least (the scalar Kalman gain, as :func:`fit_steer`): ``e_t / (e_t + e_d)``, with
+    ``e_t`` the median squared error (in corrected box heights per frame) of the velocity the
+    tracker coasts on (its person box's median motion over ``velocity_frames``) and ``e_d`` that of
+    the detections' velocity (the cue's own estimate), each against the corrected boxes' motion over
+    the next ``every`` frames (until the next scan). To 0.05 in [0, 1]; None with fewer than
+    :data:`MIN_PAIRS` of either."""
+    det = samples[samples["score"].notna() & (samples["iou"] >= 0.3) & (samples["score"] >= min_score)
+                  & (samples["truth"] >= 0)]
+    if "clip" not in det:
+        det = det.assign(clip=0)
+    key = ["frame", "track_id"]
+    err_d, err_t = [], []
+    for i, (t, truth) in enumerate(zip(tracked, truths)):  # clip by clip: clips share frame numbers and ids
+        tv = _truth_velocities(truth, max(every, 1))
+        vd = _detection_velocities(det[det["clip"] == i], window).merge(tv, on=key)
+        # the tracker's velocity on the frames the detector's is known (the same people, the same moments)
+        vt = _tracker_velocities(t, window).merge(vd[key], on=key).merge(tv, on=key)
+        for v, out in ((vd, err_d), (vt, err_t)):
+            out.extend(((v.vx - v.tx) ** 2 + (v.vy - v.ty) ** 2) / v.h ** 2)
+    record = {"tracker_pairs": len(err_t), "detector_pairs": len(err_d)}
+    if len(err_t) < MIN_PAIRS or len(err_d) < MIN_PAIRS:
+        return None, record
+    e_t, e_d = float(np.median(err_t)), float(np.median(err_d))
+    record.update(tracker_error=round(e_t, 7), detector_error=round(e_d, 7))
+    gain = e_t / max(e_t + e_d, 1e-12)
+    return float(np.clip(round(gain * 20) / 20, 0.0, 1.0)), record
 
 
 # -- 3. when an undetected track ends -------------------------------------------------------------
@@ -316,7 +398,7 @@ def fit_person(clips, truths: list[pd.DataFrame], tracked: list[pd.DataFrame], b
         samples = []
         for (factory, _fps, _truth), truth, t in zip(clips, truths, tracked):
             step("detections on the corrected frames")
-            samples.append(detection_samples(factory, truth, base, t))
+            samples.append(detection_samples(factory, truth, base, t).assign(clip=len(samples)))
         s = pd.concat(samples, ignore_index=True)
         det = base.detector
         score, rec = fit_min_score(s, det.min_score)
@@ -333,6 +415,11 @@ def fit_person(clips, truths: list[pd.DataFrame], tracked: list[pd.DataFrame], b
         out.record["steer"] = {**rec, "steer": steer}
         if steer is not None and steer != det.steer:
             out.components["steer"] = {"detector.steer": steer}
+        velocity, rec = fit_steer_velocity(s, tracked, truths, det.min_score if score is None else score,
+                                           det.every, det.velocity_frames)
+        out.record["steer_velocity"] = {**rec, "steer_velocity": velocity}
+        if velocity is not None and velocity != det.steer_velocity:
+            out.components["velocity"] = {"detector.steer_velocity": velocity}
         fps = float(clips[0][1])
         undetected = fit_undetected_frames(s, det.min_score if score is None else score, det.every, fps)
         out.record["undetected_frames"] = undetected
@@ -404,7 +491,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     per_seed = {"start": by_seed(base_tracks)}
     best, params, tracks, kept, used = scores["start"], base, base_tracks, {}, {}
     best_seeds = per_seed["start"]
-    for comp in ("detector", "steer", "extent", "ending", "noise"):
+    for comp in ("detector", "steer", "velocity", "extent", "ending", "noise"):
         changes = fit.components.get(comp)
         if comp == "extent" and (changes is not None or "detector" in kept):
             ext = fit_person_extent(tracks, truths, params.output.person)
@@ -442,6 +529,9 @@ def person_rows(record: dict) -> list[dict]:
         "steer": f"steer = {(record.get('steer') or {}).get('steer')} (median squared error: tracker "
                  f"{(record.get('steer') or {}).get('tracker_error')}, detector "
                  f"{(record.get('steer') or {}).get('detector_error')})",
+        "velocity": f"steer_velocity = {(record.get('steer_velocity') or {}).get('steer_velocity')} (median "
+                    f"squared error: tracker {(record.get('steer_velocity') or {}).get('tracker_error')}, detector "
+                    f"{(record.get('steer_velocity') or {}).get('detector_error')})",
         "extent": f"output.person = {tuple(record['person_extent'])}" if record.get("person_extent") else "-",
         "ending": f"undetected_frames = {record.get('undetected_frames')}, "
                   f"leave_fraction = {record.get('leave_fraction')}",

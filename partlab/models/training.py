@@ -335,7 +335,7 @@ def _differs(a, b) -> bool:
 
 #: how :func:`learnt` names the person-box components (:mod:`partlab.models.person`)
 PERSON_COMPONENTS = {"extent": "person box extent", "detector": "detector threshold and window",
-                     "steer": "detection steering gain",
+                     "steer": "detection steering gain", "velocity": "detection velocity gain",
                      "ending": "undetected-track ending", "noise": "part noise from person motion"}
 
 

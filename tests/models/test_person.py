@@ -215,3 +215,30 @@ def test_a_bundle_applies_the_person_box_fields_its_summary_lists_and_no_others(
     assert loaded.detection.leave_fraction == BodyParams().detection.leave_fraction  # not learnt: the default
     save_bundle(Bundle(body_params=body), tmp_path / "c")  # a bundle that learnt none of them
     assert load_bundle(tmp_path / "c").body_params.output.person == (1.0, 1.0, 0.0, 0.0)
+
+
+def _scans(truth, every, jitter, rng):
+    """Detection samples on every ``every``-th frame, the centre ``jitter`` box heights off, and the
+    corrected boxes of those frames (score NaN)."""
+    t = truth[truth.frame % every == 0]
+    rows = [(r.frame, r.x + jitter * r.h * rng.choice([-1, 1]), r.y, r.w, r.h, 1.0, 0.8, r.track_id)
+            for r in t.itertuples()]
+    rows += [(r.frame, r.x, r.y, r.w, r.h, np.nan, np.nan, r.track_id) for r in t.itertuples()]
+    return pd.DataFrame(rows, columns=["frame", "x", "y", "w", "h", "score", "iou", "truth"])
+
+
+def test_velocity_gain_trusts_whichever_motion_errs_less():
+    truth = _people(walking_truth(3, 60, seed=5))
+    rng = np.random.default_rng(4)
+    jittery = truth.assign(x=truth.x + rng.normal(0, 0.08, len(truth)) * truth.h)  # a box that shakes
+    exact_scans, noisy_scans = _scans(truth, 3, 0.0, rng), _scans(truth, 3, 0.25, rng)
+    # a shaking tracker and exact detections: follow the detections' motion
+    high, rec = P.fit_steer_velocity(exact_scans, [jittery], [truth], 0.3, every=3, window=9)
+    assert high >= 0.8 and rec["tracker_pairs"] >= 20 and rec["detector_pairs"] >= 20
+    # a smooth tracker and detections a quarter of a box height off each time: keep the tracker's
+    low, _ = P.fit_steer_velocity(noisy_scans, [truth], [truth], 0.3, every=3, window=9)
+    assert low <= 0.2
+    # two clips with the same frame numbers and ids are not mixed up: the same gain as each alone
+    both = pd.concat([exact_scans.assign(clip=0), exact_scans.assign(clip=1)], ignore_index=True)
+    assert P.fit_steer_velocity(both, [jittery, jittery], [truth, truth], 0.3, 3, 9)[0] == high
+    assert P.fit_steer_velocity(exact_scans[exact_scans.score.isna()], [jittery], [truth], 0.3, 3, 9)[0] is None
