@@ -205,8 +205,9 @@ def test_the_swap_guard_does_not_steer_a_track_onto_a_detection_its_neighbour_ov
 
 def test_steer_velocity_brings_the_parts_velocity_towards_the_motion_of_the_detections():
     """A walker moving 4 px a frame whose track's filters think it stands still: two detections
-    three frames apart show the motion; with ``steer_velocity`` 0.5 every part's velocity goes half
-    of the way there, without it the detections move the boxes but not the velocity."""
+    three frames apart show the motion; with a gain of 0.5 every part's velocity goes half of the
+    way there, with 0 the detections move the boxes but not the velocity. The gain is
+    ``steer_velocity_auto`` in an automatic run and ``steer_velocity`` in a run from given boxes."""
     import cv2
 
     from partlab.tracking.core.box import Box
@@ -215,8 +216,13 @@ def test_steer_velocity_brings_the_parts_velocity_towards_the_motion_of_the_dete
     frame[60:160, 100:130] = (40, 60, 200)
     ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
     velocity = {}
-    for gain in (0.0, 0.5):
-        t = BodyTracker(BodyParams().updated({"detector.steer_velocity": gain}), np.random.default_rng(0))
+    runs = {("auto", 0.0): ({"detector.steer_velocity_auto": 0.0}, None),
+            ("auto", 0.5): ({"detector.steer_velocity_auto": 0.5}, None),
+            ("init", 0.0): ({"detector.steer_velocity": 0.0, "detector.steer_velocity_auto": 0.5}, []),
+            ("init", 0.5): ({"detector.steer_velocity": 0.5, "detector.steer_velocity_auto": 0.0}, [])}
+    for key, (changes, init) in runs.items():
+        t = BodyTracker(BodyParams().updated(changes), np.random.default_rng(0), init=init)
+        assert t.auto == (init is None)
         t.frame_size = (320, 240)
         person = t.start_track(1, {"person": Box(100, 60, 30, 100)}, ycc, None, 0)
         det = t._reported_person_box(person)
@@ -224,7 +230,8 @@ def test_steer_velocity_brings_the_parts_velocity_towards_the_motion_of_the_dete
             box = np.array([[det.x + 4.0 * index, det.y, det.w, det.h, 1.0]])
             t.cue.detector.detect = lambda frame, regions, box=box: box
             t.cue.step(index, frame, ycc, None)
-        velocity[gain] = {n: tuple(f.state[4:6]) for n, f in person.filters.items()}
-    for name in ("head", "torso", "hipleg"):
-        assert velocity[0.0][name] == pytest.approx((0.0, 0.0), abs=1e-6)
-        assert velocity[0.5][name] == pytest.approx((2.0, 0.0), abs=1e-4)
+        velocity[key] = {n: tuple(f.state[4:6]) for n, f in person.filters.items()}
+    for mode in ("auto", "init"):
+        for name in ("head", "torso", "hipleg"):
+            assert velocity[mode, 0.0][name] == pytest.approx((0.0, 0.0), abs=1e-6)
+            assert velocity[mode, 0.5][name] == pytest.approx((2.0, 0.0), abs=1e-4)

@@ -188,13 +188,14 @@ class DetectionCue:
         self.last_seen[track_id] = (index, cx, cy)
 
     def _steer_motion(self, person) -> None:
-        """``steer_velocity``: every part's velocity goes that share of the way to the motion its
-        detections show."""
+        """``steer_velocity`` (``steer_velocity_auto`` in automatic runs): every part's velocity goes
+        that share of the way to the motion its detections show."""
         v = self.velocity.get(person.track_id)
-        if self.p.steer_velocity <= 0 or v is None:
+        gain = self.p.steer_velocity_auto if self.tracker.auto else self.p.steer_velocity
+        if gain <= 0 or v is None:
             return
         for f in person.filters.values():
-            f.nudge_velocity(v, self.p.steer_velocity)
+            f.nudge_velocity(v, gain)
 
     def _steer_coasting(self, person, reported: Box, det: Box) -> None:
         """A track coasting on its dynamics (behind someone, or lost) that a detection sees (its

@@ -368,6 +368,13 @@ class BodyDetector:
     # (10.21 -> 13.33); 0.5 with ``steer`` 0.7 gives PETS09 0.783, Crossing 4.79 and the synthetic
     # scenes 26.0 / 37.7, but the bending walker's torso (above).
     steer_velocity: float = number(0.0, FRACTION)
+    # ... the same in runs that find people themselves (no ``--init``, no keyframes), where every
+    # track was started from a detector's window rather than a drawn box, and its colour models'
+    # velocity lags the more. 0.5 (2026-12-03, docs/measurements/annotation_effort.md): PETS09
+    # automatic MOTA 0.722 -> 0.757 (seeds 1-4, each >= 0.752), edits/100 17.00 -> 15.37; OTB Human3
+    # automatic, walker covered 0.805 +- 0.045 -> 0.844 +- 0.004; randomized scenes 100-107 automatic:
+    # see the measurement.
+    steer_velocity_auto: float = number(0.5, FRACTION)
     # Swap guard: a matched detection that overlaps another track at least ``swap_guard`` times as
     # much as its own (IoU, and at least ``match_iou``) does not steer: where two walkers cross, the
     # detector's window (or the assignment) may be the other person's, and steering would carry
