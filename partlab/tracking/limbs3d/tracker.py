@@ -215,8 +215,9 @@ class Limbs3DTracker:
                     crop = cv2.morphologyEx(crop, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
-            centres.append(blobs.centres)
-            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
+            blind = stream in self.plates and sil.mean() > p.observations.blind_fill
+            centres.append(np.zeros((0, 2)) if blind else blobs.centres)
+            views.append(observe_view(sil, centres[-1] / 2.0, scale=2.0, fragment=p.priors.fragment,
                                       either=p.priors.fragment_either))
         self._centres = centres
         return centres, views
@@ -260,6 +261,9 @@ class Limbs3DTracker:
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
+        seeing = sum(len(c) > 0 for c in centres)  # views with a skin blob: a dark camera has none
+        growth = p.dynamics.gate_growth + (p.dynamics.gate_growth_dark if seeing < len(self.cameras) else 0.0)
+        unseen = p.dynamics.hold_unseen and seeing < 2  # nothing can be triangulated this frame
         for a, k in enumerate(active):
             t = self.targets[k]
             rivals = self._rivals(a, lost)
@@ -267,7 +271,7 @@ class Limbs3DTracker:
             mine = self._usable(t, points, None if few else dist[:, a], None if few else dist[:, rivals],
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
-            gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
+            gate = p.dynamics.candidate_gate * (1 + growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
             use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
                                                     weights, heads.get(t.track_id))
@@ -282,7 +286,8 @@ class Limbs3DTracker:
                 if t.returning and t.home is not None and heads.get(t.track_id) is not None:
                     t.position = heads[t.track_id] + t.home  # ... or, leaving a pair, where it came from
                 est = t.position
-            obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
+            obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled,
+                   "unseen": unseen}
             if m.state(k) == LimbState.COMBINED:
                 obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
                                                     np.delete(preds, a, axis=0))
@@ -291,7 +296,7 @@ class Limbs3DTracker:
             if partner is not None and m.state(k) == LimbState.COMBINED:
                 self.targets[partner].position = est
                 observations[partner] = Observation(position=tuple(est), likelihood=t.filter.confidence,
-                                                    labelled=True)
+                                                    labelled=True, unseen=unseen)
         for tr in m.update(index, observations):
             t = self.targets[tr.tracker]
             if tr.new == LimbState.UNLABELLED and tr.reason == "split":
