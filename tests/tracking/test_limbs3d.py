@@ -324,6 +324,29 @@ def test_frames_in_which_one_camera_of_two_is_dark_do_not_lose_a_target():
     assert lost(Limbs3DParams().updated({**blind, "dynamics.gate_growth_dark": 0.5})) == set()
 
 
+def test_two_peoples_hands_that_split_go_back_to_their_own_sides():
+    """The direction cue (sec. 7.1) from drifted estimates gave each hand the other's mode after
+    handshake seed 3's exchange (3 cameras, frame 90: a swap); with ``states.split_heads`` a pair of
+    different people's hands whose modes point against their heads by more than 60 degrees is
+    swapped back, and one person's two hands (a clap) keep the direction cue's modes."""
+    a, b = _two_cameras()
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(0), {"cam0": a, "cam1": b})
+    for tid, part in [(1, "left_hand"), (2, "right_hand"), (1, "right_hand")]:
+        tr._add(tid, part, 0, np.zeros(3), LimbState.NORMAL)
+    heads = {1: np.array([0.0, 0.0, 1600.0]), 2: np.array([1000.0, 0.0, 1600.0])}
+    near_1, near_2 = (450.0, 30.0, 1100.0), (570.0, -20.0, 1120.0)  # 120 mm apart, each nearer its head
+    wrong = {0: near_2, 1: near_1}  # person 1's hand given the mode on person 2's side
+    assert tr._split_sides(wrong, heads) == {0: near_1, 1: near_2}
+    assert tr._split_sides({0: near_1, 1: near_2}, heads) == {0: near_1, 1: near_2}  # already right
+    across = {0: (520.0, 60.0, 1100.0), 1: (500.0, -60.0, 1100.0)}  # mostly across the heads' line: kept
+    assert tr._split_sides(across, heads) == across
+    assert tr._split_sides({0: near_2, 2: near_1}, heads) == {0: near_2, 2: near_1}  # one person: kept
+    off = Limbs3DTracker(Limbs3DParams().updated({"states.split_heads": 1.0}), np.random.default_rng(0),
+                         {"cam0": a, "cam1": b})
+    off.targets = tr.targets
+    assert off._split_sides(wrong, heads) == wrong
+
+
 def test_frames_that_cannot_see_a_target_do_not_lose_it():
     m = LimbStateMachine(Limbs3DParams())
     m.add(0, LimbState.NORMAL)

@@ -248,6 +248,14 @@ class Limbs3DStates:
     history_frames: int = number(10, COUNT)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
+    # two hands of different people that split take their modes by the direction cue unless that puts
+    # each on the other's side: the modes' difference against their heads' by more than this cosine
+    # (tracker._split_sides; our addition). Handshake seed 3, 3 cameras: a lost hand and one drifting
+    # on single-view candidates met at the exchange, the direction from their wrong estimates gave
+    # each the other's mode (a swap). 2026-12-03, handshake seeds 0-9: 3 cameras 61.8 -> 49.6 mm,
+    # swaps 7 -> 3; 4 cameras 69.4 -> 63.8, 10 -> 7; 2 cameras unchanged; one person: never applies.
+    # 1 = off
+    split_heads: float = number(0.5, FRACTION)
 
 
 @dataclass(frozen=True)

@@ -297,10 +297,13 @@ class Limbs3DTracker:
                 self.targets[partner].position = est
                 observations[partner] = Observation(position=tuple(est), likelihood=t.filter.confidence,
                                                     labelled=True, unseen=unseen)
-        for tr in m.update(index, observations):
+        transitions = m.update(index, observations)
+        splits = self._split_sides({tr.tracker: tr.position for tr in transitions
+                                    if tr.new == LimbState.UNLABELLED and tr.reason == "split"}, heads)
+        for tr in transitions:
             t = self.targets[tr.tracker]
-            if tr.new == LimbState.UNLABELLED and tr.reason == "split":
-                self._split(t, tr.position, heads.get(t.track_id))
+            if tr.tracker in splits:
+                self._split(t, splits[tr.tracker], heads.get(t.track_id))
             # (a target that becomes combined and is not its pair's leader: the leader's filter tracks both)
         return self._records(index)
 
@@ -328,6 +331,29 @@ class Limbs3DTracker:
                 head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
                 if head and head[0] is not None:
                     t.home = t.position - head[0]
+
+    def _split_sides(self, splits: dict, heads: dict) -> dict:
+        """The modes the state machine gave two hands of different people that split (``splits``:
+        target -> mode), swapped when the direction cue (sec. 7.1) puts each on the other person's
+        side: the modes' difference points against their heads' by more than ``states.split_heads``
+        (cosine). The direction before the join comes from estimates that may have drifted (a hand
+        lost or on single-view candidates while the hands met); the heads are tracked to 10-50 mm,
+        and after a handshake or an exchange each hand goes back to its own person."""
+        c = self.params.states.split_heads
+        if c >= 1 or len(splits) < 2:
+            return splits
+        out = dict(splits)
+        for k, pos in splits.items():
+            t = self.targets[k]
+            for j, other in splits.items():
+                o = self.targets[j]
+                if j <= k or o.track_id == t.track_id or t.track_id not in heads or o.track_id not in heads:
+                    continue
+                d = np.subtract(pos, other)
+                h = np.subtract(heads[t.track_id], heads[o.track_id])
+                if float(d @ h) < -c * np.linalg.norm(d) * np.linalg.norm(h):
+                    out[k], out[j] = other, pos
+        return out
 
     def _split(self, t: _Target, mode, head) -> None:
         """``t`` leaves its combined pair with ``mode`` (:meth:`_split_position`)."""
