@@ -64,6 +64,9 @@ class Observation:
     modes: tuple[tuple[float, float], ...] = ()
     #: the target's box side (pixels); with it the combine/split distances scale with the target
     size: float = 0.0
+    #: the frame could not have seen the target (e.g. too few views left to triangulate anything):
+    #: it counts as a confident frame for ``lost_frames`` (the count starts again after it)
+    unseen: bool = False
 
 
 @dataclass(frozen=True)
@@ -197,7 +200,7 @@ class LimbStateMachine:
         for t, s in self._status.items():
             obs = observations.get(t, Observation())
             # likelihood counters
-            s.low = s.low + 1 if obs.likelihood < p.states.lost_likelihood else 0
+            s.low = s.low + 1 if obs.likelihood < p.states.lost_likelihood and not obs.unseen else 0
 
         for t, s in list(self._status.items()):
             if t in moved:

@@ -58,6 +58,11 @@ class Limbs3DObservations:
     # the adaptive background model has absorbed a person who sits still (radius in target sizes,
     # see output.head_size_mm); with a plate the silhouette is trusted
     support_scale: float = number(2.5)
+    # a view whose plate silhouette covers more than this fraction of it sees no people (a dark,
+    # covered or moved camera: a black frame differs from its plate everywhere, and the adapted skin
+    # model found a blob in one, standing seed 5 at 3 cameras): its blobs are dropped, and it counts
+    # as not seeing (dynamics.gate_growth_dark, hold_unseen). 1 = never (2026-12-03)
+    blind_fill: float = number(0.9, FRACTION)
 
 
 @dataclass(frozen=True)
@@ -148,6 +153,19 @@ class Limbs3DDynamics:
     # 1 -> 0 lost) and moves the 3-camera handshake 78.8 -> 76.7 mm, but the 4-camera one 69.9 ->
     # 71.5 and the 2-camera one 91.4 -> 91.7 mm with one more swap
     gate_growth: float = number(0.0)
+    # gate_growth added while some view sees no skin blob at all (a dark or covered camera, our
+    # addition): the hands it helped triangulate have pair candidates only now and then. 2026-12-03,
+    # seeds 0-9, camera 0 hidden for 30 frames, with blind_fill: standing 3 cameras lost 1 -> 0
+    # (seed 5); unhidden takes unchanged (it never applies there); 3-camera handshake hidden
+    # stretch 80.2 -> 78.7 mm but the 20 frames after it 124.6 -> 132.6. 0 = off
+    gate_growth_dark: float = number(0.5)
+    # with fewer than two views seeing skin blobs nothing can be triangulated: such a frame is no
+    # evidence against a target and does not count towards states.lost_frames (our addition,
+    # Observation.unseen). 2026-12-03, seeds 0-9, 2 cameras, camera 0 hidden for 30 frames: lost
+    # standing 2 -> 1 (seed 5 loses it unhidden too), handshake 27 -> 16 (unhidden 18), seated 0 -> 0;
+    # the 20 frames after the stretch: standing 47.9 -> 50.4 mm, handshake 105.3 -> 133.5 (hands
+    # kept on single-view candidates instead of held where lost). False = off
+    hold_unseen: bool = flag(True)
     # the dynamics' density in the importance weights f / q is a mixture: (1 - jump_mix) the
     # predicted cloud's Gaussian, jump_mix one jump_scale times wider (our addition). A clap starts
     # in 2-3 frames (a hand at ~3 m/s, 120 mm a frame): with the Gaussian alone the filter fell
@@ -230,6 +248,14 @@ class Limbs3DStates:
     history_frames: int = number(10, COUNT)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
+    # two hands of different people that split take their modes by the direction cue unless that puts
+    # each on the other's side: the modes' difference against their heads' by more than this cosine
+    # (tracker._split_sides; our addition). Handshake seed 3, 3 cameras: a lost hand and one drifting
+    # on single-view candidates met at the exchange, the direction from their wrong estimates gave
+    # each the other's mode (a swap). 2026-12-03, handshake seeds 0-9: 3 cameras 61.8 -> 49.6 mm,
+    # swaps 7 -> 3; 4 cameras 69.4 -> 63.8, 10 -> 7; 2 cameras unchanged; one person: never applies.
+    # 1 = off
+    split_heads: float = number(0.5, FRACTION)
 
 
 @dataclass(frozen=True)

@@ -215,8 +215,9 @@ class Limbs3DTracker:
                     crop = cv2.morphologyEx(crop, cv2.MORPH_OPEN, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k)))
                 skin[y0:y1, x0:x1] = crop
             blobs = find_blobs(skin, people, p.observations.blob_alpha, p.observations.blob_min_area)
-            centres.append(blobs.centres)
-            views.append(observe_view(sil, blobs.centres / 2.0, scale=2.0, fragment=p.priors.fragment,
+            blind = stream in self.plates and sil.mean() > p.observations.blind_fill
+            centres.append(np.zeros((0, 2)) if blind else blobs.centres)
+            views.append(observe_view(sil, centres[-1] / 2.0, scale=2.0, fragment=p.priors.fragment,
                                       either=p.priors.fragment_either))
         self._centres = centres
         return centres, views
@@ -260,6 +261,9 @@ class Limbs3DTracker:
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
+        seeing = sum(len(c) > 0 for c in centres)  # views with a skin blob: a dark camera has none
+        growth = p.dynamics.gate_growth + (p.dynamics.gate_growth_dark if seeing < len(self.cameras) else 0.0)
+        unseen = p.dynamics.hold_unseen and seeing < 2  # nothing can be triangulated this frame
         for a, k in enumerate(active):
             t = self.targets[k]
             rivals = self._rivals(a, lost)
@@ -267,7 +271,7 @@ class Limbs3DTracker:
             mine = self._usable(t, points, None if few else dist[:, a], None if few else dist[:, rivals],
                                 heads.get(t.track_id))
             use, use_w = points[mine], weights[mine]
-            gate = p.dynamics.candidate_gate * (1 + p.dynamics.gate_growth * min(t.missed, p.states.lost_frames))
+            gate = p.dynamics.candidate_gate * (1 + growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
             use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
                                                     weights, heads.get(t.track_id))
@@ -282,7 +286,8 @@ class Limbs3DTracker:
                 if t.returning and t.home is not None and heads.get(t.track_id) is not None:
                     t.position = heads[t.track_id] + t.home  # ... or, leaving a pair, where it came from
                 est = t.position
-            obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled}
+            obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled,
+                   "unseen": unseen}
             if m.state(k) == LimbState.COMBINED:
                 obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
                                                     np.delete(preds, a, axis=0))
@@ -291,11 +296,14 @@ class Limbs3DTracker:
             if partner is not None and m.state(k) == LimbState.COMBINED:
                 self.targets[partner].position = est
                 observations[partner] = Observation(position=tuple(est), likelihood=t.filter.confidence,
-                                                    labelled=True)
-        for tr in m.update(index, observations):
+                                                    labelled=True, unseen=unseen)
+        transitions = m.update(index, observations)
+        splits = self._split_sides({tr.tracker: tr.position for tr in transitions
+                                    if tr.new == LimbState.UNLABELLED and tr.reason == "split"}, heads)
+        for tr in transitions:
             t = self.targets[tr.tracker]
-            if tr.new == LimbState.UNLABELLED and tr.reason == "split":
-                self._split(t, tr.position, heads.get(t.track_id))
+            if tr.tracker in splits:
+                self._split(t, splits[tr.tracker], heads.get(t.track_id))
             # (a target that becomes combined and is not its pair's leader: the leader's filter tracks both)
         return self._records(index)
 
@@ -323,6 +331,29 @@ class Limbs3DTracker:
                 head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
                 if head and head[0] is not None:
                     t.home = t.position - head[0]
+
+    def _split_sides(self, splits: dict, heads: dict) -> dict:
+        """The modes the state machine gave two hands of different people that split (``splits``:
+        target -> mode), swapped when the direction cue (sec. 7.1) puts each on the other person's
+        side: the modes' difference points against their heads' by more than ``states.split_heads``
+        (cosine). The direction before the join comes from estimates that may have drifted (a hand
+        lost or on single-view candidates while the hands met); the heads are tracked to 10-50 mm,
+        and after a handshake or an exchange each hand goes back to its own person."""
+        c = self.params.states.split_heads
+        if c >= 1 or len(splits) < 2:
+            return splits
+        out = dict(splits)
+        for k, pos in splits.items():
+            t = self.targets[k]
+            for j, other in splits.items():
+                o = self.targets[j]
+                if j <= k or o.track_id == t.track_id or t.track_id not in heads or o.track_id not in heads:
+                    continue
+                d = np.subtract(pos, other)
+                h = np.subtract(heads[t.track_id], heads[o.track_id])
+                if float(d @ h) < -c * np.linalg.norm(d) * np.linalg.norm(h):
+                    out[k], out[j] = other, pos
+        return out
 
     def _split(self, t: _Target, mode, head) -> None:
         """``t`` leaves its combined pair with ``mode`` (:meth:`_split_position`)."""
