@@ -300,3 +300,5 @@ class LimbParams(Parameters):
         "people_head_top": "people.head_top",
         "people_end_frames": "people.end_frames",
     }
+    #: fields added after partlab 0.2 (no flat name)
+    ADDED: ClassVar[tuple[str, ...]] = ("states.pair_lost_claims",)
