@@ -284,3 +284,45 @@ def test_an_object_passed_between_people_is_an_exchange_and_a_bare_handshake_is_
     truth, found = _activities("handshake", 1)
     assert "exchange" not in set(found["kind"])
     assert evaluate_events(truth, found).loc["handshake", "matched"] == 1
+
+
+def _touch(a, b, start, end, kind="handshake"):
+    return pd.DataFrame([dict(start_frame=start, end_frame=end, kind=kind, track_id_a=a[0], part_a=a[1],
+                              track_id_b=b[0], part_b=b[1], ended_by="split")])
+
+
+def test_a_handshake_whose_hand_went_unseen_after_it_is_read_from_what_was_seen():
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    # b is lost from frame 61 on (it went back behind its person's body); both hands 100 px apart
+    # before and a back at rest after
+    centres = {a: {f: (100.0 if not 40 <= f <= 60 else 195.0, 300.0, 15.0) for f in range(100)},
+               b: {f: (300.0 if f < 40 else 205.0, 300.0, 15.0) for f in range(61)}}
+    bare = {k: {f: [_seen("", 0, 0.0)] for f in c} for k, c in centres.items()}
+    out = recognise(_touch(a, b, 40, 60), bare, centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("handshake", 40, 60)]
+    assert out.confidence.iloc[0] == pytest.approx(P.decision.unseen_confidence)
+    # a colour held where the hands were seen (an object that may have changed hands): not sure
+    held = {k: {f: [_seen("", 40, 0.3 if k == a and f < 40 else 0.0)] for f in c} for k, c in centres.items()}
+    assert recognise(_touch(a, b, 40, 60), held, centres, P).empty
+    # one person's two hands: a hand hidden behind the body whose track wanders onto the other
+    # hand is no clap
+    same = (1, "left_hand")
+    assert recognise(_touch(a, same, 40, 60, "clap"), {a: bare[a], same: bare[b]},
+                     {a: centres[a], same: centres[b]}, P).empty
+    # the rule off (unseen_confidence under min_confidence): nothing, as before
+    off = P.updated({"decision.unseen_confidence": 0.3})
+    assert recognise(_touch(a, b, 40, 60), bare, centres, off).empty
+
+
+def test_a_handshake_over_an_exchange_between_the_same_people_is_its_touch():
+    from partlab.tracking.activities.recognise import _exchange_touches_dropped
+
+    ex = dict(start_frame=34, end_frame=86, kind="exchange", track_id_a=1, part_a="right_hand", track_id_b=2,
+              part_b="right_hand", ended_by="split", object_colour="#00ff00", confidence=0.9)
+    shake = dict(ex, start_frame=37, end_frame=90, kind="handshake", part_a="left_hand", object_colour="")
+    later = dict(shake, start_frame=80, end_frame=140)  # mostly after the exchange: its own
+    others = dict(shake, track_id_a=3)  # another person's
+    out = _exchange_touches_dropped([ex, shake, later, others])
+    assert out == [ex, later, others]

@@ -235,3 +235,32 @@ def test_a_hand_on_its_forearm_is_tracked_at_the_arm_end_not_the_blob_centre():
     centres = LimbParams().updated({"dynamics.particles": 150, "blobs.tip_span": 0.0})
     err0, m0 = centre_error(run(LimbTracker(centres, np.random.default_rng(3), init=init), frames), truth)
     assert err0[m0.part.str.endswith("hand")].max() > 10.0
+
+
+def test_a_clapping_pair_does_not_split_onto_the_blob_where_a_lost_hand_is_looked_for():
+    # another person's hand 25 px below where the clapping hands meet, hidden until frame 24 (its
+    # filter is lost from frame ~5 and looks for it where it started): when it shows, the pair's
+    # second posterior mode would lie there, farther than the split distance, and one clapping hand
+    # would jump onto it; it is the lost hand's to recover
+    frames, truth = clap_scene(34)
+    other = (80, 105)
+    for t in range(24, 34):
+        cv2.circle(frames[t], other, 6, SKIN, -1)
+    extra = pd.DataFrame([(t, 8, "right_hand", other[0] - 6, other[1] - 6, 12, 12) for t in range(34)],
+                         columns=truth.columns)
+    truth = pd.concat([truth, extra], ignore_index=True)
+    tr = LimbTracker(P, np.random.default_rng(0), init=truth[truth.frame == 0])
+    out = run(tr, frames).set_index(["frame", "track_id", "part"])
+    for t in range(24, 30):  # the clap's hands stay together, the lost hand is found on its own blob
+        assert out.loc[(t, 7, "left_hand"), "state"] == "combined"
+        assert out.loc[(t, 7, "right_hand"), "state"] == "combined"
+    assert out.loc[(22, 8, "right_hand"), "state"] == "lost"
+    assert out.loc[(26, 8, "right_hand"), "state"] == "normal"
+    err, m = centre_error(out.reset_index(), truth)
+    assert err[(m.frame >= 26) & (m.track_id == 8)].max() < 4.0
+    # without the lost hand's claim the pair splits onto its blob as soon as it shows
+    old = LimbTracker(P.updated({"states.pair_lost_claims": False}), np.random.default_rng(0),
+                      init=truth[truth.frame == 0])
+    states = run(old, frames).set_index(["frame", "track_id", "part"])["state"]
+    assert any(states[(t, 7, "left_hand")] != "combined" for t in range(24, 30))
+

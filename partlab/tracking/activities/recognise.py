@@ -382,7 +382,8 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
                             object_colour="" if v.colour is None else hue_to_hex(v.colour))
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
-                base.update(kind="clap" if a[0] == b[0] else "handshake", confidence=0.3)
+                base.update(kind="clap" if a[0] == b[0] else "handshake",
+                            confidence=0.3 if a[0] == b[0] else _unseen_confidence(seen, params))
         rows.append(base)
         # a touch is its hands' activity even when it is not reported (a hand unseen at a decision
         # point): reading their still moments on their own instead found one more limbs3d exchange
@@ -391,6 +392,20 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
         busy[a].append((start, end))
         busy[b].append((start, end))
     return rows, busy
+
+
+def _unseen_confidence(seen: list[dict | None], params: ActivityParams) -> float:
+    """How sure a touch of two people's hands with a hand unseen at a decision point is a
+    handshake: 0.3 (not reported), or ``decision.unseen_confidence`` where every decision point
+    that was seen shows no colour held (``min_mass``) and at least ``decision.unseen_min_seen``
+    were seen: no object is around, so none changed hands (a hand the tracker lost as it went back
+    behind its person's body after a handshake). Not for claps: a person's hand hidden behind
+    their body has a track that wanders onto their other hand, which would read as claps."""
+    d = params.decision
+    known = [s for s in seen if s is not None]
+    if len(known) < d.unseen_min_seen or any(m >= d.min_mass for s in known for m in s.values()):
+        return 0.3
+    return d.unseen_confidence
 
 
 def _mass_of(held: Mapping[int, float], hue: int, params: ActivityParams) -> float:
@@ -496,8 +511,24 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
                                  confidence=round(v.margin, 3), hue=v.colour, at=_stood(cs, s0, s1)))
     rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
     rows += other_sides(rows, colours, clothes, params)
-    out = pd.DataFrame(handovers(rows, params), columns=list(ACTIVITY_COLUMNS))
+    out = pd.DataFrame(_exchange_touches_dropped(handovers(rows, params)), columns=list(ACTIVITY_COLUMNS))
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)
+
+
+def _exchange_touches_dropped(rows: list[dict]) -> list[dict]:
+    """``rows`` without the handshakes of two people that overlap an exchange between them by more
+    than half of the shorter (:func:`_overlap`): the touch of the exchange, read by another pair of
+    their hands (the giver's other hand, a hand whose track wandered onto the meeting; limb
+    tracker, exchange seed 5: an exchange 34-86 by the right hands and a handshake 37-90)."""
+    exchanges = [r for r in rows if r["kind"] == "exchange"]
+
+    def touch(r: dict) -> bool:
+        return r["kind"] == "handshake" and any(
+            {r["track_id_a"], r["track_id_b"]} == {e["track_id_a"], e["track_id_b"]}
+            and _overlap((r["start_frame"], r["end_frame"]), (e["start_frame"], e["end_frame"])) > 0.5
+            for e in exchanges)
+
+    return [r for r in rows if not touch(r)]
 
 
 def other_sides(rows: list[dict], colours: Mapping[Key, Mapping[int, list[HandColour]]],

@@ -369,7 +369,9 @@ class LimbTracker:
             if side is not None:  # two hands: each blob's part nearest the pair
                 own_c = seen.not_heads(nearest_part_candidates(seen.cands, seen.points(), tgt.filter.estimate,
                                                                side, p))
-            return self._unclaimed(own_c, exclude=(t, self.machine.partner(t)))
+            # ... nor the place a lost target is looked for: a pair of hands that meet beside a lost
+            # hand's blob (another person's hand the skin model barely sees) would split onto it
+            return self._unclaimed(own_c, exclude=(t, self.machine.partner(t)), lost=p.states.pair_lost_claims)
         tgt.filter.predict(self.rng)
         return self._owned(own_c, t, owners)
 
@@ -605,9 +607,10 @@ class LimbTracker:
                           {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep],
                           None if cands.parents is None else cands.parents[keep])
 
-    def _unclaimed(self, cands: Candidates, exclude: int | tuple) -> Candidates:
+    def _unclaimed(self, cands: Candidates, exclude: int | tuple, lost: bool = False) -> Candidates:
         """Candidates not explained by another active tracker (a lost target must not
-        recover onto a limb someone else tracks)."""
+        recover onto a limb someone else tracks); ``lost``: nor lying where a lost target is looked
+        for (:meth:`_search_centre`)."""
         if len(cands) == 0:
             return cands
         keep = np.ones(len(cands), bool)
@@ -615,9 +618,14 @@ class LimbTracker:
         for t, tgt in self.targets.items():
             if t in exclude or tgt.filter is None:
                 continue
-            if self.machine.state(t) in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
-                d = np.hypot(*(cands.centres - tgt.filter.estimate[None, :]).T)
-                keep &= d > max(tgt.size) / 2 + self.params.priors.sigma_xy
+            state = self.machine.state(t)
+            if state in (LimbState.NORMAL, LimbState.COMBINED, LimbState.UNLABELLED):
+                at = tgt.filter.estimate
+            elif lost and state == LimbState.LOST and tgt.last is not None:
+                at = self._search_centre(t)
+            else:
+                continue
+            keep &= np.hypot(*(cands.centres - at[None, :]).T) > max(tgt.size) / 2 + self.params.priors.sigma_xy
         return self._subset(cands, keep)
 
     def _propose(self, cands: Candidates, observations: dict[int, Observation], people: np.ndarray | None) -> None:
