@@ -347,6 +347,33 @@ def test_two_peoples_hands_that_split_go_back_to_their_own_sides():
     assert off._split_sides(wrong, heads) == wrong
 
 
+def test_a_pair_of_two_peoples_hands_finds_a_hand_that_left_it_unseen():
+    """Handshake seed 8, 4 cameras: the right hand left the handshake while hidden and came back
+    390 mm from the pair (prior 0.93), out of ``states.mode_search`` (300 mm): the pair kept one mode
+    and later split onto a false one (a swap). A candidate beyond it, within ``mode_search_heads``
+    split distances and nearer one of the two heads than the pair, is its second mode; not one of
+    prior below ``mode_heads_prior`` (a false one of 0.67 split seed 6's exchange), nor one that is
+    no nearer either head."""
+    a, b = _two_cameras()
+    tr = Limbs3DTracker(Limbs3DParams(), np.random.default_rng(0), {"cam0": a, "cam1": b})
+    t = tr.targets[tr._add(1, "right_hand", 0, np.zeros(3), LimbState.NORMAL)]
+    est = np.array([0.0, 0.0, 1000.0])
+    heads = [np.array([400.0, 0.0, 1400.0]), np.array([-400.0, 0.0, 1400.0])]
+    back = np.array([350.0, 0.0, 900.0])  # 350 mm from the pair, 502 from head 1 (the pair: 566)
+    aside = np.array([0.0, 350.0, 1000.0])  # 350 mm from the pair, 665 from both heads
+
+    def modes(point, w, params=tr.params, pair_heads=heads):
+        tr.params = params
+        pts, ws = np.array([est, point]), np.array([1.0, w])
+        return tr._combined_modes(t, est, np.arange(2), pts, ws, [], np.zeros((0, 3)), pair_heads)
+
+    assert modes(back, 0.93) == (tuple(est), tuple(back))
+    assert modes(back, 0.67) == (tuple(est),)
+    assert modes(aside, 0.93) == (tuple(est),)
+    assert modes(back, 0.93, pair_heads=[]) == (tuple(est),)  # one person's hands: the usual search
+    assert modes(back, 0.93, Limbs3DParams().updated({"states.mode_search_heads": 2.5})) == (tuple(est),)
+
+
 def test_frames_that_cannot_see_a_target_do_not_lose_it():
     m = LimbStateMachine(Limbs3DParams())
     m.add(0, LimbState.NORMAL)

@@ -248,6 +248,16 @@ class Limbs3DStates:
     history_frames: int = number(10, COUNT)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
+    # a combined pair of two people's hands with one mode also takes for its second a candidate of
+    # prior >= mode_heads_prior beyond mode_search but within mode_search_heads split distances of
+    # the first, nearer one of the two heads than the first and within dynamics.hand_reach of it
+    # (tracker._mode_towards_head; our addition). Handshake seed 8, 4 cameras: the right hand left
+    # the handshake while hidden (frames 60-62, its only candidate a ghost of two shared blobs) and
+    # came back 390 mm from the pair, out of mode_search: the pair stayed on the other hand and
+    # split onto a false mode (swap, 143 -> 52 mm). The prior: a false candidate of 0.67 399 mm
+    # from every part split a pair during seed 6's exchange (39 -> 64 mm); 2.5 = off
+    mode_search_heads: float = number(4.0, POSITIVE)
+    mode_heads_prior: float = number(0.8, FRACTION)
     # two hands of different people that split take their modes by the direction cue unless that puts
     # each on the other's side: the modes' difference against their heads' by more than this cosine
     # (tracker._split_sides; our addition). Handshake seed 3, 3 cameras: a lost hand and one drifting

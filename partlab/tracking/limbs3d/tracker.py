@@ -290,7 +290,7 @@ class Limbs3DTracker:
                    "unseen": unseen}
             if m.state(k) == LimbState.COMBINED:
                 obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
-                                                    np.delete(preds, a, axis=0))
+                                                    np.delete(preds, a, axis=0), self._pair_heads(k, heads))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -598,12 +598,22 @@ class Limbs3DTracker:
         self._sight_modes.append((np.asarray(best[0], float), best[1], best[2]))
         return (tuple(first), tuple(best[0]))
 
+    def _pair_heads(self, k: int, heads: dict) -> list:
+        """The heads of combined target ``k``'s and its partner's people when they are two people."""
+        partner = self.machine.partner(k)
+        if partner is None:
+            return []
+        ids = {self.targets[k].track_id, self.targets[partner].track_id}
+        return [heads[i] for i in ids if i in heads] if len(ids) == 2 else []
+
     def _combined_modes(self, t: _Target, est, idx: np.ndarray, points: np.ndarray, weights: np.ndarray, centres,
-                        others: np.ndarray) -> tuple:
+                        others: np.ndarray, pair_heads: list | None = None) -> tuple:
         """The modes of combined target ``t`` (the pair's leader) from the candidates ``idx`` it may
         use (:meth:`_modes`) and, with ``dynamics.line_of_sight`` and one mode of pairs, a second
         seen by a single view once it parts (:meth:`_single_view_mode`, :meth:`_parting`)."""
         modes = self._modes(est, points[idx], weights[idx])
+        if len(modes) == 1 and pair_heads:
+            modes = self._mode_towards_head(modes, points[idx], weights[idx], pair_heads)
         if len(modes) >= 2 or not self._line_of_sight:
             t.parting = []
             return modes
@@ -633,6 +643,29 @@ class Limbs3DTracker:
             return mode
         cam, v = self.cameras[sight[0][1]], sight[0][2]
         return cam.centre + v * float(v @ (np.asarray(head, float) + t.home - cam.centre))
+
+    def _mode_towards_head(self, modes: tuple, points: np.ndarray, weights: np.ndarray, pair_heads: list) -> tuple:
+        """``modes`` (one) and, for a pair of two people's hands, a second: the strongest candidate
+        beyond the usual search but within ``states.mode_search_heads`` split distances of the first
+        that is nearer one of the two heads than the first and within
+        ``dynamics.hand_reach`` of it (a hand leaving a handshake while hidden comes back on its own
+        person's side, out of the pair's reach)."""
+        p = self.params
+        if p.states.mode_search_heads <= p.states.mode_search or not len(points):
+            return modes
+        first = np.asarray(modes[0], float)
+        d = np.linalg.norm(points - first, axis=1)
+        ok = (d >= p.states.mode_search * p.states.split_distance) & (
+            d < p.states.mode_search_heads * p.states.split_distance) & (weights >= p.states.mode_heads_prior)
+        towards = np.zeros(len(points), bool)
+        for h in pair_heads:
+            dh = np.linalg.norm(points - h, axis=1)
+            towards |= (dh < np.linalg.norm(first - h)) & (
+                dh <= (p.dynamics.hand_reach or np.inf))
+        ok &= towards
+        if not ok.any():
+            return modes
+        return (modes[0], tuple(points[np.flatnonzero(ok)[np.argmax(weights[ok])]]))
 
     def _modes(self, est, points, weights) -> tuple:
         """The combined posterior's two strongest modes: the strongest candidate near the filter,
