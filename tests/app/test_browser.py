@@ -194,6 +194,7 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
         df = store.frame_boxes(clip.id, 0)
         return df[(df.part == "head") & (df.track_id == 1)].iloc[0]
 
+    _focus_editor(page)
     page.keyboard.press("Control+z")
     _wait_for(lambda: int(head_now().revision) == 3, what="the undo")
     assert not bool(head_now().failure) and head_now().x == head1.x
@@ -201,6 +202,7 @@ def test_upload_track_drag_and_flag_in_the_browser(server, page, store, scene, t
     # for the run to end, and press once more if nothing came (a redo with nothing left is a no-op)
     _settled(page)
     for attempt in range(3):
+        _focus_editor(page)  # the undo's rerun redraws the editor, which may take the focus away
         page.keyboard.press("Control+y")
         try:
             _wait_for(lambda: int(head_now().revision) == 4, timeout=10, what="the redo")
