@@ -236,35 +236,33 @@ def _centres(df: pd.DataFrame) -> pd.DataFrame:
 
 def _detection_velocities(det: pd.DataFrame, window: int) -> pd.DataFrame:
     """Per matched detection, the velocity the detection cue keeps for its person
-    (:meth:`partlab.tracking.body.cue.DetectionCue._seen`: the motion since the person's previous
-    detection at most ``window`` frames before, averaged with the previous estimate)."""
+    (:func:`partlab.tracking.body.cue.detection_velocity`)."""
+    from partlab.tracking.body.cue import detection_velocity
+
     rows = []
     for tid, g in det.sort_values("frame").groupby("truth"):
         prev, old = None, None
         for r in g.itertuples():
-            cx, cy = r.x + r.w / 2, r.y + r.h / 2
-            if prev is not None and 0 < r.frame - prev[0] <= window:
-                v = np.array([cx - prev[1], cy - prev[2]]) / (r.frame - prev[0])
-                old = v if old is None else 0.5 * (v + old)
+            now = (r.frame, r.x + r.w / 2, r.y + r.h / 2)
+            old = detection_velocity(prev, now, old, window)
+            if old is not None:
                 rows.append((r.frame, tid, *old))
-            else:
-                old = None
-            prev = (r.frame, cx, cy)
+            prev = now
     return pd.DataFrame(rows, columns=["frame", "track_id", "vx", "vy"])
 
 
 def _tracker_velocities(tracked: pd.DataFrame, window: int) -> pd.DataFrame:
     """Per frame and track, the velocity the tracker coasts on (:func:`partlab.tracking.body.tracker
-    ._median_velocity`: the median per-frame motion of its person box over the last ``window`` frames)."""
+    .median_velocity` of its person box over the last ``window`` frames, none across a gap)."""
+    from partlab.tracking.body.tracker import median_velocity
+
     c = _centres(tracked[tracked["part"] == "person"])
     rows = []
     for tid, g in c.sort_values("frame").groupby("track_id"):
-        f, xy = g["frame"].to_numpy(), g[["cx", "cy"]].to_numpy()
+        fc = g[["frame", "cx", "cy"]].to_numpy(float)
         for k in range(window, len(g)):
-            seg_f, seg = f[k - window:k + 1], xy[k - window:k + 1]
-            if seg_f[-1] - seg_f[0] != window:
-                continue  # a gap: the tracker's history restarts
-            rows.append((f[k], tid, *np.median(np.diff(seg, axis=0), axis=0)))
+            if fc[k, 0] - fc[k - window, 0] == window:  # no gap: the tracker's history is whole
+                rows.append((int(fc[k, 0]), tid, *median_velocity(fc[k - window:k + 1])))
     return pd.DataFrame(rows, columns=["frame", "track_id", "vx", "vy"])
 
 

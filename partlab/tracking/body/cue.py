@@ -79,6 +79,16 @@ def _within(box: Box, layout: Box, tolerance: float) -> Box:
     return Box(cx - w / 2, cy - h / 2, w, h)
 
 
+def detection_velocity(prev, now, old, window: int) -> np.ndarray | None:
+    """The per-frame motion a track's detections show: from ``prev`` to ``now`` (``(frame, cx,
+    cy)``, at most ``window`` frames apart) averaged with the previous estimate ``old``; None when
+    ``prev`` is missing or too far back (the estimate starts again)."""
+    if prev is None or not 0 < now[0] - prev[0] <= window:
+        return None
+    v = np.array([now[1] - prev[1], now[2] - prev[2]]) / (now[0] - prev[0])
+    return v if old is None else 0.5 * (v + old)
+
+
 class DetectionCue:
     """The detector, the unconfirmed detections and, per track, the frame a detection last
     matched it."""
@@ -177,15 +187,13 @@ class DetectionCue:
     def _seen(self, track_id: int, index: int, det: Box) -> None:
         """Remember where a detection saw the track and how fast it moved since the one before
         (within ``velocity_frames``; averaged with the previous estimate)."""
-        cx, cy = det.centre
-        prev = self.last_seen.get(track_id)
-        if prev is not None and 0 < index - prev[0] <= self.p.velocity_frames:
-            v = np.array([cx - prev[1], cy - prev[2]]) / (index - prev[0])
-            old = self.velocity.get(track_id)
-            self.velocity[track_id] = v if old is None else 0.5 * (v + old)
-        else:
+        now = (index, *det.centre)
+        v = detection_velocity(self.last_seen.get(track_id), now, self.velocity.get(track_id), self.p.velocity_frames)
+        if v is None:
             self.velocity.pop(track_id, None)
-        self.last_seen[track_id] = (index, cx, cy)
+        else:
+            self.velocity[track_id] = v
+        self.last_seen[track_id] = now
 
     def _steer_motion(self, person) -> None:
         """``steer_velocity`` (``steer_velocity_auto`` in automatic runs): every part's velocity goes

@@ -121,7 +121,7 @@ class Person:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
         (not touching anyone, not occluded: another person passing in front drags the
         estimate before the occlusion is decided); None if too few."""
-        return _median_velocity(self.centres)
+        return median_velocity(self.centres)
 
     def part_boxes(self) -> dict[str, Box]:
         return {name: f.box for name, f in self.filters.items()}
@@ -130,7 +130,7 @@ class Person:
         return minimum_bounding_rectangle(f.box for f in self.filters.values())
 
 
-def _median_velocity(centres) -> np.ndarray | None:
+def median_velocity(centres) -> np.ndarray | None:
     """Median per-frame motion of ``(frame, cx, cy)`` entries; None if fewer than three."""
     if len(centres) < 3:
         return None
@@ -713,7 +713,7 @@ class BodyTracker:
         when too few frames tell), rather than from wherever the frames since took it (a still
         object of its colours). Moves every part there; returns the velocity."""
         before = [c for c in person.centres if c[0] < person.lost_since]
-        v = _median_velocity(before)
+        v = median_velocity(before)
         v = np.zeros(2) if v is None else v
         if before:
             frame, cx, cy = before[-1]
