@@ -1,13 +1,14 @@
 """What `partlab track` loads (issue 12: start-up). A 5-frame track spends most of its time
-importing; these are packages the command line and the tracking path must not pay for (numba
-itself imports scipy and scipy.linalg: those are its price)."""
+importing; these are packages the command line and the tracking path must not pay for (numba's
+compiler is set up without scipy's BLAS and cffi: ``partlab.tracking.core.kernels.prepare``)."""
 
 import subprocess
 import sys
 
 import pytest
 
-HEAVY = ("sqlalchemy", "alembic", "scipy.optimize", "streamlit", "distributed", "sklearn", "plotly")
+HEAVY = ("sqlalchemy", "alembic", "scipy.optimize", "scipy.linalg", "cffi", "streamlit", "distributed", "sklearn",
+         "plotly")
 
 
 @pytest.fixture(scope="module")

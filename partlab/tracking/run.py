@@ -77,7 +77,10 @@ def build_tracker(name: str, *, model: Any = None, seed: int = 0, context: Track
                   rngs: Mapping[str, np.random.Generator] | None = None) -> Tracker:
     """Tracker ``name`` of the registry with ``model``'s parameters (``rngs``: generators per
     parameter key, by default :func:`seeded_streams` of ``seed``)."""
+    from partlab.tracking.core import kernels
+
     entry = registry.get(name)
+    kernels.prepare()  # numba's compiler set up without what the kernels never use (start-up time)
     params = {k: model_params(model, k) for k in entry.param_keys}
     rngs = dict(rngs) if rngs is not None else seeded_streams(seed, entry.param_keys)
     return registry.load(entry.factory)(params, rngs, context or TrackContext())

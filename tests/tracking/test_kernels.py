@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -127,3 +130,25 @@ def test_fused_resample_matches_the_two_steps():
     assert len(new) == n and 200 <= n < 360  # peaked weights: fewer than C N
     assert np.array_equal(new, particles[kernels.systematic_indices(w, n, 0.37)])
     assert np.all(weights == 1.0 / n)
+
+
+def test_prepare_sets_up_numba_without_blas_or_cffi_and_leaves_them_importable():
+    """``kernels.prepare`` keeps scipy's BLAS and cffi out of numba's set-up (start-up time), yet a
+    later import of either works and the kernels compute as before (a fresh process: the set-up
+    happens once per process)."""
+    code = (
+        "import sys\n"
+        "import numpy as np\n"
+        "from partlab.tracking.core import kernels\n"
+        "kernels.prepare()\n"
+        "assert 'scipy.linalg' not in sys.modules and 'cffi' not in sys.modules, sorted(sys.modules)\n"
+        "from numba.np import arraymath\n"
+        "assert arraymath._HAVE_BLAS is False\n"
+        "import cffi, scipy.linalg.cython_blas, scipy.linalg\n"
+        "print(scipy.linalg.solve(np.eye(2) * 2.0, np.ones(2)).tolist(), cffi.FFI().sizeof('int'))\n"
+        "states = np.array([[10.4, 20.6, 5.0, 7.0], [0.0, 0.0, 50.0, 50.0]], np.float32)\n"
+        "print(kernels.rectangles(states, 30, 30).tolist())\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split("\n")
+    assert out[0] == "[0.5, 0.5] 4"
+    assert out[1] == "[[8, 17, 13, 24], [0, 0, 25, 25]]"

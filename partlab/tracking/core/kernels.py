@@ -15,6 +15,9 @@ where it cannot be installed). Compiled code is cached on disk (``cache=True``).
 
 from __future__ import annotations
 
+import sys
+import threading
+
 import numpy as np
 
 try:
@@ -23,6 +26,36 @@ except ImportError:  # pragma: no cover - numba is a dependency; numpy fallback
     numba = None
 
 HAVE_NUMBA = numba is not None
+
+# What numba's CPU target imports when it is set up (at the first call of any compiled function) for
+# features no kernel here uses: scipy's BLAS (``numba.np.arraymath`` checks for it on import, for
+# ``np.dot``/``np.vdot``/``np.inner``) and cffi (calling C functions declared with cffi). Together they
+# are 0.15-0.25 s of a 5-frame ``partlab track`` (docs/measurements/startup.md).
+UNUSED_BY_KERNELS = ("scipy.linalg.cython_blas", "cffi")
+_prepared = False
+
+
+def prepare() -> None:
+    """Set up numba's CPU target once, before the first kernel call, without importing
+    :data:`UNUSED_BY_KERNELS` (numba then treats them as absent: ``np.vdot``/``np.inner`` in compiled
+    code fall back to a plain loop; ``np.dot`` would still load BLAS when compiled). Later imports of
+    those modules work as usual. Skipped when other Python threads run, which could import one of
+    them meanwhile; the kernels and their results are the same either way."""
+    global _prepared
+    if _prepared or not HAVE_NUMBA:
+        return
+    _prepared = True
+    from numba.core.registry import cpu_target
+
+    blocked = [m for m in UNUSED_BY_KERNELS if m not in sys.modules] if threading.active_count() == 1 else []
+    for m in blocked:
+        sys.modules[m] = None  # an import of it raises ImportError, which numba takes as "not installed"
+    try:
+        cpu_target.target_context.refresh()
+    finally:
+        for m in blocked:
+            if m in sys.modules and sys.modules[m] is None:
+                del sys.modules[m]
 
 
 def _jit(fn=None, **options):
