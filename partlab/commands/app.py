@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import signal
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -186,11 +187,30 @@ def run(args) -> int:
     if args.scheduler:
         env["PARTLAB_SCHEDULER"] = args.scheduler
     try:
-        return subprocess.call(streamlit_command(args.host, args.port, args.allowed_hosts), env=env)
+        return serve(streamlit_command(args.host, args.port, args.allowed_hosts), env)
     finally:
         said = job_service_note() if args.jobs == "engine" and not args.scheduler else None
         if said:
             print(said, flush=True)
+
+
+def serve(command: list[str], env: dict[str, str]) -> int:
+    """Run the Streamlit server ``command`` until it exits; a SIGTERM or SIGHUP to ``partlab app``
+    (a service manager stopping it, a closed terminal) is passed on to the server, which then stops
+    too instead of being left running without its parent. Returns the server's exit code."""
+    proc = subprocess.Popen(command, env=env)
+
+    def stop(signum, _frame):
+        proc.send_signal(signum)
+
+    previous = {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)}
+    try:
+        return proc.wait()
+    except KeyboardInterrupt:  # Ctrl+C reaches the whole process group: let the server finish stopping
+        return proc.wait()
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 def job_service_note() -> str | None:

@@ -91,3 +91,45 @@ def test_when_the_server_stops_it_says_the_job_service_runs_on_and_how_to_stop_i
         said = job_service_note()
         assert "keeps running" in said and said.endswith("kill 4242")
     assert job_service_note() is None  # its address no longer answers: it has stopped
+
+
+def test_a_sigterm_to_partlab_app_stops_its_server_too(tmp_path):
+    """A service manager stops ``partlab app`` with SIGTERM to that process alone; the Streamlit
+    server it started must stop with it, not keep the port open without a parent."""
+    import contextlib
+    import os
+    import signal
+    import socket
+    import subprocess
+    import sys
+    import time
+    import urllib.request
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    proc = subprocess.Popen([sys.executable, "-m", "partlab", "app", "--port", str(port)], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, env={**os.environ, "PARTLAB_DATA": str(tmp_path)},
+                            start_new_session=True)
+
+    def answers() -> bool:
+        try:
+            urllib.request.urlopen(f"http://127.0.0.1:{port}/_stcore/health", timeout=2)
+            return True
+        except OSError:
+            return False
+
+    try:
+        deadline = time.time() + 120
+        while not answers():
+            assert proc.poll() is None and time.time() < deadline, "the app did not start"
+            time.sleep(0.5)
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=30)
+        deadline = time.time() + 30
+        while answers() and time.time() < deadline:
+            time.sleep(0.5)
+        assert not answers(), "the server outlived partlab app"
+    finally:
+        with contextlib.suppress(ProcessLookupError):  # the server too, if it outlived partlab app
+            os.killpg(proc.pid, signal.SIGKILL)
