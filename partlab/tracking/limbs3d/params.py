@@ -246,6 +246,12 @@ class Limbs3DStates:
     start_prior: float = number(0.5, FRACTION)
     # frames of estimates kept to read the direction between two targets before they join
     history_frames: int = number(10, COUNT)
+    # a lost hand is held (and looked for) where it was relative to its person's head when last
+    # tracked alone from pairs of views (its home), not where it was lost (our addition; the lost
+    # state "uses prior information of the target position to retrieve the track", sec. 5.2):
+    # hands rest by their own body, and one lost while two people's hands met was held between
+    # them. Before 2026-12-06 only a hand that had left a combined pair was. False = that
+    lost_home: bool = flag(True)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of
