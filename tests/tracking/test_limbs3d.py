@@ -474,3 +474,35 @@ def test_a_hand_that_finds_nothing_after_a_split_goes_back_where_it_came_from():
     e = e[(e["track_id"] == 1) & (e["part"] == "right_hand") & e["frame"].between(64, 68)]
     err = np.linalg.norm(e[["X", "Y", "Z"]].to_numpy(float) - e[["X_t", "Y_t", "Z_t"]].to_numpy(float), axis=1)
     assert len(err) == 5 and err.max() < 60  # main before: 301, 360, 390, 388, 260 mm
+
+
+def _lost_hand_error(scene, params: Limbs3DParams, offset=(500.0, 0.0, 0.0)) -> list[float]:
+    """The right hand's 3D error at frames 6-8 of ``scene`` when it is put in the lost state after
+    frame 5, ``offset`` mm from where it was (a hand lost after drifting off)."""
+    cams = {c.name: c for c in scene.cameras}
+    tr = Limbs3DTracker(params, np.random.default_rng(0), cams, init=scene.init, backgrounds=scene.backgrounds)
+    truth = scene.truth3d.set_index(["frame", "track_id", "part"])[["X", "Y", "Z"]]
+    key = next(k for k, t in tr.targets.items() if t.part == "right_hand")
+    out = []
+    for i in range(9):
+        tr.step(FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}), {c: None for c in cams})
+        t = tr.targets[key]
+        if i == 5:
+            tr.machine._status[key].state = LimbState.LOST
+            t.position = t.position + np.asarray(offset)
+        elif i > 5:
+            out.append(float(np.linalg.norm(t.position - truth.loc[(i, t.track_id, t.part)].to_numpy(float))))
+    return out
+
+
+def test_a_lost_hand_is_held_where_it_was_relative_to_its_head():
+    """A lost hand is held, and looked for, at its home (where it was relative to its head when last
+    tracked alone from pairs of views), not where it was lost (``states.lost_home``; before
+    2026-12-06 only a hand that had left a combined pair was). Standing, 2 cameras: the right hand,
+    put in the lost state 500 mm from where it was, stays 500 mm off with the rule off; with it, it is
+    held at its home and found again there."""
+    scene = make_multiview_scene("standing", 2, seed=0, n_frames=9)
+    before = _lost_hand_error(scene, Limbs3DParams().updated({"states.lost_home": False}))
+    after = _lost_hand_error(scene, Limbs3DParams())
+    assert min(before) > 450
+    assert max(after) < 60

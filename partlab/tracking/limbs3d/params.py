@@ -246,6 +246,16 @@ class Limbs3DStates:
     start_prior: float = number(0.5, FRACTION)
     # frames of estimates kept to read the direction between two targets before they join
     history_frames: int = number(10, COUNT)
+    # a lost hand is held (and looked for) where it was relative to its person's head when last
+    # tracked alone from pairs of views (its home), not where it was lost (our addition; the lost
+    # state "uses prior information of the target position to retrieve the track", sec. 5.2): a
+    # hand lost after falling behind or drifting was held where nothing is, between two people
+    # (handshake 3 cameras seed 4: 355-440 mm off). Before 2026-12-06 only a hand that had left a
+    # combined pair was. Seeds 0-9: swaps handshake 3/3/5 -> 1/1/5 at 2/3/4 cameras, standing 2
+    # cameras 3 -> 2, mean errors within 0.5 mm; the tracked hands meet in less of the handshake
+    # (3 cameras 0.63 -> 0.54); held-out seeds 10-14: swaps 7 -> 9, 4 cameras 42 -> 52 mm, 2-3 cameras
+    # better (a small gain, not robust). False = before
+    lost_home: bool = flag(True)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of

@@ -281,10 +281,10 @@ class Limbs3DTracker:
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             est = self._back_home(t, est, heads.get(t.track_id))
             if m.state(k) != LimbState.LOST or t.filter.confidence >= p.states.recover_likelihood:
-                t.position = est  # a lost target stays where it was lost until something is found there
+                t.position = est  # a lost target is held until something is found where it is held
             else:
-                if t.returning and t.home is not None and heads.get(t.track_id) is not None:
-                    t.position = heads[t.track_id] + t.home  # ... or, leaving a pair, where it came from
+                if (t.returning or p.states.lost_home) and t.home is not None and heads.get(t.track_id) is not None:
+                    t.position = heads[t.track_id] + t.home  # ... or at its home (states.lost_home)
                 est = t.position
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled,
                    "unseen": unseen}
