@@ -254,8 +254,9 @@ class Limbs3DStates:
     # combined pair was. Seeds 0-9: swaps handshake 3/3/5 -> 1/1/5 at 2/3/4 cameras, standing 2
     # cameras 3 -> 2, mean errors within 0.5 mm; the tracked hands meet in less of the handshake
     # (3 cameras 0.63 -> 0.54); held-out seeds 10-14: swaps 7 -> 9, 4 cameras 42 -> 52 mm, 2-3 cameras
-    # better (a small gain, not robust). False = before
-    lost_home: bool = flag(True)
+    # better (a small gain, not robust; 3-camera activities: exchange precision 1.00 -> 0.50, false
+    # picks 1 -> 4), so it stays off: False = before
+    lost_home: bool = flag(False)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of
