@@ -383,3 +383,18 @@ def test_a_part_mostly_outside_the_frame_has_no_truth_row():
     assert _warped_extent(mask, 97, 40, warp, 100, 100, MIN_IN_FRAME) is None
     # 6 columns (60 %) inside: still a part in view
     assert _warped_extent(mask, 94, 40, warp, 100, 100, MIN_IN_FRAME) == (94, 40, 6, 20)
+
+
+def test_random_people_start_once_in_view_and_not_mostly_hidden():
+    from partlab.labelling.synth.scene import MAX_START_HIDDEN
+
+    scene = make_scene("random", seed=0, n_frames=12, width=320, height=240)
+    person = scene.truth[scene.truth.part == "person"].set_index(["track_id", "frame"])
+    starts = scene.init.groupby("track_id")["frame"].min()
+    # people 1 and 5 stand half or more behind others at frame 0: they start when they come out
+    assert person.loc[(1, 0), "occluded"] > 0.5 and person.loc[(5, 0), "occluded"] > 0.7
+    assert (starts[1], starts[5]) == (3, 2)
+    for tid, frame in starts.items():
+        hidden = person.loc[(tid, slice(None)), "occluded"].to_numpy()
+        if (hidden <= MAX_START_HIDDEN).any():  # else: never in view, started where it shows most
+            assert person.loc[(tid, frame), "occluded"] <= MAX_START_HIDDEN

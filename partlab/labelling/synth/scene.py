@@ -66,6 +66,10 @@ SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
 #: a body part (not the person) has a truth row only while at least this share of its pixels lies
 #: inside the frame (the tracker's own rule for a person leaving: ``detection.leave_fraction``)
 MIN_IN_FRAME = 0.5
+#: a randomized scene's person starts (its ``init`` row) at the first frame it is wholly inside the
+#: frame with at most this share of it hidden by others: nobody can draw, nor a tracker learn the
+#: colours of, a person standing mostly behind someone else
+MAX_START_HIDDEN = 0.25
 
 
 @dataclass(frozen=True, eq=False)
@@ -305,10 +309,10 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
     truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
-    if name == "random":  # people walking in start where an annotator would: once wholly in view
+    if name == "random":  # people start where an annotator would: once wholly in view, not hidden
         person = truth[truth["part"] == "person"]
         inside = person[(person["x"] >= 2) & (person["y"] >= 2) & (person["x"] + person["w"] <= width - 2)
-                        & (person["y"] + person["h"] <= height - 2)]
+                        & (person["y"] + person["h"] <= height - 2) & (person["occluded"] <= MAX_START_HIDDEN)]
         start = inside.groupby("track_id")["frame"].min()
         # never wholly in view: start at the frame it shows most of itself
         largest = person.assign(a=person["w"] * person["h"]).sort_values("a").groupby("track_id")["frame"].last()
