@@ -9,9 +9,11 @@ person's own body hides completely (a far hand behind the hips) falls back to it
 whole drawn shape. A truth row's box is the tight extent of those pixels inside the
 frame (``x, y`` the first column/row, ``w, h`` the number of columns/rows spanned),
 and ``occluded`` is the fraction of them where another person or an occluder is
-visible instead. Hidden parts keep their rows; parts entirely outside the frame have
-none. ``person`` is the extent of the whole drawn figure (head, torso, hip-leg, arms
-and hands).
+visible instead. Hidden parts keep their rows; a part with less than :data:`MIN_IN_FRAME`
+of its pixels inside the frame has none (a person walking out leaves a shoe of 7 x 15 px, or a
+single pixel at a corner, for several frames: a box there says nothing about where the part
+is, and Zhao & Lee count only people in view). ``person`` is the extent of the whole drawn
+figure (head, torso, hip-leg, arms and hands), written while any of it is in the frame.
 
 A tilted camera (the randomized scenes, :meth:`Camera.drawing`) is drawn on a larger canvas
 seen through a vertical image plane, then every frame is warped into the tilted camera's frame
@@ -61,6 +63,13 @@ EVENT_TRUTH_COLUMNS = ("kind", "start_frame", "end_frame", "track_id_a", "part_a
 FPS = 25.0
 OCCLUDER_ID = 255
 SKIN_LABELS = (FACE, HAND_LEFT, HAND_RIGHT, FOREARM, NECK)
+#: a body part (not the person) has a truth row only while at least this share of its pixels lies
+#: inside the frame (the tracker's own rule for a person leaving: ``detection.leave_fraction``)
+MIN_IN_FRAME = 0.5
+#: a randomized scene's person starts (its ``init`` row) at the first frame it is wholly inside the
+#: frame with at most this share of it hidden by others: nobody can draw, nor a tracker learn the
+#: colours of, a person standing mostly behind someone else
+MAX_START_HIDDEN = 0.25
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,11 +150,12 @@ def random_size(seed: int) -> tuple[int, int]:
     return RANDOM_SIZES[int(np.random.default_rng([seed, 99]).integers(len(RANDOM_SIZES)))]
 
 def _warped_extent(mask: np.ndarray, x0: int, y0: int, warp: np.ndarray, width: int,
-                   height: int) -> tuple[int, int, int, int] | None:
+                   height: int, min_inside: float = 0.0) -> tuple[int, int, int, int] | None:
     """``(x, y, w, h)`` of the pixels of ``mask`` (placed at ``(x0, y0)`` on the canvas) carried
-    into the frame by the homography ``warp``, those inside it only; None when none land inside.
-    Wholly inside: the corners of each row's first and last pixel; cut by the frame's edge: the
-    centre of every pixel (the parts inside a slanted cut are not a box's corners)."""
+    into the frame by the homography ``warp``, those inside it only; None when less than
+    ``min_inside`` of them (or none) land inside. Wholly inside: the corners of each row's first
+    and last pixel; cut by the frame's edge: the centre of every pixel (the parts inside a
+    slanted cut are not a box's corners)."""
     def carried(xs, ys):
         p = warp @ np.stack([xs + x0, ys + y0, np.ones_like(xs)])
         return p[0] / p[2], p[1] / p[2]
@@ -159,7 +169,7 @@ def _warped_extent(mask: np.ndarray, x0: int, y0: int, warp: np.ndarray, width: 
         ys, xs = np.nonzero(mask)
         px, py = carried(xs + 0.5, ys + 0.5)
         inside = (px >= 0) & (py >= 0) & (px < width) & (py < height)
-        if not inside.any():
+        if not inside.any() or inside.mean() < min_inside:
             return None
         px, py = px[inside], py[inside]
     x1, y1 = max(int(np.floor(px.min())), 0), max(int(np.floor(py.min())), 0)
@@ -181,16 +191,19 @@ def _truth_rows(i: int, drawn: list, owner: np.ndarray, warp: np.ndarray | None 
         parts = {"person": lab > 0}
         for p in FIGURE_PARTS:
             if p in fig.masks:
-                whole = fig.masks[p][crop]
-                shown = whole & np.isin(lab, PART_LABELS[p])
-                parts[p] = shown if shown.any() else whole
+                whole = fig.masks[p]
+                shown = whole & np.isin(fig.labels, PART_LABELS[p])
+                shape = shown if shown[crop].any() else whole
+                if warp is None and np.count_nonzero(shape[crop]) < MIN_IN_FRAME * np.count_nonzero(shape):
+                    continue  # mostly outside the frame (the canvas is the frame)
+                parts[p] = shape[crop]
         for part, mask in parts.items():
             total = int(mask.sum())
             if total == 0:
                 continue
             visible = int(np.count_nonzero(own[mask] == a + 1))
             if warp is not None:
-                box = _warped_extent(mask, cx1, cy1, warp, *size)
+                box = _warped_extent(mask, cx1, cy1, warp, *size, 0.0 if part == "person" else MIN_IN_FRAME)
                 if box is None:
                     continue
                 rows.append((i, a + 1, part, *box, round(1.0 - visible / total, 4)))
@@ -296,10 +309,10 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
     truth = truth.assign(_p=truth["part"].map(order)).sort_values(["frame", "track_id", "_p"], kind="stable")
     truth = normalise_tracks(truth.drop(columns="_p"))
     first = truth.groupby("track_id")["frame"].transform("min")
-    if name == "random":  # people walking in start where an annotator would: once wholly in view
+    if name == "random":  # people start where an annotator would: once wholly in view, not hidden
         person = truth[truth["part"] == "person"]
         inside = person[(person["x"] >= 2) & (person["y"] >= 2) & (person["x"] + person["w"] <= width - 2)
-                        & (person["y"] + person["h"] <= height - 2)]
+                        & (person["y"] + person["h"] <= height - 2) & (person["occluded"] <= MAX_START_HIDDEN)]
         start = inside.groupby("track_id")["frame"].min()
         # never wholly in view: start at the frame it shows most of itself
         largest = person.assign(a=person["w"] * person["h"]).sort_values("a").groupby("track_id")["frame"].last()
