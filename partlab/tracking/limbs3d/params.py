@@ -219,6 +219,15 @@ class Limbs3DDynamics:
     # 4 cameras 69.9 -> 69.4 mm (0.34 -> 0.46); standing and seated unchanged. False = main before
     line_of_sight: bool = flag(True)
     single_view_depth: float = number(600.0, POSITIVE)
+    # a head uses no candidate that shares a blob with the candidate of more views another person's
+    # tracked target claims (the one nearest its prediction within candidate_gate; our addition,
+    # sec. 6.4's ghosts for heads): in a view where two heads lie on one line of sight the nearer
+    # hides the farther, and the nearer's blob paired with the farther head's blob in a second view
+    # makes a ghost beside the farther head, inside every silhouette (p_b ~1); a head seen by one
+    # view slid 200 mm down onto one and stayed there (handshake seed 8, 3 cameras). The head
+    # keeps its single-view candidates. A no-op with two cameras (every candidate is a pair).
+    # Seeds 0-9 (docs/measurements/limbs3d.md, 2026-12-06 hs3d): see there. False = before
+    head_own_blobs: bool = flag(True)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
     # often nearer the other hand's candidates than that hand's own lagging prediction
