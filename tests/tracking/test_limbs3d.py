@@ -528,12 +528,12 @@ def test_a_head_does_not_take_a_ghost_made_from_the_other_persons_head_blob():
     camera 0 person 2's head, nearer, hides it on one line of sight). Camera 0's blob of person 2's
     head, which person 2's 3-view candidate uses, paired with camera 1's blob of person 1's face
     makes a ghost ~200 mm below person 1's head, inside every silhouette: the head slid onto it and
-    stayed (170-217 mm off in frames 25-39 with ``dynamics.head_own_blobs`` off, main before
-    2026-12-06). With the rule the head leaves that pair to the head that claims its blob and keeps
-    its single-view candidate: 77-92 mm (the depth along camera 1's line of sight still drifts)."""
+    stayed (170-217 mm off in frames 25-39 with ``dynamics.head_own_blobs`` off, the default). With
+    the rule the head leaves that pair to the head that claims its blob and keeps its single-view
+    candidate: 77-92 mm (the depth along camera 1's line of sight still drifts)."""
     scene = make_multiview_scene("handshake", 4, seed=8, n_frames=150)
-    before = _head_error(scene, Limbs3DParams().updated({"dynamics.head_own_blobs": False}), 3, 1, range(25, 40))
-    after = _head_error(scene, Limbs3DParams(), 3, 1, range(25, 40))
+    before = _head_error(scene, Limbs3DParams(), 3, 1, range(25, 40))
+    after = _head_error(scene, Limbs3DParams().updated({"dynamics.head_own_blobs": True}), 3, 1, range(25, 40))
     assert len(before) == len(after) == 15
     assert before.min() > 160
     assert after.max() < 100
