@@ -219,6 +219,19 @@ class Limbs3DDynamics:
     # 4 cameras 69.9 -> 69.4 mm (0.34 -> 0.46); standing and seated unchanged. False = main before
     line_of_sight: bool = flag(True)
     single_view_depth: float = number(600.0, POSITIVE)
+    # a head uses no candidate that shares a blob with the candidate of more views another person's
+    # tracked target claims (the one nearest its prediction within candidate_gate; our addition,
+    # sec. 6.4's ghosts for heads): in a view where two heads lie on one line of sight the nearer
+    # hides the farther, and the nearer's blob paired with the farther head's blob in a second view
+    # makes a ghost beside the farther head, inside every silhouette (p_b ~1); a head seen by one
+    # view slid 200 mm down onto one and stayed there (handshake seed 8, 3 cameras: 170-217 ->
+    # 77-92 mm). A no-op with two cameras (every candidate is a pair) and for one person. Off by
+    # default: seeds 0-9, 3 cameras, heads 50.4 -> 44.6 mm but all parts 49.5 -> 52.8 (seed 9's
+    # right hand, lost in the reach either way, held elsewhere: 96 -> 240 mm), 4 cameras 54.8 ->
+    # 54.4; held-out seeds 10-14 no better (3 cameras 80.2 -> 81.5, swaps 4 -> 5): a head freed
+    # from the ghost drifts along its one view's line of sight, and the hands' homes, relative to
+    # it, drift with it (docs/measurements/limbs3d.md, 2026-12-06, branch hs3d)
+    head_own_blobs: bool = flag(False)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
     # often nearer the other hand's candidates than that hand's own lagging prediction

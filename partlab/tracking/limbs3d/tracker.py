@@ -257,8 +257,11 @@ class Limbs3DTracker:
         preds = np.array([self.targets[k].filter.estimate for k in active]).reshape(-1, 3)
         lost = np.array([m.state(k) == LimbState.LOST for k in active], bool)
         points, weights = self.candidates(centres, views, preds[~lost])
+        self._claims: list = []  # (person, candidate): each tracked target's nearest candidate (_borrowed)
         if len(points) and len(active):
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
+            self._claims = [(self.targets[k].track_id, int(np.argmin(dist[:, a]))) for a, k in enumerate(active)
+                            if not lost[a] and dist[:, a].min() < p.dynamics.candidate_gate]
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
         seeing = sum(len(c) > 0 for c in centres)  # views with a skin blob: a dark camera has none
@@ -555,7 +558,27 @@ class Limbs3DTracker:
         use = (mine <= d.exclusive_ratio * others.min(axis=1)) if mine is not None else np.ones(len(points), bool)
         if d.hand_reach > 0 and t.part != "head" and head is not None and len(points):
             use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        if d.head_own_blobs and t.part == "head" and len(points):
+            use &= ~self._borrowed(t, len(points))
         return use
+
+    def _borrowed(self, t: _Target, n: int) -> np.ndarray:
+        """``(n,)`` whether each of the ``n`` merged candidates shares a blob with the candidate
+        another person's tracked target claims (``_claims``: the one nearest its prediction, within
+        ``dynamics.candidate_gate``) when that one spans more views (``dynamics.head_own_blobs``):
+        the blob is the other target's image, and the pair it makes here a ghost (sec. 6.4)."""
+        members = self.last.get("members") or []
+        out = np.zeros(n, bool)
+        if len(members) != n:
+            return out
+        views = [len({split_key(k)[0] for k in m}) for m in members]
+        for track_id, i in getattr(self, "_claims", []):
+            if track_id == t.track_id:
+                continue
+            for j in range(n):
+                if j != i and views[j] < views[i] and members[j] & members[i]:
+                    out[j] = True
+        return out
 
     def _single_view_mode(self, est, modes: tuple, points: np.ndarray, idx: np.ndarray, centres,
                           others: np.ndarray) -> tuple:
