@@ -293,12 +293,12 @@ class DetectionCue:
         return free
 
     def _reidentify(self, index: int, dets: np.ndarray, free: list[int], ycc) -> list[int]:
-        """``reid_hits``: a free detection no tracked person covers whose torso and hip-leg regions
-        match a dormant track's models (those of the boxes it was started from) at least
-        ``reid_similarity``, and better by ``reid_margin`` than every other dormant track's and
-        every live track's models, seen so in ``reid_hits`` scans running, re-activates that track
-        there with its id; a track that walked out is only looked for within ``reid_border``
-        detection heights of the border it left through. The free rest."""
+        """``reid_hits``: a free detection no tracked person covers, where a dormant track's person
+        could be by now (:meth:`_plausible`), whose torso and hip-leg regions match that track's
+        models (those of the boxes it was started from) at least ``reid_similarity`` and better by
+        ``reid_margin`` than every other such dormant track's, seen so in ``reid_hits`` scans
+        running, re-activates that track there with its id; a track that walked out is only looked
+        for within ``reid_border`` detection heights of the border it left through. The free rest."""
         t, p = self.tracker, self.p
         if p.reid_hits <= 0 or not t.dormant or not free:
             self.reid_candidates = [] if not t.dormant else self.reid_candidates
@@ -310,12 +310,14 @@ class DetectionCue:
             det = Box(*dets[j, :4])
             if not self._clear(det):
                 continue
-            sims = {tid: self._first_similarity(d.person, det, arr) for tid, d in t.dormant.items()}
+            sims = {tid: self._first_similarity(d.person, det, arr) for tid, d in t.dormant.items()
+                    if self._plausible(d, det, index)}
+            if not sims:
+                continue
             best = max(sims, key=sims.get)
             if sims[best] < p.reid_similarity:
                 continue
-            rivals = [v for k, v in sims.items() if k != best] + [self._live_similarity(q, det, arr)
-                                                                   for q in t.people.values()]
+            rivals = [v for k, v in sims.items() if k != best]
             if rivals and sims[best] - max(rivals) < p.reid_margin:
                 continue
             matches.append((j, det, best))
@@ -357,16 +359,18 @@ class DetectionCue:
                                                                   dtype=np.float32))[0]))
         return float(np.mean(rho))
 
-    def _live_similarity(self, person, det: Box, arr: np.ndarray) -> float:
-        """The same with a live track's current models, laid out as its parts are now."""
-        reported = self.tracker._reported_person_box(person)
-        names = [n for n in ("torso", "hipleg") if n in person.filters] or list(person.filters)
-        rho = []
-        for n in names:
-            f = person.filters[n]
-            b = _target(f.box, reported, det)
-            rho.append(float(f.similarities(arr, np.array([[*b.centre, b.w, b.h, 0.0, 0.0]], dtype=np.float32))[0]))
-        return float(np.mean(rho))
+    def _plausible(self, dormant, det: Box, index: int) -> bool:
+        """The ended track's person could be at ``det`` now: its height within ``reid_size`` times
+        that of the track's last box, its centre within ``reid_distance`` + ``reid_speed`` x (frames
+        since) detection heights of where the track was last measured clear of everyone and not
+        lost (where it ended, if never)."""
+        p, person = self.p, dormant.person
+        last = self.tracker._reported_person_box(person)
+        if not 1 / p.reid_size <= det.h / max(last.h, 1e-6) <= p.reid_size:
+            return False
+        frame, cx, cy = person.seen if person.seen is not None else (dormant.ended, *last.centre)
+        reach = (p.reid_distance + p.reid_speed * (index - frame)) * det.h
+        return bool(np.hypot(det.centre[0] - cx, det.centre[1] - cy) <= reach)
 
     def _confirm(self, index: int, dets: np.ndarray, free: list[int], ycc, mask) -> None:
         """Free detections matched to candidates of earlier scans; confirmed ones start tracks."""

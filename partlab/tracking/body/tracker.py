@@ -129,6 +129,8 @@ class Person:
     at_border: int | None = None            # last supported frame its box was at a border, not moving away
     given: dict[str, Box] = field(default_factory=dict)  # boxes it was started from (--init, keyframes), as drawn
     first: dict[str, PartFilter] = field(default_factory=dict)  # its filters as started (models of the given boxes)
+    seen: tuple[int, float, float] | None = None  # (frame, cx, cy): last measured clear of everyone, not lost
+    revived: int | None = None  # frame it was re-identified (``detector.reid_hits``), if it was
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -425,6 +427,8 @@ class BodyTracker:
         for person in active:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
                 person.centres.append((index, *person.box().centre))
+                if person.lost_since is None:
+                    person.seen = person.centres[-1]
         self._end_tracks(active, support, W, H, index)
         if self.cue is not None:
             self.cue.step(index, frame, ycc, mask, scan=self.moving_mask if self.auto else None)
@@ -737,6 +741,11 @@ class BodyTracker:
                     self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
                     self._retire(person, index, W, H, walked=True)
                     continue
+                if person.revived is not None:
+                    # re-identified: no motion of its own to coast on; it ends (dormant again) and waits
+                    self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
+                    self._retire(person, index, W, H, walked=False)
+                    continue
                 if p.detection.coast_frames <= 0 or self.auto:
                     # found automatically, a track without support ends at once (as before): the
                     # detection starts it again when the person shows; coasting there gave PETS
@@ -780,6 +789,7 @@ class BodyTracker:
         person.history.clear()
         person.observed.clear()
         person.scores = {}
+        person.revived = index
         self.people[track_id] = person
         self.revived.append((track_id, index))
         return person
