@@ -36,12 +36,14 @@ def _out_and_back(n=190, back=BLUE + BROWN):
     return frames, truths
 
 
-def _run(frames, truths, reid_hits):
-    """The body tracker from walker 1's first box, its detector replaced by one that reports every
-    person box in view (HOG finds drawn walkers only now and then)."""
+def _run(frames, truths, reid_hits, also=None):
+    """The body tracker from walker 1's first box (and ``also``: ``(frame, track id)`` of another
+    first box, walker 1's box at that frame), its detector replaced by one that reports every person
+    box in view (HOG finds drawn walkers only now and then)."""
     p = BodyParams().updated({"detector.reid_hits": reid_hits})
-    b = truths[0][1]["person"]
-    init = pd.DataFrame([dict(frame=0, track_id=1, part="person", x=b.x, y=b.y, w=b.w, h=b.h)])
+    firsts = [(0, 1)] + ([also] if also else [])
+    init = pd.DataFrame([dict(frame=f, track_id=k, part="person", x=b.x, y=b.y, w=b.w, h=b.h)
+                         for f, k in firsts for b in [truths[f][1]["person"]]])
     tracker = BodyTracker(p, np.random.default_rng(0), init=init)
     seen = {"index": 0}
     tracker.cue.detector.detect = lambda frame, regions: np.array(
@@ -78,3 +80,18 @@ def test_someone_else_coming_in_where_the_walker_left_is_not_taken_for_him():
     tracker, tracks = _run(frames, truths, reid_hits=3)
     assert tracker.revived == []
     assert tracks[(tracks.track_id == 1) & (tracks.frame > 100)].empty
+
+
+def test_a_first_box_given_on_a_re_identified_track_undoes_the_re_identification():
+    """``reid_undo_iou``: when someone's first box is given on the person a re-identified track
+    stands on, that person was new to the tracker: the re-identification is undone (its rows
+    withdrawn, the track ended again) and the given track goes on there."""
+    frames, truths = _out_and_back()
+    tracker, _ = _run(frames, truths, reid_hits=3)
+    revived_at = tracker.revived[0][1]
+    tracker, tracks = _run(frames, truths, reid_hits=3, also=(revived_at + 6, 2))
+    assert tracker.revived[0] == (1, revived_at) and 1 not in tracker.people
+    assert tracks[(tracks.track_id == 1) & (tracks.frame > 100)].empty
+    rows = tracks[(tracks.track_id == 2) & (tracks.part == "person")]
+    hits = [correct(Box(r.x, r.y, r.w, r.h), truths[r.frame][1]["person"]) for r in rows.itertuples()]
+    assert rows.frame.min() == revived_at + 6 and np.mean(hits) >= 0.9
