@@ -12,8 +12,9 @@ boxes (:mod:`partlab.tracking.core.people`, not the whole frame) and its detecti
    detection has matched for a while, when near their prediction and alike in colour;
 3. start tracks (automatic mode) once confirmed in several scans; blobs still start people the
    detector does not see;
-4. re-identify tracks given by the user that ended (``--init``): a free detection that clearly
-   matches one's models in several scans running brings it back there with its id;
+4. re-identify tracks given by the user that ended (``--init``): a free detection where that
+   person could be by now, matching its first models, in several scans running brings it back
+   there with its id;
 5. end duplicate tracks (one person tracked twice), and optionally tracks never detected.
 
 All numbers come from ``BodyParams.detector``.

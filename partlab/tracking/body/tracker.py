@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from partlab.tracking.body.cue import DetectionCue
+from partlab.tracking.body.cue import DetectionCue, _layout, _placed
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
 from partlab.tracking.body.part_filter import PartFilter, surround_counts
@@ -770,8 +770,6 @@ class BodyTracker:
         """A dormant track re-identified on the detection ``det``: back with its id and the models
         of the boxes it was started from, every part placed in ``det`` as laid out when it started,
         standing still, nothing of its last coasting kept."""
-        from partlab.tracking.body.cue import _layout, _placed
-
         person = self.dormant.pop(track_id).person
         started = minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.first.items())
         # the inner rectangles as they lay in the reported person box at the start
