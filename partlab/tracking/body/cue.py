@@ -12,7 +12,10 @@ boxes (:mod:`partlab.tracking.core.people`, not the whole frame) and its detecti
    detection has matched for a while, when near their prediction and alike in colour;
 3. start tracks (automatic mode) once confirmed in several scans; blobs still start people the
    detector does not see;
-4. end duplicate tracks (one person tracked twice), and optionally tracks never detected.
+4. re-identify tracks given by the user that ended (``--init``): a free detection where that
+   person could be by now, matching its first models, in several scans running brings it back
+   there with its id;
+5. end duplicate tracks (one person tracked twice), and optionally tracks never detected.
 
 All numbers come from ``BodyParams.detector``.
 """
@@ -37,6 +40,7 @@ class Candidate:
     box: Box
     hits: int
     last_scan: int
+    track_id: int = 0  # re-identification: the dormant track it matches
 
 
 def _blob_regions(mask: np.ndarray | None, min_height: float) -> list[Box]:
@@ -44,6 +48,11 @@ def _blob_regions(mask: np.ndarray | None, min_height: float) -> list[Box]:
         return []
     n, _, stats, _ = cv2.connectedComponentsWithStats((mask > 0).astype(np.uint8), connectivity=8)
     return [Box(*(float(v) for v in stats[i, :4])) for i in range(1, n) if stats[i, 3] >= min_height]
+
+
+def _border_gap(box: Box, border: str, W: int, H: int) -> float:
+    """Pixels between ``box`` and the frame's ``border`` (left, right, top or bottom)."""
+    return {"left": box.x, "right": W - box.x2, "top": box.y, "bottom": H - box.y2}[border]
 
 
 def _target(part: Box, person: Box, det: Box) -> Box:
@@ -103,6 +112,7 @@ class DetectionCue:
         self.velocity: dict[int, np.ndarray] = {}  # track id -> per-frame motion between its detections
         self.scans = 0
         self.detections = np.zeros((0, 5))
+        self.reid_candidates: list[Candidate] = []  # free detections matching a dormant track, scans running
 
     def step(self, index: int, frame: np.ndarray, ycc, mask: np.ndarray | None,
              scan: np.ndarray | None = None) -> None:
@@ -146,6 +156,8 @@ class DetectionCue:
         free = self._reacquire(index, [q for i, q in enumerate(people) if i not in matched], dets, free, ycc)
         if t.auto:
             self._confirm(index, dets, free, ycc, mask)
+        else:
+            free = self._reidentify(index, dets, free, ycc)
         self._end(index)
 
     def _contested(self, tracks: np.ndarray, dets: np.ndarray, pairs: list[tuple[int, int]]) -> set[tuple[int, int]]:
@@ -280,6 +292,86 @@ class DetectionCue:
             self.last_match[person.track_id] = index
             free = [j for j in free if j != best]
         return free
+
+    def _reidentify(self, index: int, dets: np.ndarray, free: list[int], ycc) -> list[int]:
+        """``reid_hits``: a free detection no tracked person covers, where a dormant track's person
+        could be by now (:meth:`_plausible`), whose torso and hip-leg regions match that track's
+        models (those of the boxes it was started from) at least ``reid_similarity`` and better by
+        ``reid_margin`` than every other such dormant track's, seen so in ``reid_hits`` scans
+        running, re-activates that track there with its id; a track that walked out is only looked
+        for within ``reid_border`` detection heights of the border it left through. The free rest."""
+        t, p = self.tracker, self.p
+        if p.reid_hits <= 0 or not t.dormant or not free:
+            self.reid_candidates = [] if not t.dormant else self.reid_candidates
+            return free
+        arr = as_array(ycc)
+        W, H = t.frame_size
+        matches = []
+        for j in free:
+            det = Box(*dets[j, :4])
+            if not self._clear(det):
+                continue
+            sims = {tid: self._first_similarity(d.person, det, arr) for tid, d in t.dormant.items()
+                    if self._plausible(d, det, index)}
+            if not sims:
+                continue
+            best = max(sims, key=sims.get)
+            if sims[best] < p.reid_similarity:
+                continue
+            rivals = [v for k, v in sims.items() if k != best]
+            if rivals and sims[best] - max(rivals) < p.reid_margin:
+                continue
+            matches.append((j, det, best))
+        kept = []
+        for j, det, tid in matches:
+            before = [c for c in self.reid_candidates if c.track_id == tid and c.last_scan == self.scans - 1]
+            near = associate_near(np.array([c.box.as_tuple() for c in before]).reshape(-1, 4),
+                                  np.array([det.as_tuple()]), self.p.confirm_distance)
+            if near:
+                c = before[near[0][0]]
+                c.box, c.hits, c.last_scan = det, c.hits + 1, self.scans
+            else:
+                border = t.dormant[tid].border
+                if border is not None and _border_gap(det, border, W, H) > p.reid_border * det.h:
+                    continue  # it walked out elsewhere
+                c = Candidate(det, 1, self.scans, tid)
+            if c.hits >= p.reid_hits and tid in t.dormant:
+                t.revive(tid, det.clip(W, H), index)
+                self.last_match[tid] = index
+                self.last_seen.pop(tid, None)
+                self.velocity.pop(tid, None)
+                free = [k for k in free if k != j]
+                continue
+            kept.append(c)
+        self.reid_candidates = [c for c in kept if c.track_id in t.dormant]
+        return free
+
+    def _first_similarity(self, person, det: Box, arr: np.ndarray) -> float:
+        """Mean similarity of the torso and hip-leg models a track was started with (its only part's
+        in whole-body mode) to the regions ``det`` puts those parts in, laid out as at its start."""
+        first = person.first
+        started = minimum_bounding_rectangle(self.tracker.report_box(n, f.box) for n, f in first.items())
+        layout = _layout({n: f.box for n, f in first.items()}, started)
+        names = [n for n in ("torso", "hipleg") if n in first] or list(first)
+        rho = []
+        for n in names:
+            b = _placed(layout[n], det)
+            rho.append(float(first[n].similarities(arr, np.array([[*b.centre, b.w, b.h, 0.0, 0.0]],
+                                                                  dtype=np.float32))[0]))
+        return float(np.mean(rho))
+
+    def _plausible(self, dormant, det: Box, index: int) -> bool:
+        """The ended track's person could be at ``det`` now: its height within ``reid_size`` times
+        that of the track's last box, its centre within ``reid_distance`` + ``reid_speed`` x (frames
+        since) detection heights of where the track was last measured clear of everyone and not
+        lost (where it ended, if never)."""
+        p, person = self.p, dormant.person
+        last = self.tracker._reported_person_box(person)
+        if not 1 / p.reid_size <= det.h / max(last.h, 1e-6) <= p.reid_size:
+            return False
+        frame, cx, cy = person.seen if person.seen is not None else (dormant.ended, *last.centre)
+        reach = (p.reid_distance + p.reid_speed * (index - frame)) * det.h
+        return bool(np.hypot(det.centre[0] - cx, det.centre[1] - cy) <= reach)
 
     def _confirm(self, index: int, dets: np.ndarray, free: list[int], ycc, mask) -> None:
         """Free detections matched to candidates of earlier scans; confirmed ones start tracks."""

@@ -413,6 +413,28 @@ class BodyDetector:
     reacquire_after: int = number(12, COUNT)
     reacquire_distance: float = number(1.0)
     reacquire_similarity: float = number(0.6, FRACTION)
+    # Re-identification of tracks given by the user (``--init``) that ended (lost and withdrawn, or
+    # walked out): a free detection (no track takes it, none covers it) where such a track's person
+    # could be by now (its height within ``reid_size`` times the track's last box's, its centre
+    # within ``reid_distance`` + ``reid_speed`` x frames since, in detection heights, of where the
+    # track was last measured clear of everyone, not lost), whose torso and hip-leg regions match the models of
+    # the boxes the track was started from at least ``reid_similarity`` (mean Bhattacharyya
+    # coefficient) and better by ``reid_margin`` than every other such ended track's, in
+    # ``reid_hits`` scans running (a single window does not), brings it back there with its id (a
+    # user expects the same person to keep their id). Colour alone cannot tell people apart here:
+    # on PETS09 a live track's models match a passer-by at 0.74-0.91, the ended track's first
+    # models its own person at 0.72-0.88, so where and when decide. A track that walked out is only
+    # looked for within ``reid_border`` detection heights of the border it left through. A person
+    # given later (their first box) on whom a re-identified track stands at IoU >= ``reid_undo_iou``
+    # was taken for the ended one: that re-identification is undone (0: never). ``reid_hits`` 0: off.
+    reid_hits: int = number(3, COUNT)
+    reid_similarity: float = number(0.7, FRACTION)
+    reid_margin: float = number(0.05, FRACTION)
+    reid_size: float = number(1.5, Rule(lo=1))
+    reid_distance: float = number(1.0, Rule(lo=0))
+    reid_speed: float = number(0.05, Rule(lo=0))
+    reid_border: float = number(1.0, Rule())
+    reid_undo_iou: float = number(0.5, FRACTION)
     # Two tracks whose person boxes overlap at IoU >= duplicate_iou (neither marked behind the
     # other) are one person twice: the one a detection matched less recently (then the younger)
     # ends; a track given with --init is not ended but goes lost (coasts, may be re-acquired).

@@ -26,6 +26,7 @@ bounding rectangle of the three parts (sec. 5.3). All numbers come from ``BodyPa
 
 from __future__ import annotations
 
+import copy
 from collections import deque
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
@@ -33,7 +34,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from partlab.tracking.body.cue import DetectionCue
+from partlab.tracking.body.cue import DetectionCue, _layout, _placed
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
 from partlab.tracking.body.part_filter import PartFilter, surround_counts
@@ -92,6 +93,17 @@ def init_starts(init: pd.DataFrame | list[TrackRecord], whole: bool = False) -> 
 
 
 @dataclass
+class Dormant:
+    """A track given by the user that ended (lost and withdrawn, or left the frame), kept for
+    ``detector.reid_hits``: its person, the frame it ended and, when it walked out, the border it
+    left through (``left``, ``right``, ``top``, ``bottom``; None when lost inside the frame)."""
+
+    person: Person
+    ended: int
+    border: str | None
+
+
+@dataclass
 class Person:
     """One tracked person: its part filters and the bookkeeping of occlusion and failure."""
 
@@ -116,6 +128,9 @@ class Person:
     coast_start: int | None = None          # first frame of the coasting stretch it is in (lost or occluded)
     at_border: int | None = None            # last supported frame its box was at a border, not moving away
     given: dict[str, Box] = field(default_factory=dict)  # boxes it was started from (--init, keyframes), as drawn
+    first: dict[str, PartFilter] = field(default_factory=dict)  # its filters as started (models of the given boxes)
+    seen: tuple[int, float, float] | None = None  # (frame, cx, cy): last measured clear of everyone, not lost
+    revived: int | None = None  # frame it was re-identified (``detector.reid_hits``), if it was
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -184,6 +199,20 @@ def _supports(mask: np.ndarray, states: np.ndarray) -> np.ndarray:
     return np.where(area > 0, inside / np.maximum(area, 1), 0.0)
 
 
+def _frozen(f: PartFilter) -> PartFilter:
+    """A copy of a part filter's appearance model as it is now (its model arrays are replaced,
+    never changed in place, by later updates), for comparing regions with it later."""
+    g = copy.copy(f)
+    g.state = f.state.copy()
+    return g
+
+
+def _nearest_border(box: Box, W: int, H: int) -> str:
+    """The border of a ``W`` x ``H`` frame nearest to ``box``."""
+    gaps = {"left": box.x, "right": W - box.x2, "top": box.y, "bottom": H - box.y2}
+    return min(gaps, key=gaps.get)
+
+
 def _overlap_fraction(a: Box, b: Box) -> float:
     """Share of ``a``'s area covered by ``b``."""
     return a.intersection(b) / a.area if a.area > 0 else 0.0
@@ -217,6 +246,8 @@ class BodyTracker:
         self.candidates: list[tuple[Box, int, Box]] = []  # (box, frames seen running, box when first seen)
         self.frames_seen = 0
         self.withdrawn: list[tuple[int, int]] = []  # (track_id, first frame): rows of a lost track that ended
+        self.dormant: dict[int, Dormant] = {}  # given tracks that ended, by id (``detector.reid_hits``)
+        self.revived: list[tuple[int, int]] = []  # (track_id, frame): a dormant track re-identified there
         self.bridges: list[tuple[int, int, int]] = []  # (track_id, first coasted frame, frame found again)
         self._ycc = LazyYcc()
         self.cue = DetectionCue(self) if self.params.detector.enabled else None
@@ -266,6 +297,8 @@ class BodyTracker:
             filters[name] = PartFilter(b, ycc, self.params, self.params.dynamics.noise[name], self.rng,
                                        surround=around)
         person = Person(track_id, filters, deque(maxlen=self.params.adjustment.history_frames), started=index)
+        if not self.auto:  # the models of the boxes it was started from, for re-identification (reid_hits)
+            person.first = {n: _frozen(f) for n, f in filters.items()}
         if "torso" in filters:
             t = filters["torso"].state
             person.offsets = {n: float((f.state[1] - t[1]) / max(t[3], 1.0))
@@ -278,7 +311,28 @@ class BodyTracker:
             start = self.pending[tid]
             if start.frame <= index:
                 del self.pending[tid]
+                self._undo_revivals(start, index)
                 self.start_track(tid, start.boxes, ycc, mask, index).given = dict(start.boxes)
+
+    def _undo_revivals(self, start: TrackStart, index: int) -> None:
+        """A person given now (their first box) on whom a re-identified track stands
+        (``detector.reid_undo_iou``) is someone new: the re-identification took them for the
+        dormant person, so it is undone (its rows since then withdrawn, the track dormant again)."""
+        iou_min = self.params.detector.reid_undo_iou
+        if not self.revived or iou_min <= 0:
+            return
+        given = start.boxes.get("person") or minimum_bounding_rectangle(start.boxes.values())
+        for tid, frame in list(self.revived):
+            person = self.people.get(tid)
+            if person is None or frame != max(f for t, f in self.revived if t == tid):
+                continue
+            if self._reported_person_box(person).iou(given) >= iou_min:
+                self.withdrawn.append((tid, frame))
+                del self.people[tid]
+                self.dormant[tid] = Dormant(person, index, None)
+                for q in self.people.values():
+                    if q.occluded_by == tid:
+                        q.occluded_by = None
 
     def _detect(self, index: int, frame: np.ndarray, ycc, mask) -> None:
         """Start tracks on person-size blobs of the foreground no tracked person covers, once
@@ -373,6 +427,8 @@ class BodyTracker:
         for person in active:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
                 person.centres.append((index, *person.box().centre))
+                if person.lost_since is None:
+                    person.seen = person.centres[-1]
         self._end_tracks(active, support, W, H, index)
         if self.cue is not None:
             self.cue.step(index, frame, ycc, mask, scan=self.moving_mask if self.auto else None)
@@ -662,7 +718,7 @@ class BodyTracker:
             if box.area <= 0 or _overlap_fraction(box, frame_box) < p.detection.leave_fraction:
                 if person.lost_since is not None and p.detection.exit_margin > 0:
                     self.withdrawn.append((person.track_id, person.lost_since))  # coasted out: those rows too
-                del self.people[person.track_id]
+                self._retire(person, index, W, H, walked=True)
                 continue
             if mask is None or person.occluded_by is not None or person.hidden_parts:
                 continue
@@ -670,10 +726,10 @@ class BodyTracker:
             if not self.auto and (not p.detection.end_init_tracks or learning):
                 continue
             if person.lost_since is not None:
-                if (index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames
-                        or self._walked_out(person, W, H, person.lost_since)):
+                walked = self._walked_out(person, W, H, person.lost_since)
+                if index - person.lost_since >= p.detection.lost_frames + p.detection.coast_frames or walked:
                     self.withdrawn.append((person.track_id, person.lost_since))
-                    del self.people[person.track_id]
+                    self._retire(person, index, W, H, walked)
                 continue
             support = _support(mask, box)
             person.unsupported = person.unsupported + 1 if support < p.detection.support_min else 0
@@ -683,7 +739,12 @@ class BodyTracker:
                 if self._walked_out(person, W, H, index - p.detection.lost_frames + 1):
                     # left the frame: the rows written since its support went are on background
                     self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
-                    del self.people[person.track_id]
+                    self._retire(person, index, W, H, walked=True)
+                    continue
+                if person.revived is not None:
+                    # re-identified: no motion of its own to coast on; it ends (dormant again) and waits
+                    self.withdrawn.append((person.track_id, index - p.detection.lost_frames + 1))
+                    self._retire(person, index, W, H, walked=False)
                     continue
                 if p.detection.coast_frames <= 0 or self.auto:
                     # found automatically, a track without support ends at once (as before): the
@@ -695,6 +756,41 @@ class BodyTracker:
         for q in list(self.people.values()):
             if q.occluded_by is not None and q.occluded_by not in self.people:
                 q.occluded_by = None
+
+    def _retire(self, person: Person, index: int, W: int, H: int, walked: bool) -> None:
+        """The track ends; a given one (``--init``) stays dormant for re-identification
+        (``detector.reid_hits``), with the border it walked out through."""
+        del self.people[person.track_id]
+        if self.auto or not person.first or self.params.detector.reid_hits <= 0:
+            return
+        border = _nearest_border(self._reported_person_box(person).clip(W, H), W, H) if walked else None
+        self.dormant[person.track_id] = Dormant(person, index, border)
+
+    def revive(self, track_id: int, det: Box, index: int) -> Person:
+        """A dormant track re-identified on the detection ``det``: back with its id and the models
+        of the boxes it was started from, every part placed in ``det`` as laid out when it started,
+        standing still, nothing of its last coasting kept."""
+        person = self.dormant.pop(track_id).person
+        started = minimum_bounding_rectangle(self.report_box(n, f.box) for n, f in person.first.items())
+        # the inner rectangles as they lay in the reported person box at the start
+        layout = _layout({n: f.box for n, f in person.first.items()}, started)
+        for name, f in person.filters.items():
+            first = person.first[name]
+            f.reference, f.surround, f.weighted = first.reference, first.surround, False
+            f._refresh_map()
+            f.steer(_placed(layout[name], det), 1.0)
+            f.set_velocity(np.zeros(2))
+        person.lost_since = person.coast_start = person.at_border = person.occluded_by = None
+        person.unsupported = person.occluded_frames = 0
+        person.hidden_parts, person.failed, person.touching = (), (), False
+        person.centres.clear()
+        person.history.clear()
+        person.observed.clear()
+        person.scores = {}
+        person.revived = index
+        self.people[track_id] = person
+        self.revived.append((track_id, index))
+        return person
 
     def _go_lost(self, person: Person, index: int, mask: np.ndarray) -> None:
         """From now on every part coasts on the person's recent velocity."""
@@ -726,11 +822,17 @@ class BodyTracker:
         """The records without those of tracks that went lost and never came back (written while
         they coasted, then withdrawn), including tracks still lost when the clip ends."""
         records = self._bridged(records)
-        gone = dict(self.withdrawn)
-        gone.update({tid: q.lost_since for tid, q in self.people.items() if q.lost_since is not None})
+        gone = list(self.withdrawn) + [(tid, q.lost_since) for tid, q in self.people.items()
+                                       if q.lost_since is not None]
         if not gone:
             return records
-        return [r for r in records if r.track_id not in gone or r.frame < gone[r.track_id]]
+        # a withdrawn stretch lasts until the track was re-identified (``detector.reid_hits``), if ever
+        spans: dict[int, list[tuple[int, float]]] = {}
+        for tid, first in gone:
+            back = [f for t, f in self.revived if t == tid and f > first]
+            spans.setdefault(tid, []).append((first, min(back, default=np.inf)))
+        return [r for r in records
+                if r.track_id not in spans or not any(a <= r.frame < b for a, b in spans[r.track_id])]
 
     def _bridged(self, records: list[TrackRecord]) -> list[TrackRecord]:
         """``occlusion.bridge``: the rows of each coasting stretch that ended with the person found
