@@ -243,3 +243,61 @@ def test_velocity_gain_trusts_whichever_motion_errs_less():
     both = pd.concat([exact_scans.assign(clip=0), exact_scans.assign(clip=1)], ignore_index=True)
     assert P.fit_steer_velocity(both, [jittery, jittery], [truth, truth], 0.3, 3, 9)[0] == high
     assert P.fit_steer_velocity(exact_scans[exact_scans.score.isna()], [jittery], [truth], 0.3, 3, 9)[0] is None
+
+
+def test_person_extent_keeps_the_most_boxes_on_their_person_not_the_median_ratio():
+    """The tracker's box is 1.15x the drawn width (median ratio: narrow it to 0.87) but its centre
+    wanders sideways by up to 0.4 of the drawn width: narrowed, the boxes furthest off fall below
+    IoU 0.5 and need moving. The fit keeps the width the edits prefer (wider than the median's)
+    and with it more boxes on their person."""
+    truth = _people(walking_truth(2, 60, seed=3))
+    rng = np.random.default_rng(0)
+    tracked = _scaled(truth, 1.15, 1.0)
+    tracked["x"] += rng.uniform(-0.4, 0.4, len(tracked)) * truth.w
+    ext = P.fit_person_extent([tracked], [truth], (1.0, 1.0, 0.0, 0.0))
+
+    def on_person(e):
+        boxes = _scaled(tracked, e[0], e[1], e[2] / e[0], e[3] / e[1])
+        return int(sum(P.iou_xywh(boxes[P.XYWH].to_numpy()[k:k + 1], truth[P.XYWH].to_numpy()[k:k + 1])[0, 0] >= 0.5
+                       for k in range(len(truth)) if k % 60))  # each track's first frame is the drawn box
+
+    median = (round(float(np.median(truth.w / tracked.w)), 3), 1.0, 0.0, 0.0)
+    assert median[0] == pytest.approx(0.87, abs=0.01)
+    assert ext[0] > 0.95, ext
+    assert on_person(ext) >= on_person(median) + 10, (on_person(ext), on_person(median))
+    assert on_person(ext) >= on_person((1.0, 1.0, 0.0, 0.0))
+
+
+def test_selection_with_a_holdout_keeps_what_carries_over_to_the_later_frames():
+    """``cuts``: fitted on the frames before the cut, scored from it. A change that puts the early
+    frames right and the later ones wrong (it fits the frames it was fitted on) lowers the pooled
+    edits over all frames and is kept without a holdout; scored on the later frames only it is
+    dropped."""
+    truth = normalise_tracks(_people(walking_truth(2, 30, seed=5)))
+    late = truth.frame >= 20
+
+    def run(_i, params):
+        out = _moved_on(truth, 1.0) if params.detector.undetected_frames != 30 else truth.copy()
+        if params.detector.undetected_frames == 30:
+            out.loc[late, "x"] += 3 * out.loc[late, "w"]  # the later third off its people
+        return out
+
+    fit = P.PersonFit(components={"ending": {"detector.undetected_frames": 30}})
+    _p, everywhere = P.select_person(run, [truth], BodyParams(), fit)
+    assert everywhere["kept"] == {"ending": True}
+    assert everywhere["scores"]["start"] == pytest.approx(100.0)
+    assert everywhere["scores"]["+ending"] == pytest.approx(100 / 3, abs=0.1)
+    params, held = P.select_person(run, [truth], BodyParams(), fit, cuts=[20])
+    assert held["kept"] == {"ending": False} and held["scored_from"] == [20]
+    assert held["scores"]["start"] == held["scores"]["+ending"] == pytest.approx(100.0)
+    assert params.detector.undetected_frames == BodyParams().detector.undetected_frames
+    assert "later ones (from frame 20)" in held["rule"]
+
+
+def test_holdout_cut_is_the_first_of_the_last_share_of_corrected_frames():
+    from partlab.models.training import holdout_cut
+
+    truth = normalise_tracks(_people(walking_truth(2, 200, seed=1)))
+    assert holdout_cut(truth, 0.35) == 130
+    assert holdout_cut(truth, 0.0) == -np.inf
+    assert holdout_cut(truth[truth.frame < 15], 0.35) == -np.inf  # too short to split: fitted and scored on all
