@@ -29,9 +29,10 @@ but measured against what the tracker and its people detector do on the same fra
 
 Each is a handful of numbers from medians, a quantile and one threshold, nothing tied to where or
 when the corrected people were; validation on the training clips (:func:`select_person`: the
-detector, then the extent refitted with it, then ending and noise) keeps each only if it lowers
-the annotator's edits there (:func:`partlab.labelling.evaluation.count_edits`, the measure the
-issue judges the tracker by), so a fit that does not help is not used.
+extent, then the detector, steering, ending and noise) keeps each only if it lowers the
+annotator's edits (:func:`partlab.labelling.evaluation.count_edits`, the measure the issue judges
+the tracker by) on the later corrected frames after being fitted on the earlier ones, so a fit
+that does not help, or helps only the frames it was fitted on, is not used.
 """
 
 from __future__ import annotations
