@@ -29,7 +29,7 @@ but measured against what the tracker and its people detector do on the same fra
 
 Each is a handful of numbers from medians, a quantile and one threshold, nothing tied to where or
 when the corrected people were; validation on the training clips (:func:`select_person`: the
-extent, then the detector, steering, ending and noise) keeps each only if it lowers the
+detector, steering, ending and noise, then the extent refitted with them) keeps each only if it lowers the
 annotator's edits (:func:`partlab.labelling.evaluation.count_edits`, the measure the issue judges
 the tracker by) on the later corrected frames after being fitted on the earlier ones, so a fit
 that does not help, or helps only the frames it was fitted on, is not used.
@@ -513,10 +513,10 @@ def _from(df: pd.DataFrame, cut: float) -> pd.DataFrame:
     return df[df["frame"] >= cut]
 
 
-#: the order :func:`select_person` tries the components in: the extent first, on the start's own
-#: runs (it changes what is written, not how people are tracked, so it is judged without the chaos
-#: of a tracker run), then what changes the tracking
-ORDER = ("extent", "detector", "steer", "velocity", "ending", "noise")
+#: the order :func:`select_person` tries the components in: what changes the tracking, then the
+#: extent, refitted on the runs of the model so far (it maps *that* tracker's box onto the drawn
+#: one, and changes what is written, not how people are tracked)
+ORDER = ("detector", "steer", "velocity", "ending", "noise", "extent")
 #: components that change only the boxes written, not the tracking (the same runs, rewritten)
 OUTPUT_ONLY = frozenset({"extent"})
 
@@ -525,8 +525,8 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
                   fit: PersonFit, base_tracks: list[pd.DataFrame] | None = None,
                   progress: Callable[[str], None] | None = None,
                   groups: list[int] | None = None, cuts: list[float] | None = None) -> tuple[BodyParams, dict]:
-    """Add the fitted components to ``base`` one at a time (:data:`ORDER`: extent, detector, steer,
-    velocity, ending, noise), keeping each only if it lowers the person-box edits on the training
+    """Add the fitted components to ``base`` one at a time (:data:`ORDER`: detector, steer,
+    velocity, ending, noise, extent), keeping each only if it lowers the person-box edits on the training
     clips below the best so far (a tie keeps the simpler model): ``(params, record)``.
 
     ``run(i, params)`` tracks validation run ``i`` against ``truths[i]``. ``groups`` (None: one
@@ -538,10 +538,11 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     boxes of the same runs (:meth:`partlab.tracking.body.tracker.BodyTracker.report_person`), so
     its per-seed differences are its own, not chance: for it half the seeds suffice.
 
-    The extent goes first, refitted (:func:`fit_person_extent`) on the start's own runs: it is
-    the one fit judged without a tracker run's chaos. What changes the tracking is tried on top
-    of it (a detector window that changed the tracker's box width would then show as costing
-    edits, not be corrected twice).
+    The extent goes last, refitted (:func:`fit_person_extent`, on the frames before the cuts) on
+    the runs of the model so far: the detection cue steers each track's person box towards its
+    detection and the velocity gain moves it along, so the extent that fits depends on what was
+    kept before it (fitted on the start's box, both would correct the same width twice). Being
+    output-only it is judged on the same runs rewritten, without a tracker run's chaos.
 
     ``cuts`` (None: every run scored on all its frames): per run, the first frame that is scored;
     the frames before it are the ones ``fit`` was made on (and the extent is refitted on), so a
@@ -574,7 +575,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     best_seeds = per_seed["start"]
     for comp in ORDER:
         changes = fit.components.get(comp)
-        if comp == "extent" and changes is not None:
+        if comp == "extent" and (changes is not None or any(kept.values())):
             ext = fit_person_extent([_before(t, c) for t, c in zip(tracks, cuts)], fitted_on,
                                     params.output.person)
             changes = {"output.person": ext} if ext and ext != params.output.person else None

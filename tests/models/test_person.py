@@ -301,3 +301,24 @@ def test_holdout_cut_is_the_first_of_the_last_share_of_corrected_frames():
     assert holdout_cut(truth, 0.35) == 130
     assert holdout_cut(truth, 0.0) == -np.inf
     assert holdout_cut(truth[truth.frame < 15], 0.35) == -np.inf  # too short to split: fitted and scored on all
+
+
+def test_extent_is_refitted_last_on_the_runs_of_what_was_kept_before_it():
+    """A kept change that alters the tracker's box (here 0.8 -> 0.75 of the drawn size, as a
+    detector window or velocity gain would) comes first: the extent is then fitted to *that* box
+    (1 / 0.75), not to the start's (1 / 0.8), which the kept change no longer writes."""
+    truth = normalise_tracks(_people(walking_truth(2, 30, seed=5)))
+
+    def run(_i, params):
+        change = params.detector.undetected_frames == 30
+        out = truth.copy() if change else _moved_on(truth, 1 / 3)
+        sw, sh, _, _ = params.output.person
+        return _scaled(out, (0.75 if change else 0.8) * sw, (0.75 if change else 0.8) * sh)
+
+    fit = P.PersonFit(components={"extent": {"output.person": (9.0, 9.0, 0.0, 0.0)},
+                                  "ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(run, [truth], BodyParams(), fit)
+    assert rec["kept"]["ending"] and rec["scores"]["+ending"] == 0.0
+    assert fit.record["person_extent"] == pytest.approx([1 / 0.75, 1 / 0.75, 0.0, 0.0], abs=2e-3)
+    assert not rec["kept"]["extent"]  # every box already on its person: a tie keeps the simpler model
+    assert list(rec["kept"]) == ["ending", "extent"]
