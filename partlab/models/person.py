@@ -504,7 +504,7 @@ def person_edits(tracks: list[pd.DataFrame], truths: list[pd.DataFrame]) -> floa
     return 100.0 * edits / max(boxes, 1)
 
 
-def _before(df: pd.DataFrame, cut: float) -> pd.DataFrame:
+def before_cut(df: pd.DataFrame, cut: float) -> pd.DataFrame:
     """The rows a fit is made on: those before ``cut`` (all for ``-inf``: no holdout)."""
     return df[df["frame"] < cut] if np.isfinite(cut) else df
 
@@ -554,7 +554,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     seeds = sorted(set(groups))
     cuts = list(cuts) if cuts is not None else [-np.inf] * len(truths)
     scored = [_from(g, c) for g, c in zip(truths, cuts)]
-    fitted_on = [_before(g, c) for g, c in zip(truths, cuts)]
+    fitted_on = [before_cut(g, c) for g, c in zip(truths, cuts)]
 
     def edits(tracks, which=None) -> float:
         which = which if which is not None else range(len(tracks))
@@ -576,7 +576,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     for comp in ORDER:
         changes = fit.components.get(comp)
         if comp == "extent" and (changes is not None or any(kept.values())):
-            ext = fit_person_extent([_before(t, c) for t, c in zip(tracks, cuts)], fitted_on,
+            ext = fit_person_extent([before_cut(t, c) for t, c in zip(tracks, cuts)], fitted_on,
                                     params.output.person)
             changes = {"output.person": ext} if ext and ext != params.output.person else None
             fit.record["person_extent"] = list(ext) if ext else None

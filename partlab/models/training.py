@@ -150,8 +150,9 @@ class TrainingOptions:
     person rows and the tracker runs): learn from the person boxes too
     (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip);
     ``validation_seeds``: how many tracker seeds each person-box component is validated over (a
-    component is kept only if it lowers the edits pooled over them and on at least half; one seed's
-    edits vary by a few per 100 boxes for the same model, so one run decides by chance);
+    component is kept only if it lowers the edits pooled over them and on every one, the person
+    box's extent on at least half; one seed's edits vary by a few per 100 boxes for the same model,
+    so one run decides by chance);
     ``holdout``: the share of each clip's corrected frames (its last ones) the person-box components
     are validated on and not fitted on, so that what is kept is what carries over to later frames
     (0: fitted and validated on the same frames)."""
@@ -284,7 +285,7 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
     """The person-box fits of :mod:`partlab.models.person` on top of ``body_p`` (what the parts
     gave), each kept only where it lowers the person-box edits on the training clips:
     ``(params, the summary's "person" record)``."""
-    from partlab.models.person import fit_person, select_person
+    from partlab.models.person import before_cut, fit_person, select_person
 
     inits = [first_boxes(g) for g in got.truths]
     n_seeds = max(int(opts.validation_seeds), 1)
@@ -305,8 +306,8 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
     # frames it was fitted on (PETS09 frames 0-199: the detector window and the ending won on the
     # frames they were fitted on and cost edits on frames 200-794, docs/measurements)
     cuts = [holdout_cut(g, opts.holdout if opts.validate else 0.0) for g in got.truths]
-    fit_truths = [g[g["frame"] < c] for g, c in zip(got.truths, cuts)]
-    fit = fit_person(clips, fit_truths, [t[t["frame"] < c] for t, c in zip(base_tracks, cuts)], body_p, table,
+    fit_truths = [before_cut(g, c) for g, c in zip(got.truths, cuts)]
+    fit = fit_person(clips, fit_truths, [before_cut(t, c) for t, c in zip(base_tracks, cuts)], body_p, table,
                      progress=step)
     if not opts.validate:
         chosen = body_p

@@ -349,3 +349,33 @@ def test_a_change_to_the_tracking_must_lower_the_edits_on_every_seed_the_extent_
     params, rec = P.select_person(run_written, [truth] * 3, BodyParams(), fit, groups=[0, 1, 2])
     assert rec["scores_by_seed"]["+extent"] == pytest.approx([0.0, 0.0, 100.0])
     assert rec["kept"] == {"extent": True}
+
+
+def test_without_a_holdout_the_fits_see_every_corrected_frame():
+    """``holdout_cut`` gives ``-inf`` when there is no split: the rows the fits are made on are then
+    all of them (not none)."""
+    from partlab.models.training import holdout_cut
+
+    truth = normalise_tracks(_people(walking_truth(2, 12, seed=1)))
+    cut = holdout_cut(truth, 0.35)
+    assert cut == -np.inf and len(P.before_cut(truth, cut)) == len(truth) == 24
+    assert len(P.before_cut(truth, 6.0)) == 12
+
+
+def test_training_without_a_holdout_fits_and_scores_on_every_corrected_frame():
+    """``holdout=0``: the miscalibrated start's person box (0.6 of the parts' box) is learnt back
+    from all 40 corrected frames and judged on all of them (no frame left out either way)."""
+    from partlab.labelling.synth import make_scene
+    from partlab.models.bundle import Bundle
+    from partlab.models.runner import body_tracker_runner
+    from partlab.models.training import iterate_frames, train_bundle
+
+    scene = make_scene("single", seed=3, n_frames=40, width=320, height=240)
+    truth = scene.truth[scene.truth.part == "person"][["frame", "track_id", "part", "x", "y", "w", "h"]]
+    start = Bundle(body_params=BodyParams().updated({"output.person": (0.6, 0.6, 0.0, 0.0)}),
+                   summary={"person": {"fields": ["output.person"]}})
+    b = train_bundle([(iterate_frames(scene.frames), scene.fps, truth)], tracker_runner=body_tracker_runner,
+                     start=start, holdout=0.0)
+    rec = b.summary["person"]
+    assert rec["kept"]["extent"] and rec["scored_from"] == [] and "later ones" not in rec["rule"], rec
+    assert b.body_params.output.person[0] > 0.7
