@@ -27,8 +27,9 @@ Person boxes teach what part boxes are not needed for (:mod:`partlab.models.pers
 box's extent around the parts, the people detector's threshold and window, when an undetected
 track ends, and the person's motion noise. With the tracker, and truth holding person rows, those
 are fitted on the earlier corrected frames of each clip and each kept only if it lowers the edits
-of the person boxes on the later ones (``TrainingOptions.holdout``; the summary's ``person``). Truth of person boxes alone (no part box: no SVM sample) therefore
-still trains a bundle, as long as one of those is kept.
+of the person boxes on the later ones (``TrainingOptions.holdout``; the summary's ``person``). Truth
+of person boxes alone (no part box: no SVM sample) therefore still trains a bundle, as long as one
+of those is kept.
 """
 
 from __future__ import annotations
