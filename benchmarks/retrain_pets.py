@@ -73,6 +73,9 @@ def compare(name: str, take, truth: pd.DataFrame, split: int, models: dict, seed
                 t0 = time.process_time()
                 props = track(take, "body", init=init if mode == "init" else None, model=model, seed=seed,
                               start=split).tracks
+                if TRACKS:
+                    TRACKS[0].mkdir(parents=True, exist_ok=True)
+                    props.to_csv(TRACKS[0] / f"{name}_{mode}_{label}_seed{seed}.csv", index=False)
                 cpu = (time.process_time() - t0) / max(take.frame_count - split, 1)
                 row = {"clip": name, "mode": mode, "model": label, "seed": seed, "cpu ms/frame": 1000 * cpu,
                        **measure(test, props, init["track_id"].nunique() if mode == "init" else 0)}
@@ -104,6 +107,7 @@ def summarise(df: pd.DataFrame) -> None:
 
 LOAD: list[Path] = []  # --load
 MODELS: list[str] = ["start", "trained"]  # --models
+TRACKS: list[Path] = []  # --tracks
 
 
 def pets(split: int, start, seeds, modes, train_seed: int, out: Path | None) -> pd.DataFrame:
@@ -174,10 +178,12 @@ def main() -> None:
     ap.add_argument("--synth-frames", type=int, default=200)
     ap.add_argument("--skip-pets", action="store_true")
     ap.add_argument("--csv", type=Path)
+    ap.add_argument("--tracks", type=Path, help="also save every run's tracks here (CLIP_MODE_MODEL_seedN.csv)")
     a = ap.parse_args()
     seeds = [int(s) for s in a.seeds.split(",") if s]  # none: only train (and save with --bundle)
     LOAD[:] = [a.load] if a.load else []
     MODELS[:] = [m for m in a.models.split(",") if m]
+    TRACKS[:] = [a.tracks] if a.tracks else []
     modes = [m for m in a.modes.split(",") if m]
     start = default_bundle() if a.start == "default" else None
     tables = []

@@ -26,9 +26,10 @@ scores and decisions.
 Person boxes teach what part boxes are not needed for (:mod:`partlab.models.person`): the person
 box's extent around the parts, the people detector's threshold and window, when an undetected
 track ends, and the person's motion noise. With the tracker, and truth holding person rows, those
-are fitted and each kept only if it lowers the edits of the person boxes on the training clips
-(the summary's ``person``). Truth of person boxes alone (no part box: no SVM sample) therefore
-still trains a bundle, as long as one of those is kept.
+are fitted on the earlier corrected frames of each clip and each kept only if it lowers the edits
+of the person boxes on the later ones (``TrainingOptions.holdout``; the summary's ``person``). Truth
+of person boxes alone (no part box: no SVM sample) therefore still trains a bundle, as long as one
+of those is kept.
 """
 
 from __future__ import annotations
@@ -150,8 +151,12 @@ class TrainingOptions:
     person rows and the tracker runs): learn from the person boxes too
     (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip);
     ``validation_seeds``: how many tracker seeds each person-box component is validated over (a
-    component is kept only if it lowers the edits pooled over them and on at least half; one seed's
-    edits vary by a few per 100 boxes for the same model, so one run decides by chance)."""
+    component is kept only if it lowers the edits pooled over them and on every one, the person
+    box's extent on at least half; one seed's edits vary by a few per 100 boxes for the same model,
+    so one run decides by chance);
+    ``holdout``: the share of each clip's corrected frames (its last ones) the person-box components
+    are validated on and not fitted on, so that what is kept is what carries over to later frames
+    (0: fitted and validated on the same frames)."""
 
     seed: int = 0
     perturbed_per_person: int = 300
@@ -160,6 +165,7 @@ class TrainingOptions:
     validate: bool = True
     person: bool | None = None
     validation_seeds: int = 3
+    holdout: float = 0.35
 
 
 @dataclass
@@ -280,7 +286,7 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
     """The person-box fits of :mod:`partlab.models.person` on top of ``body_p`` (what the parts
     gave), each kept only where it lowers the person-box edits on the training clips:
     ``(params, the summary's "person" record)``."""
-    from partlab.models.person import fit_person, select_person
+    from partlab.models.person import before_cut, fit_person, select_person
 
     inits = [first_boxes(g) for g in got.truths]
     n_seeds = max(int(opts.validation_seeds), 1)
@@ -296,7 +302,14 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
 
     step("tracking with the start")
     base_tracks = [run(j, body_p) for j in range(n)]
-    fit = fit_person(clips, got.truths, base_tracks, body_p, table, progress=step)
+    # fit on each clip's earlier corrected frames, validate on its later ones: the user tracks the
+    # rest of the clip with what is kept, so a component must carry over in time, not only fit the
+    # frames it was fitted on (PETS09 frames 0-199: the detector window and the ending won on the
+    # frames they were fitted on and cost edits on frames 200-794, docs/measurements)
+    cuts = [holdout_cut(g, opts.holdout if opts.validate else 0.0) for g in got.truths]
+    fit_truths = [before_cut(g, c) for g, c in zip(got.truths, cuts)]
+    fit = fit_person(clips, fit_truths, [before_cut(t, c) for t, c in zip(base_tracks, cuts)], body_p, table,
+                     progress=step)
     if not opts.validate:
         chosen = body_p
         for changes in fit.components.values():
@@ -308,8 +321,25 @@ def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table
         base_tracks += [run(j, body_p) for j in range(n, len(jobs))]
     truths = [got.truths[i] for i, _k in jobs[:len(base_tracks)]]
     groups = [k for _i, k in jobs[:len(base_tracks)]]
-    chosen, record = select_person(run, truths, body_p, fit, base_tracks=base_tracks, progress=step, groups=groups)
+    chosen, record = select_person(run, truths, body_p, fit, base_tracks=base_tracks, progress=step, groups=groups,
+                                   cuts=[cuts[i] for i, _k in jobs[:len(base_tracks)]])
     return chosen, {**fit.record, "fitted": sorted(fit.components), **record}
+
+
+def holdout_cut(truth: pd.DataFrame, share: float) -> float:
+    """The first frame of ``truth``'s last ``share`` of corrected frames (what validation scores
+    and the fits do not see); ``-inf`` (all frames both fitted and scored) for ``share`` 0 or a
+    stretch too short to split (fewer than :data:`MIN_HOLDOUT_FRAMES` on either side)."""
+    frames = np.sort(normalise_tracks(truth)["frame"].unique())
+    k = int(round(len(frames) * (1.0 - share)))
+    if share <= 0 or min(k, len(frames) - k) < MIN_HOLDOUT_FRAMES:
+        return -np.inf
+    return float(frames[k])
+
+
+#: frames each side of the holdout split needs (fewer: the person boxes are fitted and validated on
+#: all corrected frames)
+MIN_HOLDOUT_FRAMES = 10
 
 
 def check_span(clips: list[Clip], names: list[str], dt: float) -> None:
