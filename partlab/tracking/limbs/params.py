@@ -192,10 +192,8 @@ class LimbStates:
     # a lost target sees only candidates within recover_gate x dynamics.lost_search of where it is
     # looked for: its particles (spread lost_search) are otherwise drawn to a strong blob farther
     # off, another hand (exchange seeds 3 and 5, renderer of 2026-12-06: a hand lost behind its
-    # body "recovered" on the hands meeting in front of it, 44-48 px away). 2: two standard
-    # deviations of the search; 1.5 (30 px) also kept exchange seed 7's taker hidden as it came out
-    # from behind its body 34 px from where it was looked for. 0: off
-    recover_gate: float = number(2.0)
+    # body "recovered" on the hands meeting in front of it, 44-48 px away). 0: off
+    recover_gate: float = number(1.5)
     lost_likelihood: float = number(0.15, FRACTION)
     # hysteresis: a lost target comes back only above this confidence.
     recover_likelihood: float = number(0.3, FRACTION)
