@@ -189,11 +189,6 @@ class LimbStates:
     # from the pair's estimate; person 1's lost left hand did the same at 57. The pair then saw
     # its blob only every other frame and was lost at 72, both hands held at the meeting point.
     pair_span: bool = flag(True)
-    # a lost target sees only candidates within recover_gate x dynamics.lost_search of where it is
-    # looked for: its particles (spread lost_search) are otherwise drawn to a strong blob farther
-    # off, another hand (exchange seeds 3 and 5, renderer of 2026-12-06: a hand lost behind its
-    # body "recovered" on the hands meeting in front of it, 44-48 px away). 0: off
-    recover_gate: float = number(1.5)
     lost_likelihood: float = number(0.15, FRACTION)
     # hysteresis: a lost target comes back only above this confidence.
     recover_likelihood: float = number(0.3, FRACTION)
@@ -322,4 +317,4 @@ class LimbParams(Parameters):
     }
     #: fields added after partlab 0.2 (no flat name)
     ADDED: ClassVar[tuple[str, ...]] = ("states.pair_lost_claims", "states.split_unseen",
-                                            "states.pair_span", "states.recover_gate")
+                                            "states.pair_span")

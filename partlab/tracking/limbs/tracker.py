@@ -360,13 +360,8 @@ class LimbTracker:
         """Move the filter by its state's dynamics; the candidates it is weighed against."""
         p, tgt = self.params, self.targets[t]
         if state == LimbState.LOST:
-            centre = self._search_centre(t)
-            tgt.filter.reset(centre, self.rng, spread=p.dynamics.lost_search)
-            free = self._unclaimed(own_c, exclude=t, pairs=p.states.pair_span)
-            gate = p.states.recover_gate * p.dynamics.lost_search
-            if gate > 0 and len(free):  # a blob beyond the search's reach is someone else's
-                free = self._subset(free, np.hypot(*(free.centres - centre[None, :]).T) <= gate)
-            return free
+            tgt.filter.reset(self._search_centre(t), self.rng, spread=p.dynamics.lost_search)
+            return self._unclaimed(own_c, exclude=t, pairs=p.states.pair_span)
         if state == LimbState.COMBINED:
             # the pair's filter sees only candidates no other tracker explains (its own blobs)
             tgt.filter.predict(self.rng, p.dynamics.combined_noise_scale)
