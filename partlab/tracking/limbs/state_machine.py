@@ -16,8 +16,8 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   more than ``split_size`` target sizes (or ``split_distance`` pixels) apart; each tracker receives
   the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
-- combined -> unlabelled (the member on the side its mode went) and lost (the other): with one
-  mode only, the pair's estimate has moved more than ``split_size`` target sizes from where the
+- combined -> unlabelled (the member on the side its mode went) and lost (the other): a pair of
+  two people's hands (``Observation.two_people``) with one mode only whose estimate has moved more than ``split_size`` target sizes from where the
   hands met along the direction between them before the join (``states.split_unseen``): the
   hands have parted and one of them is no longer seen (in one camera, a hand taken back behind
   its own body); the seen mode is the member's on whose side it went (sec. 7.1's direction cue),
@@ -75,6 +75,9 @@ class Observation:
     #: the frame could not have seen the target (e.g. too few views left to triangulate anything):
     #: it counts as a confident frame for ``lost_frames`` (the count starts again after it)
     unseen: bool = False
+    #: a combined pair's leader: its two members are two people's (each hand goes back to its own
+    #: person's side after they part, which ``split_unseen`` relies on)
+    two_people: bool = False
 
 
 @dataclass(frozen=True)
@@ -263,7 +266,7 @@ class LimbStateMachine:
             move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
             move(b, LimbState.UNLABELLED, "split", t, tuple(map(float, pos_b)))
         elif (getattr(p, "split_unseen", False)  # the one-camera tracker's rule; limbs3d has no such field
-              and len(modes) < 2 and obs.position is not None and s.met is not None):
+              and obs.two_people and len(modes) < 2 and obs.position is not None and s.met is not None):
             self._split_one_unseen(frame, t, b, s, np.asarray(obs.position, float), obs.size, move)
 
     def _split_one_unseen(self, frame: int, a: int, b: int, s: _Status, at: np.ndarray, size: float,

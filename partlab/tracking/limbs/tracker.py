@@ -351,8 +351,11 @@ class LimbTracker:
             self._refine(tgt, obs_c, on_end, view.skin_bins)
         tgt.filter.resample(self.rng)
         self._remember(t, state, before, view.skin_bins)
+        partner = self.machine.partner(t) if state == LimbState.COMBINED else None
+        two_people = partner is not None and tgt.track_id is not None and \
+            self.targets[partner].track_id not in (None, tgt.track_id)
         observation = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
-                                  labelled=tgt.labelled, modes=modes, size=self._side(t))
+                                  labelled=tgt.labelled, modes=modes, size=self._side(t), two_people=two_people)
         self._place_pair(t, modes)
         return observation
 
