@@ -78,9 +78,35 @@ def test_part_boxes_nest_in_the_person_and_stack_head_torso_hipleg(clean_single)
     assert ratio.between(0.09, top).all()  # a head is about 1/7.5 of the body
 
 
-def test_lone_walker_is_never_occluded(clean_single):
-    assert clean_single.truth["occluded"].max() == 0.0
-    assert set(clean_single.truth["part"]) == set(BOX_PARTS)
+def test_lone_walker_is_occluded_only_where_its_own_body_hides_a_hand(clean_single):
+    t = clean_single.truth
+    assert set(t["part"]) == set(BOX_PARTS)
+    # no one else in the scene: a part is seen (0) or wholly behind the walker's own body (1, a
+    # far hand behind the hips: 19 left-hand and 8 right-hand frames of these 60)
+    assert set(t["occluded"].unique()) == {0.0, 1.0}
+    hidden = t[t["occluded"] > 0]
+    assert set(hidden["part"]) == {"left_hand", "right_hand"}
+    assert hidden["part"].value_counts().to_dict() == {"left_hand": 19, "right_hand": 8}
+
+
+def test_a_hand_behind_its_own_body_is_occluded_and_so_is_what_it_holds():
+    """Exchange seed 3: person 2 (profile, facing left) takes the object with the right (far)
+    hand and brings it back to rest behind the torso (frames 90-149). The hand's truth is wholly
+    occluded, and the object, drawn at the hand's depth, is hidden by the shirt: no pixel of its
+    colour left there (before: occluded 0.0 and the object drawn over the shirt)."""
+    scene = make_scene("exchange", seed=3, n_frames=150, width=360, height=240, clean=True)
+    t = scene.truth
+    row = _row(t, 96, 2, "right_hand")
+    assert (row.x, row.y, row.w, row.h) == (201, 179, 7, 8)
+    assert row.occluded == 1.0
+    assert _row(t, 96, 2, "left_hand").occluded == 0.0  # the near hand, in view
+    assert _row(t, 60, 2, "right_hand").occluded == 0.0  # out in front, taking the object
+    colour = tuple(int(scene.events["colour"][0][k:k + 2], 16) for k in (5, 3, 1))  # "#rrggbb" -> BGR
+    frame = scene.frames[96].astype(int)
+    near = np.abs(frame - np.array(colour)[None, None, :]).sum(axis=2) < 30
+    assert int(near.sum()) == 0
+    # at the handover the object is in the hands, in view: drawn as before
+    assert int((np.abs(scene.frames[60].astype(int) - np.array(colour)).sum(axis=2) < 30).sum()) > 20
 
 
 def test_hidden_walker_at_the_middle_of_the_crossing():
@@ -93,7 +119,10 @@ def test_hidden_walker_at_the_middle_of_the_crossing():
     # the far walker's torso and hip-leg are mostly hidden; at the start nobody is
     assert _row(t, n // 2, far, "torso").occluded > 0.8 and _row(t, n // 2, far, "hipleg").occluded > 0.5
     assert _row(t, n // 2, far, "head").occluded > 0.5  # a short walker behind a tall one
-    assert t[t.frame == 0]["occluded"].max() == 0.0
+    # at the start nobody hides anybody (a hand behind its own walker's hips is hidden: 1.0)
+    first = t[t.frame == 0]
+    assert first[~first["part"].str.endswith("hand")]["occluded"].max() == 0.0
+    assert set(first["occluded"].unique()) <= {0.0, 1.0}
 
 
 def test_pillar_hides_the_walker_by_its_overlap():

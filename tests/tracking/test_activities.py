@@ -303,9 +303,11 @@ def test_a_handshake_whose_hand_went_unseen_after_it_is_read_from_what_was_seen(
     out = recognise(_touch(a, b, 40, 60), bare, centres, P)
     assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("handshake", 40, 60)]
     assert out.confidence.iloc[0] == pytest.approx(P.decision.unseen_confidence)
-    # a colour held where the hands were seen (an object that may have changed hands): not sure
+    # a colour held where the hands were seen (an object that may have changed hands): no handshake
+    # (an exchange instead: test_an_exchange_whose_taker_went_unseen_after_it_is_read_from_the_giver)
     held = {k: {f: [_seen("", 40, 0.3 if k == a and f < 40 else 0.0)] for f in c} for k, c in centres.items()}
-    assert recognise(_touch(a, b, 40, 60), held, centres, P).empty
+    assert "handshake" not in set(recognise(_touch(a, b, 40, 60), held, centres, P)["kind"])
+    assert recognise(_touch(a, b, 40, 60), held, centres, P.updated({"decision.unseen_exchange": False})).empty
     # one person's two hands: a hand hidden behind the body whose track wanders onto the other
     # hand is no clap
     same = (1, "left_hand")
@@ -314,6 +316,41 @@ def test_a_handshake_whose_hand_went_unseen_after_it_is_read_from_what_was_seen(
     # the rule off (unseen_confidence under min_confidence): nothing, as before
     off = P.updated({"decision.unseen_confidence": 0.3})
     assert recognise(_touch(a, b, 40, 60), bare, centres, off).empty
+
+
+def test_an_exchange_whose_taker_went_unseen_after_it_is_read_from_the_giver():
+    """Table 1 with the taker's hand unseen after the separation (the limb tracker loses it as it
+    goes back behind its person's body with the object): the giver held the colour before and not
+    after, the taker held nothing before: an exchange, as sure as ``decision.unseen_confidence``."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    centres = {a: {f: (100.0 if not 40 <= f <= 60 else 195.0, 300.0, 15.0) for f in range(100)},
+               b: {f: (300.0 if f < 40 else 205.0, 300.0, 15.0) for f in range(61)}}  # b lost from 61
+    gives = {k: {f: [_seen("", 40, 0.3 if k == a and f < 40 else 0.0)] for f in c} for k, c in centres.items()}
+    out = recognise(_touch(a, b, 40, 60), gives, centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("exchange", 40, 60)]
+    assert out.confidence.iloc[0] == pytest.approx(P.decision.unseen_confidence)
+    assert out.object_colour.iloc[0] != ""
+    # the giver still holds it after: nothing left its hand, so no exchange (and, a colour being
+    # held, no unseen handshake either)
+    keeps = {k: {f: [_seen("", 40, 0.3 if k == a else 0.0)] for f in c} for k, c in centres.items()}
+    assert recognise(_touch(a, b, 40, 60), keeps, centres, P).empty
+    # the taker already held that colour before: nothing changed hands
+    both = {k: {f: [_seen("", 40, 0.3 if f < 40 else 0.0)] for f in c} for k, c in centres.items()}
+    assert recognise(_touch(a, b, 40, 60), both, centres, P).empty
+    # the giver unseen after, the taker seen with the colour after: an exchange too
+    centres2 = {a: {f: (100.0 if f < 40 else 195.0, 300.0, 15.0) for f in range(61)},
+                b: {f: (300.0 if not 40 <= f <= 60 else 205.0, 300.0, 15.0) for f in range(100)}}
+    takes = {a: {f: [_seen("", 40, 0.3 if f < 40 else 0.0)] for f in centres2[a]},
+             b: {f: [_seen("", 40, 0.3 if f > 60 else 0.0)] for f in centres2[b]}}
+    assert list(recognise(_touch(a, b, 40, 60), takes, centres2, P)["kind"]) == ["exchange"]
+    # one person's two hands: no activity of Table 1
+    same = (1, "left_hand")
+    assert recognise(_touch(a, same, 40, 60, "clap"), {a: gives[a], same: gives[b]},
+                     {a: centres[a], same: centres[b]}, P).empty
+    # the rule off: nothing, as before
+    assert recognise(_touch(a, b, 40, 60), gives, centres, P.updated({"decision.unseen_exchange": False})).empty
 
 
 def test_a_handshake_over_an_exchange_between_the_same_people_is_its_touch():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -162,3 +164,37 @@ def test_with_sizes_the_distances_scale_with_the_targets():
     assert m.state(0) == S.COMBINED  # modes 60 px apart < 72
     m.update(3, {0: Observation(position=(70, 0), modes=((110, 0), (30, 0)), **big)})
     assert m.state(0) == S.UNLABELLED and m.state(1) == S.UNLABELLED
+
+
+@pytest.mark.parametrize("x, seen, unseen, guess", [(104.0, 0, 1, 36.0), (36.0, 1, 0, 104.0)])
+def test_a_pair_whose_one_mode_leaves_the_meeting_point_splits_with_the_other_hand_lost(x, seen, unseen, guess):
+    # met at x=70 (tracker 0 came from the right); one mode only, 34 px to one side (> 30): the
+    # hands parted and one of them is not seen (one camera: taken back behind its body). The mode
+    # is the hand of that side; the other is lost, looked for as far back on its own side.
+    m = _pair_joined()
+    for f, step in enumerate([10.0, 20.0, 30.0], start=6):  # within the split distance: still together
+        at = 70 + step * np.sign(x - 70)
+        assert m.update(f, {0: replace(ok(at, 80, modes=((at, 80),)), two_people=True)}) == []
+    # one person's two hands (a walker's, crossing as they swing): not split so
+    assert m.update(9, {0: ok(x, 80, modes=((x, 80),))}) == []
+    tr = m.update(10, {0: replace(ok(x, 80, modes=((x, 80),)), two_people=True)})
+    got = {t.tracker: (t.new, t.reason, t.position) for t in tr}
+    assert got[seen] == (S.UNLABELLED, "split", (x, 80.0))
+    assert got[unseen] == (S.LOST, "split unseen", (guess, 80.0))
+    assert [(e.start_frame, e.end_frame, e.ended_by) for e in m.events] == [(5, 10, "split")]
+    assert m.partner(0) is None and m.partner(1) is None
+
+
+def test_a_pair_moving_together_across_the_join_direction_or_with_the_rule_off_stays_combined():
+    m = _pair_joined()
+    for f, y in enumerate([90.0, 100.0, 115.0, 130.0], start=6):  # 50 px down, across the direction
+        assert m.update(f, {0: replace(ok(72, y, modes=((72, y),)), two_people=True)}) == []
+    assert m.state(0) == S.COMBINED and m.state(1) == S.COMBINED
+    off = LimbStateMachine(P.updated({"states.split_unseen": False}))
+    for t in (0, 1):
+        off.add(t, S.NORMAL)
+    for f, gap in enumerate([60, 50, 40, 30, 24]):
+        off.update(f, {0: ok(70 + gap / 2, 80), 1: ok(70 - gap / 2, 80)})
+    off.update(5, {0: ok(78, 80), 1: ok(62, 80)})
+    assert off.update(6, {0: replace(ok(110, 80, modes=((110, 80),)), two_people=True)}) == []
+    assert off.state(0) == S.COMBINED and off.state(1) == S.COMBINED

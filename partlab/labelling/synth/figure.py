@@ -26,7 +26,7 @@ which of them stay visible (:data:`PART_LABELS`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
@@ -88,12 +88,16 @@ class Figure:
 
     ``labels: (h, w) uint8`` colour labels (0 empty); ``masks: dict part -> (h, w) bool``
     whole shapes of the parts in :data:`FIGURE_PARTS` (missing when not drawn, e.g. the
-    hip-leg of a seated person); ``origin``: image ``(x, y)`` of the top-left pixel.
+    hip-leg of a seated person); ``origin``: image ``(x, y)`` of the top-left pixel;
+    ``front: dict hand part -> (h, w) bool``: the pixels the person's own solids nearer than that
+    hand cover (the torso over a far hand at rest behind the body), so what the hand holds can be
+    drawn at the hand's depth (:func:`partlab.labelling.synth.scene._draw_objects`).
     """
 
     labels: np.ndarray
     masks: dict
     origin: tuple[int, int]
+    front: dict = field(default_factory=dict)
 
 
 class _Solid:
@@ -414,14 +418,20 @@ def draw_figure(pose: FigurePose, appearance: Appearance, view: LocalView, ancho
     shape = (int(y2 - y1), int(x2 - x1))
     labels = np.zeros(shape, np.uint8)
     masks: dict[str, np.ndarray] = {}
+    front: dict[str, np.ndarray] = {}  # hand part -> what is drawn after it (nearer, solids go far to near)
     for s in solids:
         _draw(labels, s, offset, s.label, FOREARM)
+        for m in front.values():
+            _draw(m, s, offset, 1, 1)
         if s.part is not None:
             m = masks.get(s.part)
             if m is None:
                 m = masks[s.part] = np.zeros(shape, np.uint8)
             _draw(m, s, offset, 1)
-    return Figure(labels, {k: v.astype(bool) for k, v in masks.items()}, (int(x1), int(y1)))
+            if s.part in ("left_hand", "right_hand"):
+                front[s.part] = np.zeros(shape, np.uint8)
+    return Figure(labels, {k: v.astype(bool) for k, v in masks.items()}, (int(x1), int(y1)),
+                  {k: v.astype(bool) for k, v in front.items()})
 
 
 def colour_table(appearance: Appearance) -> np.ndarray:

@@ -9,7 +9,8 @@ person's own body hides completely (a far hand behind the hips) falls back to it
 whole drawn shape. A truth row's box is the tight extent of those pixels inside the
 frame (``x, y`` the first column/row, ``w, h`` the number of columns/rows spanned),
 and ``occluded`` is the fraction of them where another person or an occluder is
-visible instead. Hidden parts keep their rows; a part with less than :data:`MIN_IN_FRAME`
+visible instead; a part its own body hides wholly is 1.0 occluded (until 2026-12-06 it was 0.0:
+the whole drawn shape was counted as seen). Hidden parts keep their rows; a part with less than :data:`MIN_IN_FRAME`
 of its pixels inside the frame has none (a person walking out leaves a shoe of 7 x 15 px, or a
 single pixel at a corner, for several frames: a box there says nothing about where the part
 is, and Zhao & Lee count only people in view). ``person`` is the extent of the whole drawn
@@ -189,6 +190,7 @@ def _truth_rows(i: int, drawn: list, owner: np.ndarray, warp: np.ndarray | None 
         own = owner[cy1:cy2, cx1:cx2]
         lab = fig.labels[crop]
         parts = {"person": lab > 0}
+        self_hidden: set[str] = set()
         for p in FIGURE_PARTS:
             if p in fig.masks:
                 whole = fig.masks[p]
@@ -197,11 +199,14 @@ def _truth_rows(i: int, drawn: list, owner: np.ndarray, warp: np.ndarray | None 
                 if warp is None and np.count_nonzero(shape[crop]) < MIN_IN_FRAME * np.count_nonzero(shape):
                     continue  # mostly outside the frame (the canvas is the frame)
                 parts[p] = shape[crop]
+                if shape is whole:
+                    self_hidden.add(p)
         for part, mask in parts.items():
             total = int(mask.sum())
             if total == 0:
                 continue
-            visible = int(np.count_nonzero(own[mask] == a + 1))
+            # a part its own body hides wholly (a far hand at rest behind the torso) is not seen
+            visible = 0 if part in self_hidden else int(np.count_nonzero(own[mask] == a + 1))
             if warp is not None:
                 box = _warped_extent(mask, cx1, cy1, warp, *size, 0.0 if part == "person" else MIN_IN_FRAME)
                 if box is None:
@@ -291,7 +296,7 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
             frame[cy1:cy2, cx1:cx2][on] = colours
             owner[cy1:cy2, cx1:cx2][on] = a + 1
             drawn.append((a, fig, crop, (cx1, cy1, cx2, cy2)))
-        _draw_objects(frame, script.objects, drawn, i)
+        _draw_objects(frame, script.objects, drawn, i, owner)
         for o, tex in zip(script.occluders, occ_tex):
             x, y, w, h = int(o.box.x), int(o.box.y), int(o.box.w), int(o.box.h)
             frame[y:y + h, x:x + w] = tex[: max(0, min(h, height - y)), : max(0, min(w, width - x))]
@@ -328,32 +333,58 @@ def make_scene(name: str, seed: int = 0, n_frames: int = 150, width: int = 720, 
                  tuple(a.appearance for a in script.actors), background, owner_maps, events)
 
 
-def _draw_objects(frame: np.ndarray, objects, drawn, i: int) -> None:
+def _draw_objects(frame: np.ndarray, objects, drawn, i: int, owner: np.ndarray | None = None) -> None:
     """Carried objects at frame ``i``: in front of the holding hand (a little below its centre, so
-    the hand still shows), or where they rest."""
-    import cv2
+    the hand still shows) and at its depth, or where they rest.
 
-    figs = {a: (fig, box) for a, fig, _, box in drawn}
+    A held object is hidden wherever something nearer than the hand is drawn: the holder's own
+    solids in front of that hand (:attr:`Figure.front`: the torso over a far hand at rest behind the
+    body) and, with the ``owner`` map, the people drawn after the holder (nearer the camera). Until
+    2026-12-06 it was drawn over everything, floating in front of a hand hidden behind the body."""
+    order = [a for a, _, _, _ in drawn]
+    figs = {a: fig for a, fig, _, _ in drawn}
     for obj in objects:
         h = int(obj.holder[i])
+        colour = tuple(int(c) for c in obj.colour)
         if h < 0:
             if not np.all(np.isfinite(obj.rest[i])):
                 continue
-            centre, r = obj.rest[i], None
-        else:
-            got = figs.get(h // 2)
-            mask = None if got is None else got[0].masks.get(HANDS[h % 2])
-            if mask is None or not mask.any():
-                continue
-            ys, xs = np.nonzero(mask)
-            x0, y0 = got[0].origin
-            hand_r = max(2.0, 0.5 * (xs.max() - xs.min() + 1))
-            centre = np.array([x0 + xs.mean(), y0 + ys.mean() + 1.1 * hand_r])
-            r = obj.radius * hand_r
-        if r is None:
             r = obj.rest_radius_px
-        cv2.ellipse(frame, (int(round(centre[0])), int(round(centre[1]))), (int(round(r)), int(round(0.8 * r))),
-                    0, 0, 360, tuple(int(c) for c in obj.colour), -1, lineType=cv2.LINE_AA)
+            cv2.ellipse(frame, (int(round(obj.rest[i][0])), int(round(obj.rest[i][1]))),
+                        (int(round(r)), int(round(0.8 * r))), 0, 0, 360, colour, -1, lineType=cv2.LINE_AA)
+            continue
+        fig = figs.get(h // 2)
+        hand = HANDS[h % 2]
+        mask = None if fig is None else fig.masks.get(hand)
+        if mask is None or not mask.any():
+            continue
+        ys, xs = np.nonzero(mask)
+        x0, y0 = fig.origin
+        hand_r = max(2.0, 0.5 * (xs.max() - xs.min() + 1))
+        centre = np.array([x0 + xs.mean(), y0 + ys.mean() + 1.1 * hand_r])
+        r = obj.radius * hand_r
+        axes, at = (int(round(r)), int(round(0.8 * r))), (int(round(centre[0])), int(round(centre[1])))
+        hgt, wid = frame.shape[:2]
+        hidden = np.zeros((hgt, wid), bool)  # what is nearer than the hand
+        front = fig.front.get(hand)
+        if front is not None and front.any():
+            fh, fw = front.shape
+            cx1, cy1, cx2, cy2 = max(x0, 0), max(y0, 0), min(x0 + fw, wid), min(y0 + fh, hgt)
+            if cx1 < cx2 and cy1 < cy2:
+                hidden[cy1:cy2, cx1:cx2] = front[cy1 - y0:cy2 - y0, cx1 - x0:cx2 - x0]
+        if owner is not None:
+            nearer = [a + 1 for a in order[order.index(h // 2) + 1:]]
+            if nearer:
+                hidden |= np.isin(owner[:hgt, :wid], nearer)
+        cover = np.zeros((hgt, wid), np.uint8)  # the object's coverage, anti-aliased as drawn before
+        cv2.ellipse(cover, at, axes, 0, 0, 360, 255, -1, lineType=cv2.LINE_AA)
+        if not (hidden & (cover > 0)).any():  # nothing in front: drawn as it always was
+            cv2.ellipse(frame, at, axes, 0, 0, 360, colour, -1, lineType=cv2.LINE_AA)
+            continue
+        alpha = np.where(hidden, 0.0, cover / 255.0).astype(np.float32)
+        on = alpha > 0
+        blend = frame[on] * (1.0 - alpha[on, None]) + np.asarray(colour, np.float32)[None, :] * alpha[on, None]
+        frame[on] = np.clip(np.round(blend), 0, 255).astype(np.uint8)
 
 
 def render_scenario(name: str, outdir: str | PathLike, seed: int = 0, n_frames: int = 150, width: int = 720,

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from partlab.tracking.core.params import FRACTION, POSITIVE, POSITIVE_COUNT, Parameters, group_field, number
+from partlab.tracking.core.params import FRACTION, POSITIVE, POSITIVE_COUNT, Parameters, flag, group_field, number
 
 
 @dataclass(frozen=True)
@@ -109,6 +109,11 @@ class Decision:
     # handshake (seeds 7 and 9 were missed so). 0.3: off
     unseen_confidence: float = number(0.5, FRACTION)
     unseen_min_seen: int = number(2, POSITIVE_COUNT)
+    # ... and an exchange (this sure too) where both hands were seen before the touch, one holding
+    # a colour the other did not, and after it the giver is seen without that colour while the
+    # taker is unseen (the limb tracker lost the taker's hand going back behind the body with the
+    # object: exchange seed 3), or the taker is seen with it while the giver is unseen
+    unseen_exchange: bool = flag(True)
     # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
     # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
     still_speed: float = number(0.05, POSITIVE)

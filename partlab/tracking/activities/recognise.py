@@ -34,7 +34,7 @@ from partlab.tracking.activities.objects import (
     hue_to_hex,
 )
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.table import Verdict, one_hand, two_hands
+from partlab.tracking.activities.table import Verdict, absent, one_hand, two_hands
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord
 
@@ -382,8 +382,13 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
                             object_colour="" if v.colour is None else hue_to_hex(v.colour))
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
-                base.update(kind="clap" if a[0] == b[0] else "handshake",
-                            confidence=0.3 if a[0] == b[0] else _unseen_confidence(seen, params))
+                v = _unseen_exchange(seen, params) if a[0] != b[0] else None
+                if v is not None:
+                    base.update(kind="exchange", confidence=params.decision.unseen_confidence,
+                                object_colour=hue_to_hex(v.colour))
+                else:
+                    base.update(kind="clap" if a[0] == b[0] else "handshake",
+                                confidence=0.3 if a[0] == b[0] else _unseen_confidence(seen, params))
         rows.append(base)
         # a touch is its hands' activity even when it is not reported (a hand unseen at a decision
         # point): reading their still moments on their own instead found one more limbs3d exchange
@@ -392,6 +397,31 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
         busy[a].append((start, end))
         busy[b].append((start, end))
     return rows, busy
+
+
+def _unseen_exchange(seen: list[dict | None], params: ActivityParams) -> Verdict | None:
+    """Table 1's exchange row read with one hand unseen after the separation (``decision.unseen_exchange``):
+    both hands seen before, one of them holding a colour the other does not; after, either the
+    giver is seen without it and the taker unseen (the object went away with a hand the tracker
+    lost, e.g. taken back behind the taker's body), or the taker is seen with it and the giver
+    unseen. None otherwise (``seen``: a before, a after, b before, b after)."""
+    d = params.decision
+    if not d.unseen_exchange:
+        return None
+    ab, aa, bb, ba = seen
+    if ab is None or bb is None:
+        return None
+    for give_b, give_a, take_b, take_a in ((ab, aa, bb, ba), (bb, ba, ab, aa)):
+        if (give_a is None) == (take_a is None):  # both seen is Table 1's case, neither is no case
+            continue
+        for hue, m in give_b.items():
+            if m < d.min_mass or not absent(_mass_of(take_b, hue, params), m, params):
+                continue
+            if take_a is None and absent(_mass_of(give_a, hue, params), m, params):
+                return Verdict("exchange", hue, d.unseen_confidence)
+            if give_a is None and _mass_of(take_a, hue, params) >= d.min_mass:
+                return Verdict("exchange", hue, d.unseen_confidence)
+    return None
 
 
 def _unseen_confidence(seen: list[dict | None], params: ActivityParams) -> float:

@@ -47,7 +47,7 @@ def _margin(present: list[float], absent: list[float], params: ActivityParams) -
     return float(max(0.0, min(1.0, 0.5 * (up + down) + 0.5)))
 
 
-def _absent(m: float, present: float, params: ActivityParams) -> bool:
+def absent(m: float, present: float, params: ActivityParams) -> bool:
     """Not held: below ``max_mass_absent``, or a small fraction of what the other point holds."""
     return m <= max(params.decision.max_mass_absent, params.decision.absent_ratio * present)
 
@@ -61,8 +61,8 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
             if m < d.min_mass:
                 continue
             gained = _mass(dst_a, hue, params)
-            if (gained >= d.min_mass and _absent(_mass(dst_b, hue, params), gained, params)
-                    and _absent(_mass(src_a, hue, params), m, params)):
+            if (gained >= d.min_mass and absent(_mass(dst_b, hue, params), gained, params)
+                    and absent(_mass(src_a, hue, params), m, params)):
                 return Verdict("exchange", hue, _margin([m, gained], [_mass(dst_b, hue, params),
                                                                         _mass(src_a, hue, params)], params))
     margin = 1.0 - _moved(a_before, b_before, a_after, b_after, params) / max(d.min_mass, 1e-9)
@@ -97,14 +97,14 @@ def one_hand(before: dict, after: dict, params: ActivityParams, stays=None) -> V
     best = None
     for hue, m in after.items():
         was = _mass(before, hue, params)
-        if m >= d.min_mass and _absent(was, m, params) and stays(hue) is not True:
+        if m >= d.min_mass and absent(was, m, params) and stays(hue) is not True:
             v = Verdict("pick", hue, _margin([m], [was], params))
             best = v if best is None or v.margin > best.margin else best
     for hue, m in before.items():
         now = _mass(after, hue, params)
         if m < d.min_mass:
             continue
-        if _absent(now, m, params):
+        if absent(now, m, params):
             v = Verdict("place", hue, _margin([m], [now], params))
         elif stays(hue) is True:
             v = Verdict("place", hue, _margin([m], [], params))

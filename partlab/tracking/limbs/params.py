@@ -174,6 +174,24 @@ class LimbStates:
     # stays lost on it), and one of them then tracked the wrong hand (synthetic exchange seed 3).
     # Desk 320x240 and 720x480 (12 seeds) and walker (4 seeds) rates: unchanged.
     pair_lost_claims: bool = flag(True)
+    # a combined pair of two people's hands seen as one mode that has moved more than split_size
+    # sides from where the hands met, along the direction between them before the join, has parted
+    # with one hand unseen
+    # (one camera: the taker's hand back behind its own body after an exchange): the mode goes to
+    # the member on its side, the other is lost (sec. 5.2) and looked for as far back the other
+    # way. Off: the pair stayed combined on the seen hand, both labels on it (exchange seed 3: the
+    # giver's hand, from the handover to the end of the clip). Not for one person's two hands: a
+    # walker's hands cross as they swing and the pair moves with the walker (synthetic walker seed
+    # 1: right-hand mean rate 0.725 -> 0.671 when it applied to them).
+    split_unseen: bool = flag(True)
+    # a combined pair owns the candidates within a split distance of its estimate (its two hands,
+    # apart but not yet split) and, for a lost hand looking for its blob, every part of a blob it
+    # sits on (two hands already). Off: only those within half a box plus sigma_xy, as a single
+    # hand. Exchange seed 3 (renderer of 2026-12-06): person 2's left hand, lost from frame 6 (a
+    # faint blob) and found again at 52, jumped 60 px onto the meeting hands' second blob, 20 px
+    # from the pair's estimate; person 1's lost left hand did the same at 57. The pair then saw
+    # its blob only every other frame and was lost at 72, both hands held at the meeting point.
+    pair_span: bool = flag(True)
     lost_likelihood: float = number(0.15, FRACTION)
     # hysteresis: a lost target comes back only above this confidence.
     recover_likelihood: float = number(0.3, FRACTION)
@@ -301,4 +319,5 @@ class LimbParams(Parameters):
         "people_end_frames": "people.end_frames",
     }
     #: fields added after partlab 0.2 (no flat name)
-    ADDED: ClassVar[tuple[str, ...]] = ("states.pair_lost_claims",)
+    ADDED: ClassVar[tuple[str, ...]] = ("states.pair_lost_claims", "states.split_unseen",
+                                            "states.pair_span")

@@ -16,6 +16,14 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   more than ``split_size`` target sizes (or ``split_distance`` pixels) apart; each tracker receives
   the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
+- combined -> unlabelled (the member on the side its mode went) and lost (the other): a pair of
+  two people's hands (``Observation.two_people``) with one mode only whose estimate has moved more than ``split_size`` target sizes from where the
+  hands met along the direction between them before the join (``states.split_unseen``): the
+  hands have parted and one of them is no longer seen (in one camera, a hand taken back behind
+  its own body); the seen mode is the member's on whose side it went (sec. 7.1's direction cue),
+  and the other, with no mode to receive, is lost (sec. 5.2's lost state: no candidate represents
+  it) rather than riding on the other's hand; it is looked for where it would be had it moved
+  back as far the other way;
 - normal / unlabelled / combined -> lost: the likelihood stays below
   ``lost_likelihood`` for ``lost_frames`` frames (sec. 5.2: "test the posterior
   probabilities against a threshold");
@@ -67,6 +75,9 @@ class Observation:
     #: the frame could not have seen the target (e.g. too few views left to triangulate anything):
     #: it counts as a confident frame for ``lost_frames`` (the count starts again after it)
     unseen: bool = False
+    #: a combined pair's leader: its two members are two people's (each hand goes back to its own
+    #: person's side after they part, which ``split_unseen`` relies on)
+    two_people: bool = False
 
 
 @dataclass(frozen=True)
@@ -100,6 +111,7 @@ class _Status:
     partner: int | None = None
     joined_at: int = -1
     before: np.ndarray | None = None  # this tracker's position minus its partner's, before the join
+    met: np.ndarray | None = None  # combined: where the pair's estimate was when the two joined
     history: deque = field(default_factory=deque)
 
 
@@ -253,12 +265,35 @@ class LimbStateMachine:
             self._end_join(frame, t, b, "split")
             move(t, LimbState.UNLABELLED, "split", b, tuple(map(float, pos_a)))
             move(b, LimbState.UNLABELLED, "split", t, tuple(map(float, pos_b)))
+        elif (getattr(p, "split_unseen", False)  # the one-camera tracker's rule; limbs3d has no such field
+              and obs.two_people and len(modes) < 2 and obs.position is not None and s.met is not None):
+            self._split_one_unseen(frame, t, b, s, np.asarray(obs.position, float), obs.size, move)
+
+    def _split_one_unseen(self, frame: int, a: int, b: int, s: _Status, at: np.ndarray, size: float,
+                          move) -> None:
+        """The pair's one mode ``at`` has left the meeting point by more than the split distance
+        along the direction between the two before the join: the member on that side receives it,
+        the other is lost, looked for as far back the other way from the meeting point."""
+        before = np.asarray(s.before, float)
+        norm = _length(before)
+        if norm <= 0:
+            return
+        u = before / norm  # from b towards a, before the join
+        along = float(np.dot(at - s.met, u))
+        if abs(along) <= distance_threshold(self.params.states.split_distance, self.params.states.split_size,
+                                            size):
+            return
+        seen, unseen = (a, b) if along > 0 else (b, a)
+        guess = s.met - along * u  # the unseen hand, gone back as far the other way
+        self._end_join(frame, a, b, "split")
+        move(seen, LimbState.UNLABELLED, "split", unseen, tuple(map(float, at)))
+        move(unseen, LimbState.LOST, "split unseen", seen, tuple(map(float, guess)))
 
     def _end_join(self, frame: int, a: int, b: int, how: str) -> None:
         sa, sb = self._status[a], self._status[b]
         self.events.append(JoinEvent(sa.joined_at, frame, min(a, b), max(a, b), how))
         for s in (sa, sb):
-            s.partner, s.joined_at, s.before = None, -1, None
+            s.partner, s.joined_at, s.before, s.met = None, -1, None, None
 
     def _combine(self, frame: int, observations: dict[int, Observation], move) -> None:
         """Pair normal trackers whose estimates are closer than ``combine_distance``, closest first."""
@@ -282,10 +317,11 @@ class LimbStateMachine:
                 continue
             used |= {a, b}
             before = self._direction_before(a, b, observations)
+            met = (np.asarray(observations[a].position, float) + np.asarray(observations[b].position, float)) / 2
             for t, other, vec in ((a, b, before), (b, a, -before)):
                 s = self._status[t]
                 move(t, LimbState.COMBINED, "estimates joined", other)
-                s.partner, s.joined_at, s.before = other, frame, vec
+                s.partner, s.joined_at, s.before, s.met = other, frame, vec, met.copy()
 
     def _direction_before(self, a: int, b: int, observations: dict[int, Observation]) -> np.ndarray:
         """Position of a minus b at the latest remembered frame when they were still apart."""

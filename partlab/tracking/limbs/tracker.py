@@ -351,8 +351,11 @@ class LimbTracker:
             self._refine(tgt, obs_c, on_end, view.skin_bins)
         tgt.filter.resample(self.rng)
         self._remember(t, state, before, view.skin_bins)
+        partner = self.machine.partner(t) if state == LimbState.COMBINED else None
+        two_people = partner is not None and tgt.track_id is not None and \
+            self.targets[partner].track_id not in (None, tgt.track_id)
         observation = Observation(position=tuple(tgt.filter.estimate), likelihood=tgt.filter.confidence,
-                                  labelled=tgt.labelled, modes=modes, size=self._side(t))
+                                  labelled=tgt.labelled, modes=modes, size=self._side(t), two_people=two_people)
         self._place_pair(t, modes)
         return observation
 
@@ -361,7 +364,7 @@ class LimbTracker:
         p, tgt = self.params, self.targets[t]
         if state == LimbState.LOST:
             tgt.filter.reset(self._search_centre(t), self.rng, spread=p.dynamics.lost_search)
-            return self._unclaimed(own_c, exclude=t)
+            return self._unclaimed(own_c, exclude=t, pairs=p.states.pair_span)
         if state == LimbState.COMBINED:
             # the pair's filter sees only candidates no other tracker explains (its own blobs)
             tgt.filter.predict(self.rng, p.dynamics.combined_noise_scale)
@@ -588,10 +591,21 @@ class LimbTracker:
         if len(cands) == 0 or not live:
             return np.full(len(cands), -1), np.zeros(len(cands), bool)
         est = np.array([self.targets[t].filter.estimate for t in live])
-        reach = np.array([max(self.targets[t].size) / 2 + self.params.priors.sigma_xy for t in live])
+        reach = np.array([self._claim_radius(t) for t in live])
         d = np.hypot(cands.centres[:, None, 0] - est[None, :, 0], cands.centres[:, None, 1] - est[None, :, 1])
         j = d.argmin(axis=1)
         return np.asarray(live)[j], d[np.arange(len(cands)), j] <= reach[j]
+
+    def _claim_radius(self, t: int) -> float:
+        """How far from a target's estimate a candidate is its own: half its box plus sigma_xy; a
+        combined pair's (with ``states.pair_span``) reaches a split distance: its two hands, apart
+        but not yet split, are both its."""
+        tgt = self.targets[t]
+        reach = max(tgt.size) / 2 + self.params.priors.sigma_xy
+        if self.params.states.pair_span and self.machine.state(t) == LimbState.COMBINED:
+            st = self.params.states
+            reach = max(reach, distance_threshold(st.split_distance, st.split_size, self._side(t)))
+        return reach
 
     def _owned(self, cands: Candidates, t: int, owners: tuple[np.ndarray, np.ndarray]) -> Candidates:
         """The candidates a normal filter is weighted against: all but those another target sits on
@@ -607,10 +621,13 @@ class LimbTracker:
                           {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep],
                           None if cands.parents is None else cands.parents[keep])
 
-    def _unclaimed(self, cands: Candidates, exclude: int | tuple, lost: bool = False) -> Candidates:
+    def _unclaimed(self, cands: Candidates, exclude: int | tuple, lost: bool = False,
+                   pairs: bool = False) -> Candidates:
         """Candidates not explained by another active tracker (a lost target must not
         recover onto a limb someone else tracks); ``lost``: nor lying where a lost target is looked
-        for (:meth:`_search_centre`)."""
+        for (:meth:`_search_centre`); ``pairs``: nor within a split distance of a combined pair
+        (its two hands, apart but not yet split) or on any part of a blob it sits on (the blob
+        holds two hands already: its other end, an arm's, is no third hand)."""
         if len(cands) == 0:
             return cands
         keep = np.ones(len(cands), bool)
@@ -625,7 +642,11 @@ class LimbTracker:
                 at = self._search_centre(t)
             else:
                 continue
-            keep &= np.hypot(*(cands.centres - at[None, :]).T) > max(tgt.size) / 2 + self.params.priors.sigma_xy
+            reach = self._claim_radius(t) if pairs else max(tgt.size) / 2 + self.params.priors.sigma_xy
+            near = np.hypot(*(cands.centres - at[None, :]).T) <= reach
+            if pairs and state == LimbState.COMBINED and cands.parents is not None and near.any():
+                near |= np.isin(cands.parents, cands.parents[near])
+            keep &= ~near
         return self._subset(cands, keep)
 
     def _propose(self, cands: Candidates, observations: dict[int, Observation], people: np.ndarray | None) -> None:
@@ -820,6 +841,10 @@ class LimbTracker:
                 tgt.filter = self._make_filter(tgt, tr.position)
             tgt.filter.reset(tr.position, self.rng)
             tgt.last = np.asarray(tr.position, float)
+        elif tr.reason == "split unseen":  # parted from its pair, not seen: looked for at the guess
+            tgt.last, tgt.anchor = np.asarray(tr.position, float), self._head_of(tr.tracker)
+            if tgt.filter is None:
+                tgt.filter = self._make_filter(tgt, tgt.last)
         elif tr.new == LimbState.LOST:
             if tgt.filter is None:  # a follower of a lost pair
                 tgt.filter = self._make_filter(tgt, tgt.last)
