@@ -116,6 +116,7 @@ class Person:
     coast_start: int | None = None          # first frame of the coasting stretch it is in (lost or occluded)
     at_border: int | None = None            # last supported frame its box was at a border, not moving away
     given: dict[str, Box] = field(default_factory=dict)  # boxes it was started from (--init, keyframes), as drawn
+    steps: deque = field(default_factory=lambda: deque(maxlen=3))  # torso displacements of its first measured frames
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -369,6 +370,7 @@ class BodyTracker:
         if not self.whole:
             self._detect_failures(active, ycc, mask)
         self._update_models(active)
+        self._learn_start_velocity(active, index)
 
         for person in active:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
@@ -380,6 +382,27 @@ class BodyTracker:
             self._detect(index, frame, ycc, mask)
         self._note_coasting(index, new_ids)
         return self._records(index, new_ids)
+
+    def _learn_start_velocity(self, active: list[Person], index: int) -> None:
+        """``dynamics.start_velocity_frames``: in a track's first frames, every part's velocity goes
+        ``start_velocity_gain`` of the way to the median of the torso estimate's last displacements
+        (Xu, Deng & Jia sec. 3: the velocity is the last displacement of the estimate). A track
+        starts standing, and the colour filters learn a walker's speed only through their velocity
+        noise; a lagging new track slides onto a slower neighbour."""
+        d = self.params.dynamics
+        if d.start_velocity_frames <= 0 or d.start_velocity_gain <= 0:
+            return
+        for person in active:
+            if index - person.started > d.start_velocity_frames or "torso" not in person.prev:
+                continue
+            if person.occluded_by is not None or person.lost_since is not None or person.adjusted:
+                continue  # coasting or re-initialised: no displacement measured this frame
+            person.steps.append(person.filters["torso"].state[0:2] - person.prev["torso"][0:2])
+            if len(person.steps) < 2:
+                continue
+            v = np.median(np.asarray(person.steps), axis=0)
+            for f in person.filters.values():
+                f.nudge_velocity(v, d.start_velocity_gain)
 
     def _note_coasting(self, index: int, new_ids: set[int]) -> None:
         """Keep, per person, where its current coasting stretch (lost, or behind someone) began; a
