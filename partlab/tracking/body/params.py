@@ -555,7 +555,8 @@ class BodyParams(Parameters):
                                         "background.camera_motion", "background.camera_hold",
                                         "background.camera_residual", "background.camera_rewind",
                                         "detection.exit_margin", "detection.exit_window", "occlusion.bridge",
-                                        "output.head_sets_sides", "appearance.surround", "appearance.surround_floor")
+                                        "output.head_sets_sides", "appearance.surround", "appearance.surround_floor",
+                                        "dynamics.start_velocity_frames", "dynamics.start_velocity_gain")
 
     #: partlab 0.2's flat names (the shipped bundle and users' bundles) -> where they live now
     FLAT: ClassVar[dict[str, str | None]] = {

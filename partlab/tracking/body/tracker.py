@@ -392,6 +392,8 @@ class BodyTracker:
         d = self.params.dynamics
         if d.start_velocity_frames <= 0 or d.start_velocity_gain <= 0:
             return
+        if self.camera is not None and self.camera.moving:
+            return  # a panning camera follows its walker: the image displacement is not theirs
         for person in active:
             if index - person.started > d.start_velocity_frames or "torso" not in person.prev:
                 continue
