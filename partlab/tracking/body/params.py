@@ -169,7 +169,8 @@ class BodyDynamics:
     # sec. 3, x_t - x_{t-1} = x_{t-1} - x_{t-2}). A track starts standing (velocity 0) and its
     # particles learn a walker's speed only through their velocity noise: on PETS09 a track given at
     # frame 528 moved at -2.4 px a frame three frames later while its estimate moved at -10, lagged
-    # onto the slower person behind and swapped with them. 0 frames: off. 12 (2026-12-06): PETS09
+    # onto the slower person behind and swapped with them. Not while the camera moves (a panning
+    # camera follows its walker: OTB Human3 rate 0.51 -> 0.27 with it). 0 frames: off. 12 (2026-12-06): PETS09
     # from the first boxes, seeds 1-8, person rate 0.759 -> 0.830, MOTA 0.730 -> 0.740, IDF1
     # 0.844 -> 0.851, edits/100 16.58 -> 15.17; automatic, seeds 1-4, MOTA 0.773 -> 0.782, IDF1
     # 0.803 -> 0.824 (docs/measurements/annotation_effort.md).
