@@ -173,7 +173,8 @@ class BodyDynamics:
     # camera follows its walker: OTB Human3 rate 0.51 -> 0.27 with it). 0 frames: off. 12 (2026-12-06): PETS09
     # from the first boxes, seeds 1-8, person rate 0.759 -> 0.830, MOTA 0.730 -> 0.740, IDF1
     # 0.844 -> 0.851, edits/100 16.58 -> 15.17; automatic, seeds 1-4, MOTA 0.773 -> 0.782, IDF1
-    # 0.803 -> 0.824 (docs/measurements/annotation_effort.md).
+    # 0.803 -> 0.824, but randomized scenes 100-101 automatic MOTA 0.458 -> 0.435
+    # (docs/measurements/annotation_effort.md).
     start_velocity_frames: int = number(12, COUNT)
     start_velocity_gain: float = number(0.5, FRACTION)
 
