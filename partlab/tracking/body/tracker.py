@@ -131,6 +131,7 @@ class Person:
     first: dict[str, PartFilter] = field(default_factory=dict)  # its filters as started (models of the given boxes)
     seen: tuple[int, float, float] | None = None  # (frame, cx, cy): last measured clear of everyone, not lost
     revived: int | None = None  # frame it was re-identified (``detector.reid_hits``), if it was
+    steps: deque = field(default_factory=lambda: deque(maxlen=3))  # torso displacements of its first measured frames
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -423,6 +424,7 @@ class BodyTracker:
         if not self.whole:
             self._detect_failures(active, ycc, mask)
         self._update_models(active)
+        self._learn_start_velocity(active, index)
 
         for person in active:
             if not person.touching and person.occluded_by is None and not person.hidden_parts:
@@ -436,6 +438,29 @@ class BodyTracker:
             self._detect(index, frame, ycc, mask)
         self._note_coasting(index, new_ids)
         return self._records(index, new_ids)
+
+    def _learn_start_velocity(self, active: list[Person], index: int) -> None:
+        """``dynamics.start_velocity_frames``: in a track's first frames, every part's velocity goes
+        ``start_velocity_gain`` of the way to the median of the torso estimate's last displacements
+        (Xu, Deng & Jia sec. 3: the velocity is the last displacement of the estimate). A track
+        starts standing, and the colour filters learn a walker's speed only through their velocity
+        noise; a lagging new track slides onto a slower neighbour."""
+        d = self.params.dynamics
+        if d.start_velocity_frames <= 0 or d.start_velocity_gain <= 0:
+            return
+        if self.camera is not None and self.camera.moving:
+            return  # a panning camera follows its walker: the image displacement is not theirs
+        for person in active:
+            if index - person.started > d.start_velocity_frames or "torso" not in person.prev:
+                continue
+            if person.occluded_by is not None or person.lost_since is not None or person.adjusted:
+                continue  # coasting or re-initialised: no displacement measured this frame
+            person.steps.append(person.filters["torso"].state[0:2] - person.prev["torso"][0:2])
+            if len(person.steps) < 2:
+                continue
+            v = np.median(np.asarray(person.steps), axis=0)
+            for f in person.filters.values():
+                f.nudge_velocity(v, d.start_velocity_gain)
 
     def _note_coasting(self, index: int, new_ids: set[int]) -> None:
         """Keep, per person, where its current coasting stretch (lost, or behind someone) began; a
