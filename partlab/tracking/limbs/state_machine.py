@@ -17,8 +17,9 @@ and ``lost``. Transitions, each driven by what the low layer reports per frame
   the mode that keeps the
   direction between them from before the join (sec. 7.1), which labels them again;
 - combined -> unlabelled (the member on the side its mode went) and lost (the other): a pair of
-  two people's hands (``Observation.two_people``) with one mode only whose estimate has moved more than ``split_size`` target sizes from where the
-  hands met along the direction between them before the join (``states.split_unseen``): the
+  two people's hands (``Observation.two_people``) with one mode only whose estimate has moved
+  more than ``split_size`` target sizes from where the hands met along the direction between
+  them before the join (``states.split_unseen``): the
   hands have parted and one of them is no longer seen (in one camera, a hand taken back behind
   its own body); the seen mode is the member's on whose side it went (sec. 7.1's direction cue),
   and the other, with no mode to receive, is lost (sec. 5.2's lost state: no candidate represents
