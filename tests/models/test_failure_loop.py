@@ -25,9 +25,11 @@ def test_shipped_detector_and_adjustment_keep_the_head_the_plain_tracker_loses(s
         rates[name] = part_rates(tracks, scene.truth)
         if det is not None:
             assert (tracks[tracks.part == "person"].state == "adjusted").sum() >= 5
-    # measured: plain head 0.72 / 0.77 (it stays above the torso while the head hangs in front),
-    # with detection and adjustment 1.00 / 0.99; torso and hip-leg no worse
-    assert rates["plain"]["head"] < 0.85
+    # measured (seeds 3 / 4): plain head 0.87 / 0.77 (it stays above the torso while the head hangs
+    # in front; 0.72 / 0.76 before dynamics.start_velocity_frames), with detection and adjustment
+    # 1.00 / 0.96; torso and hip-leg no worse
+    assert rates["plain"]["head"] < 0.9
     assert rates["adjusted"]["head"] >= 0.95
+    assert rates["adjusted"]["head"] - rates["plain"]["head"] >= 0.1
     for part in ("torso", "hipleg"):
         assert rates["adjusted"][part] >= rates["plain"][part] - 0.02
