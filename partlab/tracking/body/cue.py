@@ -50,9 +50,9 @@ def _blob_regions(mask: np.ndarray | None, min_height: float) -> list[Box]:
     return [Box(*(float(v) for v in stats[i, :4])) for i in range(1, n) if stats[i, 3] >= min_height]
 
 
-def _border_gap(box: Box, border: str, W: int, H: int) -> float:
-    """Pixels between ``box`` and the frame's ``border`` (left, right, top or bottom)."""
-    return {"left": box.x, "right": W - box.x2, "top": box.y, "bottom": H - box.y2}[border]
+def border_gaps(box: Box, W: int, H: int) -> dict[str, float]:
+    """Pixels between ``box`` and each border of a ``W`` x ``H`` frame (left, right, top, bottom)."""
+    return {"left": box.x, "right": W - box.x2, "top": box.y, "bottom": H - box.y2}
 
 
 def _target(part: Box, person: Box, det: Box) -> Box:
@@ -332,7 +332,7 @@ class DetectionCue:
                 c.box, c.hits, c.last_scan = det, c.hits + 1, self.scans
             else:
                 border = t.dormant[tid].border
-                if border is not None and _border_gap(det, border, W, H) > p.reid_border * det.h:
+                if border is not None and border_gaps(det, W, H)[border] > p.reid_border * det.h:
                     continue  # it walked out elsewhere
                 c = Candidate(det, 1, self.scans, tid)
             if c.hits >= p.reid_hits and tid in t.dormant:

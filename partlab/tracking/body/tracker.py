@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING
 import cv2
 import numpy as np
 
-from partlab.tracking.body.cue import DetectionCue, _layout, _placed
+from partlab.tracking.body.cue import DetectionCue, _layout, _placed, border_gaps
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
 from partlab.tracking.body.part_filter import PartFilter, surround_counts
@@ -210,7 +210,7 @@ def _frozen(f: PartFilter) -> PartFilter:
 
 def _nearest_border(box: Box, W: int, H: int) -> str:
     """The border of a ``W`` x ``H`` frame nearest to ``box``."""
-    gaps = {"left": box.x, "right": W - box.x2, "top": box.y, "bottom": H - box.y2}
+    gaps = border_gaps(box, W, H)
     return min(gaps, key=gaps.get)
 
 
