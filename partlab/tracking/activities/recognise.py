@@ -34,7 +34,7 @@ from partlab.tracking.activities.objects import (
     hue_to_hex,
 )
 from partlab.tracking.activities.params import ActivityParams
-from partlab.tracking.activities.table import Verdict, absent, one_hand, two_hands
+from partlab.tracking.activities.table import Verdict, absent, mass, one_hand, two_hands
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord
 
@@ -356,7 +356,7 @@ def _two_hand_verdict(seen: list[dict], a: Key, b: Key, windows, centres, where,
     v = two_hands(ab, bb, aa, ba, a[0] == b[0], params)
     if v.kind != "exchange" or v.colour is None:
         return v
-    giver, taker = (a, b) if _mass_of(ab, v.colour, params) >= _mass_of(bb, v.colour, params) else (b, a)
+    giver, taker = (a, b) if mass(ab, v.colour, params) >= mass(bb, v.colour, params) else (b, a)
     if not _stayed_put(where, centres, giver, taker, v.colour, windows, params):
         return v
     return replace(two_hands({}, {}, {}, {}, a[0] == b[0], params), margin=0.5)
@@ -415,11 +415,11 @@ def _unseen_exchange(seen: list[dict | None], params: ActivityParams) -> Verdict
         if (give_a is None) == (take_a is None):  # both seen is Table 1's case, neither is no case
             continue
         for hue, m in give_b.items():
-            if m < d.min_mass or not absent(_mass_of(take_b, hue, params), m, params):
+            if m < d.min_mass or not absent(mass(take_b, hue, params), m, params):
                 continue
-            if take_a is None and absent(_mass_of(give_a, hue, params), m, params):
+            if take_a is None and absent(mass(give_a, hue, params), m, params):
                 return Verdict("exchange", hue, d.unseen_confidence)
-            if give_a is None and _mass_of(take_a, hue, params) >= d.min_mass:
+            if give_a is None and mass(take_a, hue, params) >= d.min_mass:
                 return Verdict("exchange", hue, d.unseen_confidence)
     return None
 
@@ -436,11 +436,6 @@ def _unseen_confidence(seen: list[dict | None], params: ActivityParams) -> float
     if len(known) < d.unseen_min_seen or any(m >= d.min_mass for s in known for m in s.values()):
         return 0.3
     return d.unseen_confidence
-
-
-def _mass_of(held: Mapping[int, float], hue: int, params: ActivityParams) -> float:
-    reach = params.decision.same_colour / DEGREES_PER_BIN
-    return max((m for h, m in held.items() if min((h - hue) % HUE_BINS, (hue - h) % HUE_BINS) <= reach), default=0.0)
 
 
 def _distinct(rows: list[dict]) -> list[dict]:
@@ -533,7 +528,7 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
                 # the side where the colour is gone (after a place, before a pick): a view that still
                 # shows it as much as the views together showed it held saw no change there
                 lo, hi, held = (a0, a1, before) if v.kind == "place" else (b0, b1, after)
-                if _one_view_mass(colours.get(key, {}), lo, hi, v.colour, params) >= _mass_of(held, v.colour, params):
+                if _one_view_mass(colours.get(key, {}), lo, hi, v.colour, params) >= mass(held, v.colour, params):
                     continue
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
@@ -591,7 +586,7 @@ def other_sides(rows: list[dict], colours: Mapping[Key, Mapping[int, list[HandCo
             after = _without(_held_seen(cs, a0, a1, 1, params), worn)
             if before is None or after is None:
                 continue
-            was, now = _mass_of(before, r["hue"], params), _mass_of(after, r["hue"], params)
+            was, now = mass(before, r["hue"], params), mass(after, r["hue"], params)
             held, gone = (was, now) if other == "place" else (now, was)
             if held < d.min_mass or gone > max(d.max_mass_absent, d.absent_ratio * held):
                 continue
@@ -616,7 +611,7 @@ def _one_view_mass(colours: Mapping[int, list[HandColour]], lo: int, hi: int, hu
             views.setdefault(o.view, []).append(o)
     if len(views) < 2:
         return 0.0
-    return max(_mass_of(colour_masses(fuse(obs), params), hue, params) for obs in views.values())
+    return max(mass(colour_masses(fuse(obs), params), hue, params) for obs in views.values())
 
 
 def _stood(centres: Mapping[int, tuple[float, float, float]], s0: int, s1: int) -> tuple[float, float, float] | None:

@@ -20,6 +20,7 @@ handshake is never called an exchange unless a colour changed hands.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from partlab.tracking.activities.objects import DEGREES_PER_BIN, HUE_BINS
@@ -33,10 +34,11 @@ class Verdict:
     margin: float  # how far the deciding shares are from the thresholds (0..1)
 
 
-def _mass(held: dict[int, float], hue: int, params: ActivityParams) -> float:
+def mass(held: Mapping[int, float], hue: int, params: ActivityParams) -> float:
+    """The largest share ``held`` gives a hue within ``decision.same_colour`` of ``hue`` (0: none)."""
     reach = params.decision.same_colour / DEGREES_PER_BIN
-    return max((m for h, m in held.items() if min(abs(h - hue) % HUE_BINS, HUE_BINS - abs(h - hue) % HUE_BINS)
-                <= reach), default=0.0)
+    return max((m for h, m in held.items() if min((h - hue) % HUE_BINS, (hue - h) % HUE_BINS) <= reach),
+               default=0.0)
 
 
 def _margin(present: list[float], absent: list[float], params: ActivityParams) -> float:
@@ -60,11 +62,11 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
         for hue, m in src_b.items():
             if m < d.min_mass:
                 continue
-            gained = _mass(dst_a, hue, params)
-            if (gained >= d.min_mass and absent(_mass(dst_b, hue, params), gained, params)
-                    and absent(_mass(src_a, hue, params), m, params)):
-                return Verdict("exchange", hue, _margin([m, gained], [_mass(dst_b, hue, params),
-                                                                        _mass(src_a, hue, params)], params))
+            gained = mass(dst_a, hue, params)
+            if (gained >= d.min_mass and absent(mass(dst_b, hue, params), gained, params)
+                    and absent(mass(src_a, hue, params), m, params)):
+                return Verdict("exchange", hue, _margin([m, gained], [mass(dst_b, hue, params),
+                                                                        mass(src_a, hue, params)], params))
     margin = 1.0 - _moved(a_before, b_before, a_after, b_after, params) / max(d.min_mass, 1e-9)
     return Verdict("clap" if same_person else "handshake", None, float(max(0.2, min(1.0, 0.6 + 0.4 * margin))))
 
@@ -78,8 +80,8 @@ def _moved(a_before: dict, b_before: dict, a_after: dict, b_after: dict, params:
     out = 0.0
     for src_b, dst_b, src_a, dst_a in ((a_before, b_before, a_after, b_after), (b_before, a_before, b_after, a_after)):
         for hue in set(src_b) | set(dst_a):
-            lost = _mass(src_b, hue, params) - _mass(src_a, hue, params)
-            gained = _mass(dst_a, hue, params) - _mass(dst_b, hue, params)
+            lost = mass(src_b, hue, params) - mass(src_a, hue, params)
+            gained = mass(dst_a, hue, params) - mass(dst_b, hue, params)
             out = max(out, min(lost, gained))
     return out
 
@@ -96,12 +98,12 @@ def one_hand(before: dict, after: dict, params: ActivityParams, stays=None) -> V
     stays = stays or (lambda hue: None)
     best = None
     for hue, m in after.items():
-        was = _mass(before, hue, params)
+        was = mass(before, hue, params)
         if m >= d.min_mass and absent(was, m, params) and stays(hue) is not True:
             v = Verdict("pick", hue, _margin([m], [was], params))
             best = v if best is None or v.margin > best.margin else best
     for hue, m in before.items():
-        now = _mass(after, hue, params)
+        now = mass(after, hue, params)
         if m < d.min_mass:
             continue
         if absent(now, m, params):
