@@ -549,14 +549,15 @@ def test_a_head_does_not_take_a_ghost_made_from_the_other_persons_head_blob():
 def test_a_hand_lost_with_its_combined_pair_is_held_at_its_home():
     """Handshake, 2 cameras (the first two of the benchmark's 4-camera render of seed 7): person 1's
     left hand and person 2's right hand are combined in the exchange (frames 79-100) and lost
-    together at frame 101, their modes never parting. Held where the pair was lost (the default),
-    the left hand drifts nowhere, 379-424 mm off in frames 102-130 and near person 2's right hand
-    (the benchmark's swap); with ``states.combined_lost_home`` it is held at its home, relative to
+    together at frame 101, their modes never parting. Held where the pair was lost (rule off),
+    the left hand stays 379-424 mm off in frames 102-130, near person 2's right hand (the
+    benchmark's swap); with ``states.combined_lost_home`` it is held at its home, relative to
     its head, as a hand that left the pair by a split is: 279-323 mm off (that home is where it
     was last tracked alone, already reaching for the exchange, so still far from where it rests)."""
     scene = make_multiview_scene("handshake", 4, seed=7, n_frames=150)
     frames = range(102, 131)
-    before = _part_error(scene, Limbs3DParams(), 2, 1, "left_hand", frames, seed=7)
+    before = _part_error(scene, Limbs3DParams().updated({"states.combined_lost_home": False}), 2, 1, "left_hand",
+                         frames, seed=7)
     after = _part_error(scene, Limbs3DParams().updated({"states.combined_lost_home": True}), 2, 1, "left_hand",
                         frames, seed=7)
     assert len(before) == len(after) == 29
