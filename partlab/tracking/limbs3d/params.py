@@ -279,8 +279,9 @@ class Limbs3DStates:
     # off and within 135 mm of person 2's right hand (a swap); at its home 279-323 mm (that home is
     # where it was last tracked alone, already reaching). 2026-12-06, seeds 0-9: 2-camera handshake
     # seeds 6 and 7 only (83.0 -> 72.7, 68.7 -> 64.6 mm, each loses its swap); held-out seeds 10-19:
-    # 2-camera handshake seed 15 only (73.3 -> 60.4 mm); every other take (standing, seated, 3 and 4
-    # cameras) the same to 0.1 mm: no pair is lost combined there. False = main before
+    # 2-camera handshake seed 15 only (73.3 -> 60.4 mm); every other take (standing and handshake
+    # 0-19, seated 0-9, at 2-4 cameras) the same to 0.1 mm: no pair is lost combined there. False =
+    # main before
     combined_lost_home: bool = flag(True)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
