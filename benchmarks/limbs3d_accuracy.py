@@ -5,7 +5,9 @@ Per scenario and seed one scene is rendered from 4 cameras (``--scene-cams``) at
 memory, no codec) and tracked with the first 2, 3 and 4 of them (``--tracker limbs3d`` from the truth's first frame).
 Prints, per scenario and camera count, the mean 3D error per part (mean over seeds, +- standard
 deviation over seeds), the median, the fraction of frames within 100 mm, hand swaps after the
-clap/handshake (a hand nearer the other hand's truth than its own for 10+ frames after frame 85),
+clap/handshake (a hand nearer the other hand's truth than its own for 10+ frames after frame 85;
+``swaps_on``: only a hand within 135 mm of that other hand's truth; ``swaps_exchanged``: pairs of
+hands each on the other's truth, see :func:`exchanges`),
 a run with camera 0 hidden for 30 frames (frames 60-89, ``--hide-from`` cameras and more: targets
 in the lost state at any frame of 60-100 hidden / with every camera, error over the hidden stretch
 and after it) and CPU frames/s of the tracker alone; last, per scenario and camera count, the mean
@@ -74,6 +76,36 @@ def swaps(e: pd.DataFrame, after: int = 85, frames: int = 10) -> int:
             bad += bool(others) and min(others) < own
         n += bad >= frames
     return n
+
+
+def exchanges(e: pd.DataFrame, after: int = 85, frames: int = 10, near: float = 135.0) -> tuple[int, int]:
+    """Hand swaps that are one: (a hand **on** another hand: its estimate within ``near`` mm of
+    another hand's truth and nearer it than its own for ``frames``+ frames after ``after``; pairs of
+    hands with **exchanged** labels: each on the other for ``frames``+ common frames).
+
+    :func:`swaps` also counts a hand that is off by 250-650 mm, nowhere near any hand, but a little
+    nearer another hand's truth than its own: a lost or drifting hand, which the mean error shows,
+    not a swap of labels. ``near`` is the activities' ``decision.contact_mm`` (two hands within it
+    touch)."""
+    hands = e[e["part"].isin(["left_hand", "right_hand"]) & (e["frame"] >= after)]
+    truth = hands.set_index(["frame", "track_id", "part"])[["X_t", "Y_t", "Z_t"]]
+    keys = sorted(hands.groupby(["track_id", "part"]).groups)
+    on: dict = {k: set() for k in keys}  # (frame, other hand) at which hand k is on the other hand
+    for r in hands.itertuples():
+        est = np.array([r.X, r.Y, r.Z])
+        for o in keys:
+            if o != (r.track_id, r.part) and (r.frame, *o) in truth.index:
+                d = np.linalg.norm(est - truth.loc[(r.frame, *o)].to_numpy(float))
+                if d < near and d < r.err:
+                    on[(r.track_id, r.part)].add((r.frame, o))
+    hand_on = sum(len(v) >= frames for v in on.values())
+    pairs = 0
+    for i, a in enumerate(keys):
+        for b in keys[i + 1:]:
+            fa = {f for f, o in on[a] if o == b}
+            fb = {f for f, o in on[b] if o == a}
+            pairs += len(fa & fb) >= frames
+    return hand_on, pairs
 
 
 def meetings(e: pd.DataFrame, events: pd.DataFrame, contact: float = 135.0) -> dict:
@@ -173,6 +205,7 @@ def main() -> None:
             for n_cams in args.cams:
                 e, fps = run(scene, n_cams, params, seed=seed)
                 row = {"scenario": name, "seed": seed, "cams": n_cams, "fps": fps, "swaps": swaps(e)}
+                row["swaps_on"], row["swaps_exchanged"] = exchanges(e)
                 row.update(meetings(e, scene.events))
                 for part, g in e.groupby("part"):
                     row[f"{part}_mean"] = g["err"].mean()
@@ -186,7 +219,8 @@ def main() -> None:
                 print({k: (round(v, 2) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
     df = pd.DataFrame(rows)
     cols = [c for c in df.columns if c.endswith(("_mean", "_median", "_within100")) or c.startswith("meet_") or c in
-            ("fps", "swaps", "hidden_lost", "unhidden_lost", "hidden_lost_at_100", "unhidden_lost_at_100")]
+            ("fps", "swaps", "swaps_on", "swaps_exchanged", "hidden_lost", "unhidden_lost", "hidden_lost_at_100",
+             "unhidden_lost_at_100")]
     summary = df.groupby(["scenario", "cams"])[cols].agg(["mean", "std"])
     pd.set_option("display.width", 250)
     pd.set_option("display.max_columns", 60)
@@ -195,7 +229,8 @@ def main() -> None:
     for (name, n_cams), g in df.groupby(["scenario", "cams"]):
         over = [f"{r.seed} ({', '.join(f'{c[:-5]} {getattr(r, c):.0f}' for c in parts if getattr(r, c) > 50)})"
                 for r in g.itertuples() if max(getattr(r, c) for c in parts) > 50]
-        sums = {c: int(g[c].sum()) for c in ("swaps", "hidden_lost", "unhidden_lost") if c in g}
+        sums = {c: int(g[c].sum()) for c in ("swaps", "swaps_on", "swaps_exchanged", "hidden_lost", "unhidden_lost")
+                if c in g}
         sums.update({c: round(float(g[c].mean()), 2) for c in g.columns
                      if c.startswith("meet_") and g[c].notna().any()})
         print(f"{name} {n_cams} cameras, {len(g)} seeds: all parts {g[parts].mean(axis=1).mean():.1f} "

@@ -270,6 +270,19 @@ class Limbs3DStates:
     # better (a small gain, not robust; 3-camera activities: exchange precision 1.00 -> 0.50, false
     # picks 1 -> 4), so it stays off: False = before
     lost_home: bool = flag(False)
+    # a hand of a combined pair that is lost with it (the state machine's "combined -> lost": the
+    # pair's modes never parted) is held and looked for at its home, relative to its head, as a
+    # hand that left the pair by a split is with three views or more (our addition; sec. 5.2's lost
+    # state retrieves the track from prior information of its position, and after an exchange each
+    # hand goes back to its own person, sec. 7.1). Handshake seed 7, 2 cameras: person 1's left hand,
+    # lost with person 2's right at the end of the exchange, was held where the pair was, 379-424 mm
+    # off and within 135 mm of person 2's right hand (a swap); at its home 279-323 mm (that home is
+    # where it was last tracked alone, already reaching). 2026-12-06, seeds 0-9: 2-camera handshake
+    # seeds 6 and 7 only (83.0 -> 72.7, 68.7 -> 64.6 mm, each loses its swap); held-out seeds 10-19:
+    # 2-camera handshake seed 15 only (73.3 -> 60.4 mm); every other take (standing and handshake
+    # 0-19, seated 0-9, at 2-4 cameras) the same to 0.1 mm: no pair is lost combined there. False =
+    # main before
+    combined_lost_home: bool = flag(True)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of

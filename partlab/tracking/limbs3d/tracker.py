@@ -307,6 +307,9 @@ class Limbs3DTracker:
             t = self.targets[tr.tracker]
             if tr.tracker in splits:
                 self._split(t, splits[tr.tracker], heads.get(t.track_id))
+            elif (p.states.combined_lost_home and tr.old == LimbState.COMBINED and tr.new == LimbState.LOST
+                  and t.part != "head"):
+                t.returning = True  # held at its home while lost (sec. 7.1: after a handshake each hand goes back)
             # (a target that becomes combined and is not its pair's leader: the leader's filter tracks both)
         return self._records(index)
 
