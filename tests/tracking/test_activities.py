@@ -363,3 +363,40 @@ def test_a_handshake_over_an_exchange_between_the_same_people_is_its_touch():
     others = dict(shake, track_id_a=3)  # another person's
     out = _exchange_touches_dropped([ex, shake, later, others])
     assert out == [ex, later, others]
+
+
+def test_a_pick_carried_slowly_away_is_read_where_the_hand_left():
+    """``decision.held_near``: a hand stands still at (100, 100) over frames 20-40 (20 px hand),
+    having come in fast, and leaves at 2 px a frame; the object it took shows round it (0.3 of the
+    circle) over 41-65 and not from 66 on (hidden as the hand comes down elsewhere). The far window
+    (where the hand is ``apart_size`` sides away, from frame 71) sees nothing: only the window right
+    after the still moment shows the pick."""
+    from partlab.tracking.activities.recognise import recognise
+
+    hand = (1, "right_hand")
+    centres = {hand: {f: (100.0 + (10.0 * (20 - f) if f < 20 else 0.0 if f <= 40 else 2.0 * (f - 40)), 100.0, 20.0)
+                      for f in range(0, 100)}}
+    colours = {hand: {f: [_seen("", 40, 0.3 if 41 <= f <= 65 else 0.0)] for f in range(0, 100)}}
+    out = recognise(None, colours, centres, P)
+    # the still moment from 21: centres are smoothed over three frames
+    assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("pick", 21, 40)]
+    assert recognise(None, colours, centres, P.updated({"decision.held_near": False})).empty
+    # the object shows round the hand all along (held before, during and after): nothing
+    always = {hand: {f: [_seen("", 40, 0.3)] for f in range(0, 100)}}
+    assert recognise(None, always, centres, P).empty
+
+
+def test_two_picks_of_one_colour_by_one_hand_are_one_pick():
+    from partlab.tracking.activities.recognise import picked_once
+
+    green, blue = 40, 110
+    first, second = _one_hand("pick", 25, 40, 1, green, confidence=0.9), _one_hand("pick", 45, 56, 1, green + 2)
+    out = picked_once([first, second], P)
+    assert [(r["kind"], r["start_frame"], r["end_frame"], r["confidence"]) for r in out] == [("pick", 25, 56, 0.8)]
+    # not one: another colour, another hand, a place between them, or too far apart in time
+    gap = P.decision.merge_gap
+    for rows in ([first, _one_hand("pick", 45, 56, 1, blue)],
+                 [first, _one_hand("pick", 45, 56, 1, green, part="left_hand")],
+                 [first, _one_hand("place", 42, 43, 1, green), second],
+                 [first, _one_hand("pick", 41 + gap, 80 + gap, 1, green)]):
+        assert len(picked_once(rows, P)) == len(rows)
