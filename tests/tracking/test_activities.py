@@ -400,3 +400,31 @@ def test_two_picks_of_one_colour_by_one_hand_are_one_pick():
                  [first, _one_hand("place", 42, 43, 1, green), second],
                  [first, _one_hand("pick", 41 + gap, 80 + gap, 1, green)]):
         assert len(picked_once(rows, P)) == len(rows)
+
+
+def test_a_touch_with_an_object_in_hand_is_no_handshake():
+    """Table 1's first row needs no object in either hand (``decision.object_at_touch``): a colour
+    held before and after the touch that is round the hands during it too is an object still in
+    hand (the tracker split the hands before it was passed); one only near the hand at rest (the
+    trousers a hanging hand is next to) is not at the meeting and the touch stays a handshake."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    # both hands seen throughout: 100 px apart at rest, 10 px apart (touching) over 40-60
+    centres = {a: {f: (100.0 if not 40 <= f <= 60 else 195.0, 300.0, 15.0) for f in range(100)},
+               b: {f: (300.0 if not 40 <= f <= 60 else 205.0, 300.0, 15.0) for f in range(100)}}
+
+    def colours(share_at_rest, share_at_touch):
+        return {k: {f: [_seen("", 40, (share_at_touch if 40 <= f <= 60 else share_at_rest) if k == a else 0.0)]
+                    for f in c} for k, c in centres.items()}
+
+    bare = recognise(_touch(a, b, 40, 60), colours(0.0, 0.0), centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in bare.itertuples()] == [("handshake", 40, 60)]
+    # an object in a's hand before, at and after the touch: none of Table 1's activities
+    assert recognise(_touch(a, b, 40, 60), colours(0.3, 0.3), centres, P).empty
+    # a colour round a's hand at rest only (0.3 before and after, 0.02 at the meeting): a handshake
+    trousers = recognise(_touch(a, b, 40, 60), colours(0.3, 0.02), centres, P)
+    assert list(trousers["kind"]) == ["handshake"]
+    # the rule off: the object in hand is a handshake, as before
+    off = recognise(_touch(a, b, 40, 60), colours(0.3, 0.3), centres, P.updated({"decision.object_at_touch": False}))
+    assert list(off["kind"]) == ["handshake"]

@@ -114,6 +114,12 @@ class Decision:
     # taker is unseen (the limb tracker lost the taker's hand going back behind the body with the
     # object: exchange seed 3), or the taker is seen with it while the giver is unseen
     unseen_exchange: bool = flag(True)
+    # Table 1's first row (handshake or clap) is a touch with no object in either hand before or
+    # after: a touch where a colour held at a decision point is also round the hands over the touch
+    # (an object at the meeting, not just near a hand at rest) and no exchange is read is no
+    # activity of the table (confidence 0.3). One camera, limb tracker, seeds 0-9: two exchanges
+    # the tracker split before the handover were read as handshakes, one as a clap
+    object_at_touch: bool = flag(True)
     # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
     # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
     still_speed: float = number(0.05, POSITIVE)

@@ -379,6 +379,10 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                 v = _two_hand_verdict(seen, a, b, ((b0, b1), (a0, a1)), centres, where or {}, params)
                 if v.kind == "exchange" and a[0] == b[0]:
                     continue  # an object moved from one of a person's hands to the other: no activity of Table 1
+                if v.kind in ("clap", "handshake") and params.decision.object_at_touch:
+                    touch = [_without(_held(colours.get(k, {}), start, end, params), worn) for k in (a, b)]
+                    if object_at_touch(seen, touch, params) is not None:
+                        v = replace(v, margin=0.3)  # an object in hand: not row 1 of Table 1
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
                             object_colour="" if v.colour is None else hue_to_hex(v.colour))
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
@@ -397,6 +401,25 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
         busy[a].append((start, end))
         busy[b].append((start, end))
     return rows, busy
+
+
+def object_at_touch(seen: list[dict], touch: list[dict | None], params: ActivityParams) -> int | None:
+    """The colour (hue bin) of an object held at a touch of two hands, or None: a colour one of the
+    four decision points (``seen``) holds (``min_mass``) that is also held round either hand over
+    the touch itself (``touch``: the two hands' colours fused over it, None where unseen). Table 1
+    calls a touch a handshake or a clap only when *no* hand holds an object before or after (row
+    1); a colour that stays with one hand through the touch (no exchange read) is an object still
+    in hand, and the touch is none of the table's activities. A colour only near a hand at rest
+    (the trousers a hanging hand is next to) is not at the meeting, so it does not count (one
+    camera, handshake seeds 6 and 9: hue 110-112 0.10-0.31 round a resting hand, none at the
+    touch; exchange seed 0: the object 0.30 round both hands at the touch, read as a handshake
+    because the tracker split the hands before it was passed)."""
+    d = params.decision
+    for held in seen:
+        for hue, m in (held or {}).items():
+            if m >= d.min_mass and any(t is not None and mass(t, hue, params) >= d.min_mass for t in touch):
+                return hue
+    return None
 
 
 def _unseen_exchange(seen: list[dict | None], params: ActivityParams) -> Verdict | None:
