@@ -370,17 +370,24 @@ def test_a_pick_carried_slowly_away_is_read_where_the_hand_left():
     having come in fast, and leaves at 2 px a frame; the object it took shows round it (0.3 of the
     circle) over 41-65 and not from 66 on (hidden as the hand comes down elsewhere). The far window
     (where the hand is ``apart_size`` sides away, from frame 71) sees nothing: only the window right
-    after the still moment shows the pick."""
+    after the still moment shows the pick, and the object is seen to leave with the hand."""
     from partlab.tracking.activities.recognise import recognise
 
     hand = (1, "right_hand")
     centres = {hand: {f: (100.0 + (10.0 * (20 - f) if f < 20 else 0.0 if f <= 40 else 2.0 * (f - 40)), 100.0, 20.0)
                       for f in range(0, 100)}}
     colours = {hand: {f: [_seen("", 40, 0.3 if 41 <= f <= 65 else 0.0)] for f in range(0, 100)}}
-    out = recognise(None, colours, centres, P)
+    # where the object's pixels are: at the hand, moving with it as it leaves
+    moves = {hand: {f: ((40, centres[hand][f][0], 110.0),) for f in range(30, 66)}}
+    out = recognise(None, colours, centres, P, where=moves)
     # the still moment from 21: centres are smoothed over three frames
     assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("pick", 21, 40)]
-    assert recognise(None, colours, centres, P.updated({"decision.held_near": False})).empty
+    assert recognise(None, colours, centres, P.updated({"decision.held_near": False}), where=moves).empty
+    # a colour that stays where the hand stood while the hand leaves (the room behind it) is no pick,
+    # nor one whose movement is not seen
+    stays = {hand: {f: ((40, 100.0, 110.0),) for f in range(30, 66)}}
+    assert recognise(None, colours, centres, P, where=stays).empty
+    assert recognise(None, colours, centres, P).empty
     # the object shows round the hand all along (held before, during and after): nothing
     always = {hand: {f: [_seen("", 40, 0.3)] for f in range(0, 100)}}
     assert recognise(None, always, centres, P).empty

@@ -125,13 +125,13 @@ class Decision:
     still_speed: float = number(0.05, POSITIVE)
     still_frames: int = number(8, POSITIVE_COUNT)
     # a still moment the decision points far from it (``apart_size``) read as neither pick nor place
-    # is read again with the side where the object is held right beside it (the ``gap`` windows): a
-    # pick with the window just after the hand left, a place with the one just before it came. A
-    # hand carrying the object slowly away from where it picked it up is ``apart_size`` hand sides
-    # from there only when it comes down to place it (one camera, pick_place seed 3: the object
-    # 0.24-0.48 of the circle over 54-78, 0.02 at 83-91, where the far window fell: the pick was
-    # missed). The other side stays far: an object resting where the hand stood still shows round
-    # the hand until it has moved on (``stays_behind`` still tells one left behind from one held)
+    # is read again for a pick with the window right after the hand left (the ``gap`` window), where
+    # the colour is also seen to leave with the hand (``stays_behind`` False). A hand carrying the
+    # object slowly away from where it picked it up is ``apart_size`` hand sides from there only
+    # when it comes down to place it (one camera, pick_place seed 3: the object 0.24-0.48 of the
+    # circle over 54-78, 0.02 at 83-91, where the far window fell: the pick was missed). Without
+    # the movement test the room behind a hand of the 3-camera takes (no silhouettes there) gave a
+    # false pick (standing seed 9, a hue 0.16-0.21 round the hand that stayed where it stood)
     held_near: bool = flag(True)
     # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
     # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the

@@ -534,12 +534,12 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
             far_before, far_after = moved_windows(cs, s0, s1, params)
             v = _still_verdict(key, cs, s0, s1, (far_before, far_after), colours, clothes, where, last, params)
             if v is None and d.held_near:
-                # the side where the object is held read right beside the still moment (``held_near``)
-                near_before, near_after = _windows(s0, s1, params)
-                v = (_still_verdict(key, cs, s0, s1, (far_before, near_after), colours, clothes, where, last,
-                                    params, "pick")
-                     or _still_verdict(key, cs, s0, s1, (near_before, far_after), colours, clothes, where, last,
-                                       params, "place"))
+                # a pick read with the window right after the still moment (``held_near``), where
+                # the colour is seen to leave with the hand
+                v = _still_verdict(key, cs, s0, s1, (far_before, _windows(s0, s1, params)[1]), colours, clothes,
+                                   where, last, params, "pick")
+                if v is not None and stays_behind(where.get(key, {}), cs, v.colour, s0, s1, params) is not False:
+                    v = None
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
