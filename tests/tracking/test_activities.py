@@ -435,3 +435,21 @@ def test_a_touch_with_an_object_in_hand_is_no_handshake():
     # the rule off: the object in hand is a handshake, as before
     off = recognise(_touch(a, b, 40, 60), colours(0.3, 0.3), centres, P.updated({"decision.object_at_touch": False}))
     assert list(off["kind"]) == ["handshake"]
+
+
+def test_an_exchange_seen_held_at_one_point_needs_only_not_absent_at_the_other():
+    """``decision.exchange_band``: the colour held (``min_mass``) by the taker after and only in the
+    band between ``max_mass_absent`` and ``min_mass`` round the giver before (a small object seen
+    edge-on: 3-camera handshake seed 9, limbs3d hands, 0.077 before and 0.119 after) is an
+    exchange; neither side held, or one side absent, is not."""
+    green = 40
+    band = P.decision.max_mass_absent + 0.5 * (P.decision.min_mass - P.decision.max_mass_absent)  # 0.06
+    assert two_hands({green: band}, {}, {}, {green: 0.12}, False, P).kind == "exchange"
+    assert two_hands({green: 0.12}, {}, {}, {green: band}, False, P).kind == "exchange"
+    assert two_hands({green: band}, {}, {}, {green: band}, False, P).kind == "handshake"  # neither held
+    assert two_hands({green: 0.02}, {}, {}, {green: 0.12}, False, P).kind == "handshake"  # absent before
+    # the giver keeps it, or the taker had it already: nothing changed hands
+    assert two_hands({green: band}, {}, {green: band}, {green: 0.12}, False, P).kind == "handshake"
+    assert two_hands({green: band}, {green: band}, {}, {green: 0.12}, False, P).kind == "handshake"
+    off = P.updated({"decision.exchange_band": False})
+    assert two_hands({green: band}, {}, {}, {green: 0.12}, False, off).kind == "handshake"

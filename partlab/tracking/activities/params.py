@@ -77,6 +77,13 @@ class Decision:
     # decision point (the object already near the hand before it is picked up); between: no decision
     max_mass_absent: float = number(0.04, FRACTION)
     absent_ratio: float = number(0.25, FRACTION)
+    # an exchange's colour held (``min_mass``) at one end (the giver before, or the taker after) needs
+    # at the other only to be not absent (above ``max_mass_absent`` and ``absent_ratio`` of the held
+    # share): hysteresis, as for touches; once the object is seen in one hand, a smaller share of it
+    # in the other (seen edge-on, half hidden by the fingers) is the same object. 3-camera handshake
+    # seed 9 (limbs3d hands): 0.077 round the giver before, 0.119 round the taker after, read as a
+    # handshake. Off: both ends need ``min_mass``
+    exchange_band: bool = flag(True)
     # two modes within this many degrees are the same colour (an object seen before and after)
     same_colour: float = number(10.0, POSITIVE)
     # the decision points of a two-hand activity are where the hands are this many hand sides apart
