@@ -453,3 +453,18 @@ def test_an_exchange_seen_held_at_one_point_needs_only_not_absent_at_the_other()
     assert two_hands({green: band}, {green: band}, {}, {green: 0.12}, False, P).kind == "handshake"
     off = P.updated({"decision.exchange_band": False})
     assert two_hands({green: band}, {}, {}, {green: 0.12}, False, off).kind == "handshake"
+
+
+def test_a_touch_of_a_frame_or_two_is_no_join():
+    """``decision.min_touch_frames`` (3): two hands near each other over frames 40-41 only did not
+    meet; over 40-42 they did."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    centres = {a: {f: (100.0, 300.0, 15.0) for f in range(100)}, b: {f: (300.0, 300.0, 15.0) for f in range(100)}}
+    bare = {k: {f: [_seen("", 0, 0.0)] for f in c} for k, c in centres.items()}
+    assert recognise(_touch(a, b, 40, 41), bare, centres, P).empty
+    three = recognise(_touch(a, b, 40, 42), bare, centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in three.itertuples()] == [("handshake", 40, 42)]
+    every = P.updated({"decision.min_touch_frames": 1})
+    assert list(recognise(_touch(a, b, 40, 41), bare, centres, every)["kind"]) == ["handshake"]

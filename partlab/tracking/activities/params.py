@@ -99,6 +99,14 @@ class Decision:
     # ... and, with 3D positions (a multi-camera tracker), when their centres are at most this many mm
     # apart: 1.5 hand sides of an adult hand (about 45 mm radius)
     contact_mm: float = number(135.0, POSITIVE)
+    # a join of two hands (after ``merge_gap``) seen over fewer frames than this is no climax point:
+    # two hands whose estimates pass near each other in a frame or two (3D jitter of limbs3d's
+    # hands, a one-frame combine of the limb tracker), not hands that met. 3-camera takes, limbs3d
+    # hands, seeds 0-9: three such 1-2 frame touches were a false clap and two false handshakes
+    # (standing seed 6, handshake seeds 7 and 8); one camera, exchange seed 4: a 2-frame join
+    # 39-40 was read as the exchange, too short to match it (the exchange found instead as a
+    # handover, 41-81). 1: every touch counts
+    min_touch_frames: int = number(3, POSITIVE_COUNT)
     # hysteresis: a touch lasts until the hands are this many times the touching distance apart
     # (a clap's hands part a little between the beats; a shaking pair's boxes jitter)
     release_ratio: float = number(1.4, POSITIVE)

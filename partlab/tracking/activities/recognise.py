@@ -367,6 +367,8 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
     rows, busy = [], defaultdict(list)
     for j in merged_joins(joins, params):
         a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
+        if a[1] in HAND_PARTS and b[1] in HAND_PARTS and end - start + 1 < params.decision.min_touch_frames:
+            continue  # two hands near each other in a frame or two: no join (``min_touch_frames``)
         base = dict(start_frame=start, end_frame=end, kind=j["kind"], track_id_a=a[0], part_a=a[1],
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
