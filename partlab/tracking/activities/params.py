@@ -148,18 +148,18 @@ class Decision:
     # the movement test the room behind a hand of the 3-camera takes (no silhouettes there) gave a
     # false pick (standing seed 9, a hue 0.16-0.21 round the hand that stayed where it stood)
     held_near: bool = flag(True)
-    # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
-    # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the
-    # colour's position moved along the hand's displacement by less than ``follow_ratio`` of it
-    # (median over the frames): a held object moves with the hand (about 1), a resting one does not
-    # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
-    # than following. Seen in at least ``follow_frames`` such frames.
     # a hand the tracker lost for at most ``bridge_frames`` frames and found again within
     # ``bridge_size`` hand sides of where it was last seen was there all along (a tracker of skin
     # blobs loses a hand that stops on a skin-coloured desk, or that takes an object, and finds it
     # again where it stopped): the still moments read it at where it was found again over the gap
     bridge_frames: int = number(20, POSITIVE_COUNT)
     bridge_size: float = number(1.5, POSITIVE)
+    # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
+    # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the
+    # colour's position moved along the hand's displacement by less than ``follow_ratio`` of it
+    # (median over the frames): a held object moves with the hand (about 1), a resting one does not
+    # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
+    # than following. Seen in at least ``follow_frames`` such frames.
     follow_move: float = number(0.5, POSITIVE)
     follow_ratio: float = number(0.5, FRACTION)
     follow_frames: int = number(3, POSITIVE_COUNT)
