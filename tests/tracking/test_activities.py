@@ -363,3 +363,108 @@ def test_a_handshake_over_an_exchange_between_the_same_people_is_its_touch():
     others = dict(shake, track_id_a=3)  # another person's
     out = _exchange_touches_dropped([ex, shake, later, others])
     assert out == [ex, later, others]
+
+
+def test_a_pick_carried_slowly_away_is_read_where_the_hand_left():
+    """``decision.held_near``: a hand stands still at (100, 100) over frames 20-40 (20 px hand),
+    having come in fast, and leaves at 2 px a frame; the object it took shows round it (0.3 of the
+    circle) over 41-65 and not from 66 on (hidden as the hand comes down elsewhere). The far window
+    (where the hand is ``apart_size`` sides away, from frame 71) sees nothing: only the window right
+    after the still moment shows the pick, and the object is seen to leave with the hand."""
+    from partlab.tracking.activities.recognise import recognise
+
+    hand = (1, "right_hand")
+    centres = {hand: {f: (100.0 + (10.0 * (20 - f) if f < 20 else 0.0 if f <= 40 else 2.0 * (f - 40)), 100.0, 20.0)
+                      for f in range(0, 100)}}
+    colours = {hand: {f: [_seen("", 40, 0.3 if 41 <= f <= 65 else 0.0)] for f in range(0, 100)}}
+    # where the object's pixels are: at the hand, moving with it as it leaves
+    moves = {hand: {f: ((40, centres[hand][f][0], 110.0),) for f in range(30, 66)}}
+    out = recognise(None, colours, centres, P, where=moves)
+    # the still moment from 21: centres are smoothed over three frames
+    assert [(r.kind, r.start_frame, r.end_frame) for r in out.itertuples()] == [("pick", 21, 40)]
+    assert recognise(None, colours, centres, P.updated({"decision.held_near": False}), where=moves).empty
+    # a colour that stays where the hand stood while the hand leaves (the room behind it) is no pick,
+    # nor one whose movement is not seen
+    stays = {hand: {f: ((40, 100.0, 110.0),) for f in range(30, 66)}}
+    assert recognise(None, colours, centres, P, where=stays).empty
+    assert recognise(None, colours, centres, P).empty
+    # the object shows round the hand all along (held before, during and after): nothing
+    always = {hand: {f: [_seen("", 40, 0.3)] for f in range(0, 100)}}
+    assert recognise(None, always, centres, P).empty
+
+
+def test_two_picks_of_one_colour_by_one_hand_are_one_pick():
+    from partlab.tracking.activities.recognise import picked_once
+
+    green, blue = 40, 110
+    first, second = _one_hand("pick", 25, 40, 1, green, confidence=0.9), _one_hand("pick", 45, 56, 1, green + 2)
+    out = picked_once([first, second], P)
+    assert [(r["kind"], r["start_frame"], r["end_frame"], r["confidence"]) for r in out] == [("pick", 25, 56, 0.8)]
+    # not one: another colour, another hand, a place between them, or too far apart in time
+    gap = P.decision.merge_gap
+    for rows in ([first, _one_hand("pick", 45, 56, 1, blue)],
+                 [first, _one_hand("pick", 45, 56, 1, green, part="left_hand")],
+                 [first, _one_hand("place", 42, 43, 1, green), second],
+                 [first, _one_hand("pick", 41 + gap, 80 + gap, 1, green)]):
+        assert len(picked_once(rows, P)) == len(rows)
+
+
+def test_a_touch_with_an_object_in_hand_is_no_handshake():
+    """Table 1's first row needs no object in either hand (``decision.object_at_touch``): a colour
+    held before and after the touch that is round the hands during it too is an object still in
+    hand (the tracker split the hands before it was passed); one only near the hand at rest (the
+    trousers a hanging hand is next to) is not at the meeting and the touch stays a handshake."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    # both hands seen throughout: 100 px apart at rest, 10 px apart (touching) over 40-60
+    centres = {a: {f: (100.0 if not 40 <= f <= 60 else 195.0, 300.0, 15.0) for f in range(100)},
+               b: {f: (300.0 if not 40 <= f <= 60 else 205.0, 300.0, 15.0) for f in range(100)}}
+
+    def colours(share_at_rest, share_at_touch):
+        return {k: {f: [_seen("", 40, (share_at_touch if 40 <= f <= 60 else share_at_rest) if k == a else 0.0)]
+                    for f in c} for k, c in centres.items()}
+
+    bare = recognise(_touch(a, b, 40, 60), colours(0.0, 0.0), centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in bare.itertuples()] == [("handshake", 40, 60)]
+    # an object in a's hand before, at and after the touch: none of Table 1's activities
+    assert recognise(_touch(a, b, 40, 60), colours(0.3, 0.3), centres, P).empty
+    # a colour round a's hand at rest only (0.3 before and after, 0.02 at the meeting): a handshake
+    trousers = recognise(_touch(a, b, 40, 60), colours(0.3, 0.02), centres, P)
+    assert list(trousers["kind"]) == ["handshake"]
+    # the rule off: the object in hand is a handshake, as before
+    off = recognise(_touch(a, b, 40, 60), colours(0.3, 0.3), centres, P.updated({"decision.object_at_touch": False}))
+    assert list(off["kind"]) == ["handshake"]
+
+
+def test_an_exchange_seen_held_at_one_point_needs_only_not_absent_at_the_other():
+    """``decision.exchange_band``: the colour held (``min_mass``) by the taker after and only in the
+    band between ``max_mass_absent`` and ``min_mass`` round the giver before (a small object seen
+    edge-on: 3-camera handshake seed 9, limbs3d hands, 0.077 before and 0.119 after) is an
+    exchange; neither side held, or one side absent, is not."""
+    green = 40
+    band = P.decision.max_mass_absent + 0.5 * (P.decision.min_mass - P.decision.max_mass_absent)  # 0.06
+    assert two_hands({green: band}, {}, {}, {green: 0.12}, False, P).kind == "exchange"
+    assert two_hands({green: 0.12}, {}, {}, {green: band}, False, P).kind == "exchange"
+    assert two_hands({green: band}, {}, {}, {green: band}, False, P).kind == "handshake"  # neither held
+    assert two_hands({green: 0.02}, {}, {}, {green: 0.12}, False, P).kind == "handshake"  # absent before
+    # the giver keeps it, or the taker had it already: nothing changed hands
+    assert two_hands({green: band}, {}, {green: band}, {green: 0.12}, False, P).kind == "handshake"
+    assert two_hands({green: band}, {green: band}, {}, {green: 0.12}, False, P).kind == "handshake"
+    off = P.updated({"decision.exchange_band": False})
+    assert two_hands({green: band}, {}, {}, {green: 0.12}, False, off).kind == "handshake"
+
+
+def test_a_touch_of_a_frame_or_two_is_no_join():
+    """``decision.min_touch_frames`` (3): two hands near each other over frames 40-41 only did not
+    meet; over 40-42 they did."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (1, "right_hand"), (2, "right_hand")
+    centres = {a: {f: (100.0, 300.0, 15.0) for f in range(100)}, b: {f: (300.0, 300.0, 15.0) for f in range(100)}}
+    bare = {k: {f: [_seen("", 0, 0.0)] for f in c} for k, c in centres.items()}
+    assert recognise(_touch(a, b, 40, 41), bare, centres, P).empty
+    three = recognise(_touch(a, b, 40, 42), bare, centres, P)
+    assert [(r.kind, r.start_frame, r.end_frame) for r in three.itertuples()] == [("handshake", 40, 42)]
+    every = P.updated({"decision.min_touch_frames": 1})
+    assert list(recognise(_touch(a, b, 40, 41), bare, centres, every)["kind"]) == ["handshake"]

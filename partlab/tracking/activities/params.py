@@ -77,6 +77,13 @@ class Decision:
     # decision point (the object already near the hand before it is picked up); between: no decision
     max_mass_absent: float = number(0.04, FRACTION)
     absent_ratio: float = number(0.25, FRACTION)
+    # an exchange's colour held (``min_mass``) at one end (the giver before, or the taker after) needs
+    # at the other only to be not absent (above ``max_mass_absent`` and ``absent_ratio`` of the held
+    # share): hysteresis, as for touches; once the object is seen in one hand, a smaller share of it
+    # in the other (seen edge-on, half hidden by the fingers) is the same object. 3-camera handshake
+    # seed 9 (limbs3d hands): 0.077 round the giver before, 0.119 round the taker after, read as a
+    # handshake. Off: both ends need ``min_mass``
+    exchange_band: bool = flag(True)
     # two modes within this many degrees are the same colour (an object seen before and after)
     same_colour: float = number(10.0, POSITIVE)
     # the decision points of a two-hand activity are where the hands are this many hand sides apart
@@ -92,6 +99,14 @@ class Decision:
     # ... and, with 3D positions (a multi-camera tracker), when their centres are at most this many mm
     # apart: 1.5 hand sides of an adult hand (about 45 mm radius)
     contact_mm: float = number(135.0, POSITIVE)
+    # a join of two hands (after ``merge_gap``) seen over fewer frames than this is no climax point:
+    # two hands whose estimates pass near each other in a frame or two (3D jitter of limbs3d's
+    # hands, a one-frame combine of the limb tracker), not hands that met. 3-camera takes, limbs3d
+    # hands, seeds 0-9: three such 1-2 frame touches were a false clap and two false handshakes
+    # (standing seed 6, handshake seeds 7 and 8); one camera, exchange seed 4: a 2-frame join
+    # 39-40 was read as the exchange, too short to match it (the exchange found instead as a
+    # handover, 41-81). 1: every touch counts
+    min_touch_frames: int = number(3, POSITIVE_COUNT)
     # hysteresis: a touch lasts until the hands are this many times the touching distance apart
     # (a clap's hands part a little between the beats; a shaking pair's boxes jitter)
     release_ratio: float = number(1.4, POSITIVE)
@@ -114,22 +129,37 @@ class Decision:
     # taker is unseen (the limb tracker lost the taker's hand going back behind the body with the
     # object: exchange seed 3), or the taker is seen with it while the giver is unseen
     unseen_exchange: bool = flag(True)
+    # Table 1's first row (handshake or clap) is a touch with no object in either hand before or
+    # after: a touch where a colour held at a decision point is also round the hands over the touch
+    # (an object at the meeting, not just near a hand at rest) and no exchange is read is no
+    # activity of the table (confidence 0.3). One camera, limb tracker, seeds 0-9: two exchanges
+    # the tracker split before the handover were read as handshakes, one as a clap
+    object_at_touch: bool = flag(True)
     # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
     # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
     still_speed: float = number(0.05, POSITIVE)
     still_frames: int = number(8, POSITIVE_COUNT)
-    # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
-    # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the
-    # colour's position moved along the hand's displacement by less than ``follow_ratio`` of it
-    # (median over the frames): a held object moves with the hand (about 1), a resting one does not
-    # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
-    # than following. Seen in at least ``follow_frames`` such frames.
+    # a still moment the decision points far from it (``apart_size``) read as neither pick nor place
+    # is read again for a pick with the window right after the hand left (the ``gap`` window), where
+    # the colour is also seen to leave with the hand (``stays_behind`` False). A hand carrying the
+    # object slowly away from where it picked it up is ``apart_size`` hand sides from there only
+    # when it comes down to place it (one camera, pick_place seed 3: the object 0.24-0.48 of the
+    # circle over 54-78, 0.02 at 83-91, where the far window fell: the pick was missed). Without
+    # the movement test the room behind a hand of the 3-camera takes (no silhouettes there) gave a
+    # false pick (standing seed 9, a hue 0.16-0.21 round the hand that stayed where it stood)
+    held_near: bool = flag(True)
     # a hand the tracker lost for at most ``bridge_frames`` frames and found again within
     # ``bridge_size`` hand sides of where it was last seen was there all along (a tracker of skin
     # blobs loses a hand that stops on a skin-coloured desk, or that takes an object, and finds it
     # again where it stopped): the still moments read it at where it was found again over the gap
     bridge_frames: int = number(20, POSITIVE_COUNT)
     bridge_size: float = number(1.5, POSITIVE)
+    # after a still moment, a colour "stays behind" (an object put down, or one the hand only passed)
+    # when, over the frames the hand is at least ``follow_move`` hand sides from where it stood, the
+    # colour's position moved along the hand's displacement by less than ``follow_ratio`` of it
+    # (median over the frames): a held object moves with the hand (about 1), a resting one does not
+    # (0, a little more where the hand's circle and arm hide part of it): 0.5 is nearer staying
+    # than following. Seen in at least ``follow_frames`` such frames.
     follow_move: float = number(0.5, POSITIVE)
     follow_ratio: float = number(0.5, FRACTION)
     follow_frames: int = number(3, POSITIVE_COUNT)

@@ -367,6 +367,8 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
     rows, busy = [], defaultdict(list)
     for j in merged_joins(joins, params):
         a, b, start, end = j["a"], j["b"], j["start_frame"], j["end_frame"]
+        if a[1] in HAND_PARTS and b[1] in HAND_PARTS and end - start + 1 < params.decision.min_touch_frames:
+            continue  # two hands near each other in a frame or two: no join (``min_touch_frames``)
         base = dict(start_frame=start, end_frame=end, kind=j["kind"], track_id_a=a[0], part_a=a[1],
                     track_id_b=b[0], part_b=b[1], ended_by=j["ended_by"], object_colour="", confidence=0.5)
         if a[1] in HAND_PARTS and b[1] in HAND_PARTS:
@@ -379,6 +381,10 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
                 v = _two_hand_verdict(seen, a, b, ((b0, b1), (a0, a1)), centres, where or {}, params)
                 if v.kind == "exchange" and a[0] == b[0]:
                     continue  # an object moved from one of a person's hands to the other: no activity of Table 1
+                if v.kind in ("clap", "handshake") and params.decision.object_at_touch:
+                    touch = [_without(_held(colours.get(k, {}), start, end, params), worn) for k in (a, b)]
+                    if object_at_touch(seen, touch, params) is not None:
+                        v = replace(v, margin=0.3)  # an object in hand: not row 1 of Table 1
                 base.update(kind=v.kind, confidence=round(v.margin, 3),
                             object_colour="" if v.colour is None else hue_to_hex(v.colour))
             else:  # a hand unseen at a decision point: the state machine's guess, less sure
@@ -397,6 +403,25 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
         busy[a].append((start, end))
         busy[b].append((start, end))
     return rows, busy
+
+
+def object_at_touch(seen: list[dict], touch: list[dict | None], params: ActivityParams) -> int | None:
+    """The colour (hue bin) of an object held at a touch of two hands, or None: a colour one of the
+    four decision points (``seen``) holds (``min_mass``) that is also held round either hand over
+    the touch itself (``touch``: the two hands' colours fused over it, None where unseen). Table 1
+    calls a touch a handshake or a clap only when *no* hand holds an object before or after (row
+    1); a colour that stays with one hand through the touch (no exchange read) is an object still
+    in hand, and the touch is none of the table's activities. A colour only near a hand at rest
+    (the trousers a hanging hand is next to) is not at the meeting, so it does not count (one
+    camera, handshake seeds 6 and 9: hue 110-112 0.10-0.31 round a resting hand, none at the
+    touch; exchange seed 0: the object 0.30 round both hands at the touch, read as a handshake
+    because the tracker split the hands before it was passed)."""
+    d = params.decision
+    for held in seen:
+        for hue, m in (held or {}).items():
+            if m >= d.min_mass and any(t is not None and mass(t, hue, params) >= d.min_mass for t in touch):
+                return hue
+    return None
 
 
 def _unseen_exchange(seen: list[dict | None], params: ActivityParams) -> Verdict | None:
@@ -508,36 +533,82 @@ def recognise(joins: pd.DataFrame | None, colours: Mapping[Key, Mapping[int, lis
         for s0, s1 in still_moments(cs, params):
             if any(s0 <= e + d.gap + d.window and s1 >= b - d.gap - d.window for b, e in busy.get(key, ())):
                 continue  # part of a two-hand activity
-            (b0, b1), (a0, a1) = moved_windows(cs, s0, s1, params)
-            worn = clothes.get(key[0], np.zeros(0, int))
-            before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn)
-                             for lo, hi in ((b0, b1), (a0, a1)))
-            only = None
-            if before is not None and after is None and a1 <= last:
-                # unseen where it should have moved on (a giver's hand lost as the taker pulls the
-                # object away): what it held at the end of its still moment tells a place, nothing else
-                after, only = _without(_held(colours.get(key, {}), s1 - d.window, s1, params), worn), "place"
-                a0, a1 = s1 - d.window, s1
-            if before is None or after is None:
-                continue
-            v = one_hand(before, after, params,
-                         lambda hue, k=key, c=cs, a=s0, b=s1: stays_behind(where.get(k, {}), c, hue, a, b, params))
-            if v is not None and only is not None and v.kind != only:
-                continue
-            if v is not None and v.colour is not None:
-                # the side where the colour is gone (after a place, before a pick): a view that still
-                # shows it as much as the views together showed it held saw no change there
-                lo, hi, held = (a0, a1, before) if v.kind == "place" else (b0, b1, after)
-                if _one_view_mass(colours.get(key, {}), lo, hi, v.colour, params) >= mass(held, v.colour, params):
-                    continue
+            far_before, far_after = moved_windows(cs, s0, s1, params)
+            v = _still_verdict(key, cs, s0, s1, (far_before, far_after), colours, clothes, where, last, params)
+            if v is None and d.held_near:
+                # a pick read with the window right after the still moment (``held_near``), where
+                # the colour is seen to leave with the hand
+                v = _still_verdict(key, cs, s0, s1, (far_before, _windows(s0, s1, params)[1]), colours, clothes,
+                                   where, last, params, "pick")
+                if v is not None and stays_behind(where.get(key, {}), cs, v.colour, s0, s1, params) is not False:
+                    v = None
             if v is not None:
                 rows.append(dict(start_frame=s0, end_frame=s1, kind=v.kind, track_id_a=key[0], part_a=key[1],
                                  track_id_b=0, part_b="", ended_by="still", object_colour=hue_to_hex(v.colour),
                                  confidence=round(v.margin, 3), hue=v.colour, at=_stood(cs, s0, s1)))
     rows = [r for r in _distinct(rows) if r["confidence"] >= params.decision.min_confidence or r["kind"] == "hand_head"]
+    rows = picked_once(rows, params)
     rows += other_sides(rows, colours, clothes, params)
     out = pd.DataFrame(_exchange_touches_dropped(handovers(rows, params)), columns=list(ACTIVITY_COLUMNS))
     return out.sort_values(["start_frame", "track_id_a", "part_a"], kind="stable").reset_index(drop=True)
+
+
+def _still_verdict(key: Key, cs, s0: int, s1: int, windows, colours, clothes, where, last: int,
+                   params: ActivityParams, only: str | None = None) -> Verdict | None:
+    """Rows 4-5 of Table 1 for the still moment ``s0..s1`` of hand ``key`` read at ``windows``
+    (before, after); ``only``: the one kind wanted (None: either)."""
+    d = params.decision
+    (b0, b1), (a0, a1) = windows
+    worn = clothes.get(key[0], np.zeros(0, int))
+    before, after = (_without(_held(colours.get(key, {}), lo, hi, params), worn) for lo, hi in ((b0, b1), (a0, a1)))
+    if before is not None and after is None and a1 <= last and only in (None, "place"):
+        # unseen where it should have moved on (a giver's hand lost as the taker pulls the
+        # object away): what it held at the end of its still moment tells a place, nothing else
+        after, only = _without(_held(colours.get(key, {}), s1 - d.window, s1, params), worn), "place"
+        a0, a1 = s1 - d.window, s1
+    if before is None or after is None:
+        return None
+    v = one_hand(before, after, params,
+                 lambda hue: stays_behind(where.get(key, {}), cs, hue, s0, s1, params))
+    if v is None or (only is not None and v.kind != only):
+        return None
+    if v.colour is not None:
+        # the side where the colour is gone (after a place, before a pick): a view that still
+        # shows it as much as the views together showed it held saw no change there
+        lo, hi, held = (a0, a1, before) if v.kind == "place" else (b0, b1, after)
+        if _one_view_mass(colours.get(key, {}), lo, hi, v.colour, params) >= mass(held, v.colour, params):
+            return None
+    return v
+
+
+def picked_once(rows: list[dict], params: ActivityParams) -> list[dict]:
+    """``rows`` with each run of picks (places) of one colour by one hand, each starting at most
+    ``decision.merge_gap`` frames after the previous one ends and with no other activity of that
+    hand in between, made one pick (place) from the first's start to the last's end: a hand
+    cannot pick up what it already holds, and two still moments of one pick are a stop the
+    tracker broke in two (one camera, pick_place seed 6: the tracked hand jumped 36 px onto the
+    arm and back over frames 38-44, two picks 25-40 and 45-56 of the one 25-57). The merged row
+    keeps the less sure confidence."""
+    d = params.decision
+    reach = d.same_colour / DEGREES_PER_BIN
+    order = sorted(range(len(rows)), key=lambda i: rows[i]["start_frame"])
+    out: list[dict] = []
+    last: dict[Key, int] = {}  # per hand, the index in ``out`` of its latest activity
+    for i in order:
+        r = rows[i]
+        hands = [k for k in ((r["track_id_a"], r["part_a"]), (r["track_id_b"], r["part_b"])) if k != (0, "")]
+        prev = out[last[hands[0]]] if len(hands) == 1 and hands[0] in last else None
+        if (prev is not None and r["kind"] in ("pick", "place") and prev["kind"] == r["kind"]
+                and prev.get("hue") is not None and r.get("hue") is not None
+                and min((prev["hue"] - r["hue"]) % HUE_BINS, (r["hue"] - prev["hue"]) % HUE_BINS) <= reach
+                and r["start_frame"] - prev["end_frame"] <= d.merge_gap):
+            prev.update(end_frame=max(prev["end_frame"], r["end_frame"]),
+                        confidence=min(prev["confidence"], r["confidence"]))
+            continue
+        out.append(dict(r))
+        for k in hands:
+            last[k] = len(out) - 1
+    return out
 
 
 def _exchange_touches_dropped(rows: list[dict]) -> list[dict]:

@@ -59,12 +59,14 @@ def two_hands(a_before: dict, b_before: dict, a_after: dict, b_after: dict, same
     """Rows 1-3 of Table 1 for two hands that joined and separated."""
     d = params.decision
     for src_b, dst_b, src_a, dst_a in ((a_before, b_before, a_after, b_after), (b_before, a_before, b_after, a_after)):
-        for hue, m in src_b.items():
-            if m < d.min_mass:
+        for hue in (set(src_b) | set(dst_a)) if d.exchange_band else set(src_b):
+            m, gained = mass(src_b, hue, params), mass(dst_a, hue, params)
+            if d.exchange_band:  # one side held, the other at least not absent (hysteresis)
+                if max(m, gained) < d.min_mass or absent(min(m, gained), max(m, gained), params):
+                    continue
+            elif m < d.min_mass or gained < d.min_mass:
                 continue
-            gained = mass(dst_a, hue, params)
-            if (gained >= d.min_mass and absent(mass(dst_b, hue, params), gained, params)
-                    and absent(mass(src_a, hue, params), m, params)):
+            if absent(mass(dst_b, hue, params), gained, params) and absent(mass(src_a, hue, params), m, params):
                 return Verdict("exchange", hue, _margin([m, gained], [mass(dst_b, hue, params),
                                                                         mass(src_a, hue, params)], params))
     margin = 1.0 - _moved(a_before, b_before, a_after, b_after, params) / max(d.min_mass, 1e-9)
