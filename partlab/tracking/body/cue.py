@@ -257,7 +257,8 @@ class DetectionCue:
 
     def _reacquire(self, index: int, unmatched: list, dets: np.ndarray, free: list[int], ycc) -> list[int]:
         """Lost tracks, and tracks unmatched for ``reacquire_after`` frames, jump to a free detection
-        near their prediction whose torso region matches the torso's model; the free rest."""
+        near their prediction whose torso region matches the torso's model, standing (and learning
+        its velocity again, ``dynamics.relearn_velocity``); the free rest."""
         t, p = self.tracker, self.p
         for person in unmatched:
             if not free:
@@ -285,6 +286,9 @@ class DetectionCue:
                 continue
             for g in person.filters.values():
                 g.set_velocity(np.zeros(2))
+            if t.params.dynamics.relearn_velocity:  # standing there: learns its walker's speed as a new track
+                person.learns_from = index
+                person.steps.clear()
             self._steer(person, reported, Box(*dets[best, :4]), 1.0)
             person.lost_since = None
             person.unsupported = 0

@@ -132,6 +132,7 @@ class Person:
     seen: tuple[int, float, float] | None = None  # (frame, cx, cy): last measured clear of everyone, not lost
     revived: int | None = None  # frame it was re-identified (``detector.reid_hits``), if it was
     steps: deque = field(default_factory=lambda: deque(maxlen=3))  # torso displacements of its first measured frames
+    learns_from: int = 0  # frame its velocity started from zero (its start; a re-acquisition standing)
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -297,7 +298,8 @@ class BodyTracker:
                 b = Box(b.x, b.y, max(b.w, 2.0), max(b.h, 2.0))
             filters[name] = PartFilter(b, ycc, self.params, self.params.dynamics.noise[name], self.rng,
                                        surround=around)
-        person = Person(track_id, filters, deque(maxlen=self.params.adjustment.history_frames), started=index)
+        person = Person(track_id, filters, deque(maxlen=self.params.adjustment.history_frames), started=index,
+                        learns_from=index)
         if not self.auto:  # the models of the boxes it was started from, for re-identification (reid_hits)
             person.first = {n: _frozen(f) for n, f in filters.items()}
         if "torso" in filters:
@@ -444,14 +446,15 @@ class BodyTracker:
         ``start_velocity_gain`` of the way to the median of the torso estimate's last displacements
         (Xu, Deng & Jia sec. 3: the velocity is the last displacement of the estimate). A track
         starts standing, and the colour filters learn a walker's speed only through their velocity
-        noise; a lagging new track slides onto a slower neighbour."""
+        noise; a lagging new track slides onto a slower neighbour. A track the detection cue re-acquired
+        standing learns its velocity again the same way (``relearn_velocity``)."""
         d = self.params.dynamics
         if d.start_velocity_frames <= 0 or d.start_velocity_gain <= 0:
             return
         if self.camera is not None and self.camera.moving:
             return  # a panning camera follows its walker: the image displacement is not theirs
         for person in active:
-            if index - person.started > d.start_velocity_frames or "torso" not in person.prev:
+            if index - person.learns_from > d.start_velocity_frames or "torso" not in person.prev:
                 continue
             if person.occluded_by is not None or person.lost_since is not None or person.adjusted:
                 continue  # coasting or re-initialised: no displacement measured this frame
