@@ -590,8 +590,8 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
         which = which if which is not None else range(len(tracks))
         return measure([_from(tracks[j], cuts[j]) for j in which], [scored[j] for j in which])
 
-    def by_seed(tracks) -> list[float]:
-        return [error(tracks, [j for j, g in enumerate(groups) if g == k]) for k in seeds]
+    def by_seed(tracks, measure=person_error) -> list[float]:
+        return [error(tracks, [j for j, g in enumerate(groups) if g == k], measure) for k in seeds]
 
     def score(params, name):
         step(f"validating {name}")
@@ -602,6 +602,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     scores = {"start": error(base_tracks)}
     per_seed = {"start": by_seed(base_tracks)}
     edits = {"start": error(base_tracks, measure=person_edits)}
+    edits_seeds = {"start": by_seed(base_tracks, person_edits)}
     gains = {}
     params, tracks, kept, used = base, base_tracks, {}, {}
     best_seeds = per_seed["start"]
@@ -622,6 +623,7 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
         s_seeds = by_seed(trial_tracks)
         scores[f"+{comp}"], per_seed[f"+{comp}"] = error(trial_tracks), s_seeds
         edits[f"+{comp}"] = error(trial_tracks, measure=person_edits)
+        edits_seeds[f"+{comp}"] = by_seed(trial_tracks, person_edits)
         mean, se = paired_gain(s_seeds, best_seeds)
         gains[comp] = {"mean": round(mean, 3), "se": round(se, 3)}
         kept[comp] = bool(mean < 0 and mean <= -margin * se)
@@ -639,13 +641,15 @@ def select_person(run: Callable[[int, BodyParams], pd.DataFrame], truths: list[p
     return params, {"scores": {k: round(v, 3) for k, v in scores.items()},
                     "scores_by_seed": {k: [round(x, 3) for x in v] for k, v in per_seed.items()},
                     "edits": {k: round(v, 3) for k, v in edits.items()},
+                    "edits_by_seed": {k: [round(x, 3) for x in v] for k, v in edits_seeds.items()},
                     "gains": gains, "kept": kept, "fields": fields, "rule": rule, "measure": "soft edits/100",
                     "scored_from": sorted({int(c) for c in cuts if np.isfinite(c)})}
 
 
 def person_rows(record: dict) -> list[dict]:
-    """The summary's ``person`` record as rows ``component, edits/100, decision, fitted``: what was
-    fitted, the edits each component gave on the training clips and whether it was kept."""
+    """The summary's ``person`` record as rows ``component, edits/100, soft edits/100, gain, decision,
+    fitted``: what was fitted, the edits and soft edits (what decides) each component gave on the
+    training clips' validation runs, its mean paired gain ± standard error, and whether it was kept."""
     det = record.get("detector") or {}
     shrink = tuple(det["shrink"]) if det.get("shrink") else "-"
     fitted = {
@@ -664,19 +668,30 @@ def person_rows(record: dict) -> list[dict]:
         "noise": "parts' position/velocity noise widened to the person's" if "noise" in record.get("fitted", [])
         else "the person moves no faster than the parts' defaults",
     }
-    scores, kept = record.get("scores", {}), record.get("kept", {})
-    rows = [dict(component="start", **{"edits/100": scores.get("start")}, decision="baseline", fitted="")]
+    scores, kept, edits = record.get("scores", {}), record.get("kept", {}), record.get("edits", {})
+    gains = record.get("gains", {})
+
+    def gain(comp):
+        g = gains.get(comp)
+        return f"{g['mean']:+.2f} ± {g['se']:.2f}" if g else ""
+
+    rows = [dict(component="start", **{"edits/100": edits.get("start"), "soft edits/100": scores.get("start")},
+                 gain="", decision="baseline", fitted="")]
     for comp, text in fitted.items():
         decision = ("kept" if kept.get(comp) else "dropped") if comp in kept else "not tried"
-        rows.append(dict(component=comp, **{"edits/100": scores.get(f"+{comp}")}, decision=decision, fitted=text))
+        rows.append(dict(component=comp, **{"edits/100": edits.get(f"+{comp}"),
+                                            "soft edits/100": scores.get(f"+{comp}")},
+                         gain=gain(comp), decision=decision, fitted=text))
     return rows
 
 
 def person_table(record: dict) -> str:
     """:func:`person_rows` as aligned text (``partlab train``)."""
-    lines = [f"{'component':9} {'edits/100':>9}  {'decision':10} fitted"]
+    def num(v):
+        return v if v is not None else float("nan")
+
+    lines = [f"{'component':9} {'edits/100':>9} {'soft':>7} {'gain ± se':>14}  {'decision':10} fitted"]
     for r in person_rows(record):
-        e = r["edits/100"]
-        lines.append(f"{r['component']:9} {e if e is not None else float('nan'):9.2f}  {r['decision']:10} "
-                     f"{r['fitted']}")
+        lines.append(f"{r['component']:9} {num(r['edits/100']):9.2f} {num(r['soft edits/100']):7.2f} "
+                     f"{r['gain']:>14}  {r['decision']:10} {r['fitted']}")
     return "\n".join(lines)

@@ -428,7 +428,8 @@ def learnt(summary: dict, new_detector: bool) -> tuple[list[str], str]:
     person = summary.get("person")
     if person is not None:
         why.append("nothing fitted from the person boxes (" + (", ".join(person.get("fitted", [])) or "none fitted")
-                   + ") lowered the edits on the training clips" if person.get("fitted") else
+                   + ") lowered the person boxes' error on the training clips beyond the tracker seeds' "
+                   "spread" if person.get("fitted") else
                    "the person boxes gave nothing to fit (too few frames where the tracker or the detector "
                    "was on a corrected person)")
     if selection is not None and not why:

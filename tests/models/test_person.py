@@ -163,6 +163,7 @@ def test_training_from_person_boxes_alone_recalibrates_a_wrong_person_box(tmp_pa
     assert main([*args, "-o", str(tmp_path / "b")]) == 0
     text = capsys.readouterr().out
     assert "person box extent (validated, from person boxes)" in text and "failure SVMs: none trained" in text
+    assert "soft" in text and "gain ± se" in text  # the validation table: edits, soft edits, paired gain
     b = load_bundle(tmp_path / "b")
     rec = b.summary["person"]
     assert rec["kept"]["extent"] and rec["scores"]["+extent"] < rec["scores"]["start"] - 20, rec
