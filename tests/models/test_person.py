@@ -422,3 +422,25 @@ def test_training_without_a_holdout_fits_and_scores_on_every_corrected_frame():
     rec = b.summary["person"]
     assert rec["kept"]["extent"] and rec["scored_from"] == [] and "later ones" not in rec["rule"], rec
     assert b.body_params.output.person[0] > 0.7
+
+
+def test_person_boxes_that_keep_nothing_leave_nothing_learnt_and_say_why():
+    """A component within the seeds' spread is dropped; with no SVM sample and nothing else fitted the
+    bundle learnt nothing, and the reason names what was fitted and the rule that dropped it (the
+    command line then exits 2 and saves nothing, the app and the task runner never make it a default)."""
+    from partlab.models.training import learnt
+
+    truth = normalise_tracks(_people(walking_truth(2, 40, seed=5)))
+    off = {False: [0.5] * 8, True: [0.3] * 4 + [0.65] * 4}  # -2.5 ± 6.6 per 100 boxes
+
+    def run(i, params):
+        return _moved_on(truth, off[params.detector.undetected_frames == 30][i])
+
+    fit = P.PersonFit(components={"ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(run, [truth] * 8, BodyParams(), fit, groups=list(range(8)))
+    assert rec["kept"] == {"ending": False} and rec["fields"] == [] and params == BodyParams()
+    got, why = learnt({"person": {**rec, "fitted": ["ending"]}, "svms": {}, "variances": [],
+                       "samples": {"total": 0}}, new_detector=False)
+    assert got == []
+    assert "nothing fitted from the person boxes (ending) lowered the person boxes' error on the training clips " \
+           "beyond the tracker seeds' spread" in why
