@@ -462,6 +462,39 @@ def count_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = 
     return EditCount(edits, len(truth), int(keyframes), moved, drawn, deleted)
 
 
+#: the IoU band over which :func:`soft_edits` blurs the edits' threshold (:data:`EDIT_IOU` in its middle)
+SOFT_EDIT_BAND = (0.3, 0.7)
+
+
+def soft_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = "person") -> tuple[float, int]:
+    """:func:`count_edits` with its IoU threshold blurred into a ramp: ``(soft edits, truth boxes)``.
+
+    Per frame, ``max(truth boxes, proposals) - sum of s(IoU)`` over the same assignment as the edits,
+    with ``s`` rising linearly from 0 at IoU 0.3 to 1 at 0.7 (:data:`SOFT_EDIT_BAND`) instead of
+    jumping at 0.5: a missing or spurious box still costs one, a box well on its person nothing, and
+    one near the threshold what its overlap says. The edits count a box at IoU 0.49 as wrong and one
+    at 0.51 as right, so a small change to the tracker moves them by whole boxes where the boxes
+    themselves hardly moved; this measure moves with the boxes, which is what training's validation
+    needs to compare two models on a short stretch (:func:`partlab.models.person.select_person`).
+    """
+    lo, hi = SOFT_EDIT_BAND
+    truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
+    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
+    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
+    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
+    total = 0.0
+    for f in set(t_by) | set(k_by):
+        t = t_by.get(f, np.empty((0, 4)))
+        k = k_by.get(f, np.empty((0, 4)))
+        right = 0.0
+        if len(t) and len(k):
+            iou = iou_xywh(t, k)
+            rows, cols = linear_sum_assignment(iou, maximize=True)
+            right = float(np.clip((iou[rows, cols] - lo) / (hi - lo), 0.0, 1.0).sum())
+        total += max(len(t), len(k)) - right
+    return total, len(truth)
+
+
 def keyframe_frames(first: int, last: int, every: int) -> np.ndarray:
     """The frames an annotator keys on a track seen from ``first`` to ``last``: every
     ``every``-th frame from its first, and its last (where it leaves)."""

@@ -150,10 +150,12 @@ class TrainingOptions:
     runs per clip); without it, everything fitted is used. ``person`` (None: when the truth has
     person rows and the tracker runs): learn from the person boxes too
     (:mod:`partlab.models.person`: one detector pass and up to five more tracker runs per clip);
-    ``validation_seeds``: how many tracker seeds each person-box component is validated over (a
-    component is kept only if it lowers the edits pooled over them and on every one, the person
-    box's extent on at least half; one seed's edits vary by a few per 100 boxes for the same model,
-    so one run decides by chance);
+    ``validation_seeds``: how many tracker seeds each person-box component is validated over, each run
+    from the corrected boxes where the validated frames begin, the same seeds for the models compared;
+    ``validation_margin``: a component is kept only if its mean paired gain in soft edits
+    (:func:`partlab.models.person.select_person`) reaches this many standard errors of it (one seed's
+    edits on PETS09 vary by 5-15 per 100 boxes for the same model, so one run, or "lower on every
+    seed", decides by chance);
     ``holdout``: the share of each clip's corrected frames (its last ones) the person-box components
     are validated on and not fitted on, so that what is kept is what carries over to later frames
     (0: fitted and validated on the same frames)."""
@@ -164,7 +166,8 @@ class TrainingOptions:
     fit_sharpness: bool | None = None
     validate: bool = True
     person: bool | None = None
-    validation_seeds: int = 3
+    validation_seeds: int = 8
+    validation_margin: float = 1.0
     holdout: float = 0.35
 
 
@@ -284,46 +287,68 @@ def _until(factory: FramesFactory, truth: pd.DataFrame) -> FramesFactory:
 def _learn_from_people(clips, got: _Samples, body_p: BodyParams, detector, table: pd.DataFrame,
                        opts: TrainingOptions, step, tracker_runner) -> tuple[BodyParams, dict]:
     """The person-box fits of :mod:`partlab.models.person` on top of ``body_p`` (what the parts
-    gave), each kept only where it lowers the person-box edits on the training clips:
+    gave), each kept only where it lowers the person boxes' error on the training clips:
     ``(params, the summary's "person" record)``."""
     from partlab.models.person import before_cut, fit_person, select_person
 
-    inits = [first_boxes(g) for g in got.truths]
-    n_seeds = max(int(opts.validation_seeds), 1)
-    # validation run j: clip j % n, tracker seed opts.seed + clip + 1000 * (j // n); the first seed's
-    # runs are the ones the fits are made on
     n = len(clips)
-    jobs = [(i, k) for k in range(n_seeds) for i in range(n)]
-
-    def run(j, params):
-        i, k = jobs[j]
-        return tracker_runner(clips[i][0], clips[i][1], inits[i], opts.seed + i + 1000 * k, params=params,
-                              failure_detector=detector)
-
-    step("tracking with the start")
-    base_tracks = [run(j, body_p) for j in range(n)]
+    inits = [first_boxes(g) for g in got.truths]
     # fit on each clip's earlier corrected frames, validate on its later ones: the user tracks the
     # rest of the clip with what is kept, so a component must carry over in time, not only fit the
     # frames it was fitted on (PETS09 frames 0-199: the detector window and the ending won on the
     # frames they were fitted on and cost edits on frames 200-794, docs/measurements)
     cuts = [holdout_cut(g, opts.holdout if opts.validate else 0.0) for g in got.truths]
     fit_truths = [before_cut(g, c) for g, c in zip(got.truths, cuts)]
-    fit = fit_person(clips, fit_truths, [before_cut(t, c) for t, c in zip(base_tracks, cuts)], body_p, table,
-                     progress=step)
+    fit_clips = [_window(clips[i][0], -np.inf, c if np.isfinite(c) else np.inf) for i, c in enumerate(cuts)]
+
+    def fit_runs(params) -> list[pd.DataFrame]:
+        return [before_cut(tracker_runner(fit_clips[i], clips[i][1], inits[i], opts.seed + i, params=params,
+                                          failure_detector=detector), cuts[i]) for i in range(n)]
+
+    step("tracking with the start")
+    base_fit_tracks = fit_runs(body_p)
+    fit = fit_person(clips, fit_truths, base_fit_tracks, body_p, table, progress=step)
     if not opts.validate:
         chosen = body_p
         for changes in fit.components.values():
             chosen = chosen.updated(changes)
         return chosen, {**fit.record, "fitted": sorted(fit.components), "kept": {c: True for c in fit.components},
                         "fields": sorted(f for changes in fit.components.values() for f in changes)}
-    if fit.components and n_seeds > 1:
-        step(f"tracking with the start, {n_seeds - 1} more seed(s)")
-        base_tracks += [run(j, body_p) for j in range(n, len(jobs))]
-    truths = [got.truths[i] for i, _k in jobs[:len(base_tracks)]]
-    groups = [k for _i, k in jobs[:len(base_tracks)]]
-    chosen, record = select_person(run, truths, body_p, fit, base_tracks=base_tracks, progress=step, groups=groups,
-                                   cuts=[cuts[i] for i, _k in jobs[:len(base_tracks)]])
+    if not fit.components:
+        return body_p, {**fit.record, "fitted": [], "kept": {}, "fields": []}
+    # validation runs start where the user's tracking of the rest would: from the corrected boxes at
+    # the cut (and each later person's first), with the background model starting there too, over
+    # several tracker seeds paired between the models compared. Run from the clip's first boxes, a
+    # walker lost before the cut cost edits on every scored frame, whatever the component did after it
+    val_truths = [g[g["frame"] >= c] for g, c in zip(got.truths, cuts)]
+    val_inits = [first_boxes(g) for g in val_truths]
+    val_clips = [_window(clips[i][0], c, np.inf) for i, c in enumerate(cuts)]
+    n_seeds = max(int(opts.validation_seeds), 1)
+    jobs = [(i, k) for k in range(n_seeds) for i in range(n)]
+
+    def run(j, params):
+        i, k = jobs[j]
+        return tracker_runner(val_clips[i], clips[i][1], val_inits[i], opts.seed + i + 1000 * (k + 1), params=params,
+                              failure_detector=detector)
+
+    def refit_runs(params):
+        return base_fit_tracks if params is body_p else fit_runs(params)
+
+    chosen, record = select_person(run, [val_truths[i] for i, _k in jobs], body_p, fit, progress=step,
+                                   groups=[k for _i, k in jobs], cuts=[cuts[i] for i, _k in jobs],
+                                   fit_runs=refit_runs, fit_truths=fit_truths, margin=opts.validation_margin)
     return chosen, {**fit.record, "fitted": sorted(fit.components), **record}
+
+
+def _window(factory: FramesFactory, first: float, stop: float) -> FramesFactory:
+    """``factory``'s frames from ``first`` up to (not including) ``stop``."""
+    def frames():
+        for index, frame in factory():
+            if index >= stop:
+                return
+            if index >= first:
+                yield index, frame
+    return frames
 
 
 def holdout_cut(truth: pd.DataFrame, share: float) -> float:
@@ -403,7 +428,8 @@ def learnt(summary: dict, new_detector: bool) -> tuple[list[str], str]:
     person = summary.get("person")
     if person is not None:
         why.append("nothing fitted from the person boxes (" + (", ".join(person.get("fitted", [])) or "none fitted")
-                   + ") lowered the edits on the training clips" if person.get("fitted") else
+                   + ") lowered the person boxes' error on the training clips beyond the tracker seeds' "
+                   "spread" if person.get("fitted") else
                    "the person boxes gave nothing to fit (too few frames where the tracker or the detector "
                    "was on a corrected person)")
     if selection is not None and not why:

@@ -209,6 +209,24 @@ def test_count_edits_moves_draws_and_deletes_once_each():
     assert e.edits == 6 and e.truth_boxes == 4 and e.per_100 == 150.0
 
 
+def test_soft_edits_blur_the_threshold_and_count_missing_and_spurious_boxes_whole():
+    from partlab.labelling.evaluation import count_edits, soft_edits
+
+    truth = _rows([(0, 1, "person", 0, 0, 10, 20), (0, 2, "person", 50, 0, 10, 20),
+                   (1, 1, "person", 0, 0, 12, 20), (2, 1, "person", 0, 0, 10, 20), (3, 1, "person", 0, 0, 10, 20)])
+    props = _rows([(0, 7, "person", 0, 0, 10, 20),       # right: 0
+                   (0, 8, "person", 56, 0, 10, 20),      # IoU 0.25, below the ramp: 1
+                   (1, 7, "person", 4, 0, 12, 20),       # IoU 0.5, the edits' threshold: 0.5
+                   (2, 7, "person", 2.5, 0, 10, 20),     # IoU 0.6: 0.25
+                   (3, 7, "person", 1.0, 0, 10, 20),     # IoU 9/11, above the ramp: 0
+                   (3, 8, "person", 200, 0, 10, 20),     # spurious: 1
+                   (4, 9, "person", 200, 0, 10, 20)])    # a frame without truth: 1
+    e, n = soft_edits(truth, props)
+    assert n == 5 and e == pytest.approx(1 + 0.5 + 0.25 + 1 + 1)
+    assert count_edits(truth, props).edits == 3  # the IoU 0.5 and 0.6 boxes count as right
+    assert soft_edits(truth, truth) == (0.0, 5)
+
+
 def test_interpolation_between_keyframes_meets_them_and_is_linear():
     from partlab.labelling.evaluation import count_edits, interpolate_keyframes, keyframes_of
 

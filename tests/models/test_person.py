@@ -102,7 +102,9 @@ def test_selection_keeps_only_what_lowers_the_edits():
                                   "ending": {"detector.undetected_frames": 30}})
     params, rec = P.select_person(run, [truth], BodyParams(), fit)
     assert rec["kept"] == {"extent": True, "ending": False}  # the ending changed nothing: a tie keeps the simpler
-    assert rec["scores"]["start"] == pytest.approx(100.0) and rec["scores"]["+extent"] == 0.0
+    # 0.6 of the drawn box: IoU 0.36, every box an edit, and 0.15 of one right on the soft edits' ramp
+    assert rec["edits"]["start"] == pytest.approx(100.0) and rec["scores"]["start"] == pytest.approx(85.0)
+    assert rec["scores"]["+extent"] == 0.0 and rec["edits"]["+extent"] == 0.0
     assert params.output.person == pytest.approx((1 / 0.6, 1 / 0.6, 0.0, 0.0), abs=2e-3)
     assert params.detector.undetected_frames == 0 and rec["fields"] == ["output.person"]
     assert len(calls) == 3  # start, +extent, +ending
@@ -161,6 +163,7 @@ def test_training_from_person_boxes_alone_recalibrates_a_wrong_person_box(tmp_pa
     assert main([*args, "-o", str(tmp_path / "b")]) == 0
     text = capsys.readouterr().out
     assert "person box extent (validated, from person boxes)" in text and "failure SVMs: none trained" in text
+    assert "soft" in text and "gain ± se" in text  # the validation table: edits, soft edits, paired gain
     b = load_bundle(tmp_path / "b")
     rec = b.summary["person"]
     assert rec["kept"]["extent"] and rec["scores"]["+extent"] < rec["scores"]["start"] - 20, rec
@@ -318,16 +321,21 @@ def test_extent_is_refitted_last_on_the_runs_of_what_was_kept_before_it():
     fit = P.PersonFit(components={"extent": {"output.person": (9.0, 9.0, 0.0, 0.0)},
                                   "ending": {"detector.undetected_frames": 30}})
     params, rec = P.select_person(run, [truth], BodyParams(), fit)
-    assert rec["kept"]["ending"] and rec["scores"]["+ending"] == 0.0
+    # every box on its person at IoU 0.75 ** 2: no edit left, and a third of one on the soft edits' ramp
+    assert rec["kept"]["ending"] and rec["edits"]["+ending"] == 0.0
+    assert rec["scores"]["+ending"] == pytest.approx(100 * (1 - (0.5625 - 0.3) / 0.4))
     assert fit.record["person_extent"] == pytest.approx([1 / 0.75, 1 / 0.75, 0.0, 0.0], abs=2e-3)
-    assert not rec["kept"]["extent"]  # every box already on its person: a tie keeps the simpler model
+    # the edits would call the extent a tie; the soft edits see the boxes fit their people exactly
+    assert rec["kept"]["extent"] and rec["scores"]["+extent"] == 0.0
+    assert params.output.person == pytest.approx((1 / 0.75, 1 / 0.75, 0.0, 0.0), abs=2e-3)
     assert list(rec["kept"]) == ["ending", "extent"]
 
 
-def test_a_change_to_the_tracking_must_lower_the_edits_on_every_seed_the_extent_on_half():
-    """Lower pooled and on 2 of 3 seeds (PETS09's detector window on frames 130-199): a change to
-    the tracking is dropped, since one seed's edits move by a few per 100 boxes by chance; the
-    extent, which rewrites the same runs, is kept on 2 of 3."""
+def test_a_gain_within_the_seeds_spread_is_dropped_a_consistent_one_kept():
+    """Lower pooled and on 2 of 3 seeds by a third of the boxes, higher on the third by as much
+    (PETS09's detector window on frames 130-199): the mean paired gain (-11.1) is within one standard
+    error (22.2), so the change is dropped; the extent, which rewrites the same runs, gains 85 on two
+    seeds and loses 15 on the third (-51.7 ± 33.3): kept."""
     truth = normalise_tracks(_people(walking_truth(2, 30, seed=5)))
 
     def run(i, params):  # seeds 0, 1: a third of the frames off at the start, none with the change;
@@ -348,7 +356,42 @@ def test_a_change_to_the_tracking_must_lower_the_edits_on_every_seed_the_extent_
     fit = P.PersonFit(components={"extent": {"output.person": (9.0, 9.0, 0.0, 0.0)}})
     params, rec = P.select_person(run_written, [truth] * 3, BodyParams(), fit, groups=[0, 1, 2])
     assert rec["scores_by_seed"]["+extent"] == pytest.approx([0.0, 0.0, 100.0])
+    assert rec["gains"]["extent"] == pytest.approx({"mean": -51.667, "se": 33.333}, abs=1e-3)
     assert rec["kept"] == {"extent": True}
+
+
+def test_one_seed_that_loses_a_walker_does_not_veto_a_gain_on_all_others():
+    """Eight paired seeds. A change that keeps a fifth more of the frames right on seven seeds and on
+    the eighth loses a walker for half of them (+30: what one seed's chaos does to a 70-frame stretch
+    of PETS09) gains -13.75 ± 6.25 per 100 boxes: kept, where "lower on every seed" dropped it. One
+    that gains 20 on four seeds and loses 15 on the other four is lower pooled (-2.5) but within its
+    standard error (6.6): dropped."""
+    truth = normalise_tracks(_people(walking_truth(2, 40, seed=5)))
+    start = [0.5] * 8
+    good = [0.3] * 7 + [0.8]
+    mixed = [0.3] * 4 + [0.65] * 4
+
+    def runner(change):
+        def run(i, params):
+            off = change[i] if params.detector.undetected_frames == 30 else start[i]
+            return _moved_on(truth, off)
+        return run
+
+    fit = P.PersonFit(components={"ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(runner(good), [truth] * 8, BodyParams(), fit, groups=list(range(8)))
+    assert rec["scores_by_seed"]["start"] == pytest.approx([50.0] * 8)
+    assert rec["scores_by_seed"]["+ending"] == pytest.approx([30.0] * 7 + [80.0])
+    assert rec["gains"]["ending"] == pytest.approx({"mean": -13.75, "se": 6.25})
+    assert rec["kept"] == {"ending": True} and params.detector.undetected_frames == 30
+    assert "paired over 8 tracker seeds, by at least 1 standard error" in rec["rule"]
+    _params, rec = P.select_person(runner(mixed), [truth] * 8, BodyParams(), fit, groups=list(range(8)))
+    assert rec["scores"]["+ending"] < rec["scores"]["start"]
+    assert rec["gains"]["ending"]["mean"] == pytest.approx(-2.5)
+    assert rec["gains"]["ending"]["se"] == pytest.approx(6.614, abs=1e-3)
+    assert rec["kept"] == {"ending": False}
+    # a margin of zero standard errors is the pooled rule: the mixed change passes it
+    _params, rec = P.select_person(runner(mixed), [truth] * 8, BodyParams(), fit, groups=list(range(8)), margin=0.0)
+    assert rec["kept"] == {"ending": True}
 
 
 def test_without_a_holdout_the_fits_see_every_corrected_frame():
@@ -379,3 +422,25 @@ def test_training_without_a_holdout_fits_and_scores_on_every_corrected_frame():
     rec = b.summary["person"]
     assert rec["kept"]["extent"] and rec["scored_from"] == [] and "later ones" not in rec["rule"], rec
     assert b.body_params.output.person[0] > 0.7
+
+
+def test_person_boxes_that_keep_nothing_leave_nothing_learnt_and_say_why():
+    """A component within the seeds' spread is dropped; with no SVM sample and nothing else fitted the
+    bundle learnt nothing, and the reason names what was fitted and the rule that dropped it (the
+    command line then exits 2 and saves nothing, the app and the task runner never make it a default)."""
+    from partlab.models.training import learnt
+
+    truth = normalise_tracks(_people(walking_truth(2, 40, seed=5)))
+    off = {False: [0.5] * 8, True: [0.3] * 4 + [0.65] * 4}  # -2.5 ± 6.6 per 100 boxes
+
+    def run(i, params):
+        return _moved_on(truth, off[params.detector.undetected_frames == 30][i])
+
+    fit = P.PersonFit(components={"ending": {"detector.undetected_frames": 30}})
+    params, rec = P.select_person(run, [truth] * 8, BodyParams(), fit, groups=list(range(8)))
+    assert rec["kept"] == {"ending": False} and rec["fields"] == [] and params == BodyParams()
+    got, why = learnt({"person": {**rec, "fitted": ["ending"]}, "svms": {}, "variances": [],
+                       "samples": {"total": 0}}, new_detector=False)
+    assert got == []
+    assert "nothing fitted from the person boxes (ending) lowered the person boxes' error on the training clips " \
+           "beyond the tracker seeds' spread" in why

@@ -134,16 +134,15 @@ def _inner_rect_runner(truths):
     """A deterministic 'tracker' for :func:`partlab.models.training.train_bundle`: its inner rectangle is the
     true box moved right by 0.3 of its width, reported through ``params.output.extent``; with the
     built-in extent the boxes are too large and off-centre (under half of them on the part)."""
-    from partlab.models.training import first_boxes
-
-    def key(init):  # which clip: by the boxes it starts from (training hands the runner its own frames)
-        return tuple(init.sort_values(["track_id", "part"])["x"].round(3))
-
-    truth_of = {key(first_boxes(g)): g for _f, g in truths}
+    def rows(df):
+        return set(zip(df["frame"], df["track_id"], df["part"], df["x"].round(3)))
 
     def run(frames, fps, init, seed, params=None, failure_detector=None):
+        # which clip: the one whose truth holds the boxes it starts from (training hands the runner its
+        # own frames), tracked from the first of them (validation runs start at the holdout's cut)
         params = params or BodyParams()
-        t = truth_of[key(init)].copy()
+        g = next(g for _f, g in truths if rows(init) <= rows(g))
+        t = g[g["frame"] >= init["frame"].min()].copy()
         for part, (sw, sh, dx, dy) in params.output.extent.items():
             m = t.part == part
             w, h = t.loc[m, "w"], t.loc[m, "h"]

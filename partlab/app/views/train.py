@@ -75,7 +75,8 @@ def show_summary(summary: dict, key: str) -> None:
     if summary.get("person"):
         from partlab.models.person import person_rows
 
-        st.caption("From the person boxes (each kept only if it lowered the edits on the training clips):")
+        st.caption("From the person boxes (each kept only if it lowered the person boxes' error on the "
+                   "training clips beyond the tracker seeds' spread):")
         st.dataframe(pd.DataFrame(person_rows(summary["person"])), hide_index=True)
     variances = pd.DataFrame(summary.get("variances") or [])
     if len(variances):
