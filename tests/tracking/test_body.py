@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from partlab.tracking.body.decomposition import decompose
-from partlab.tracking.body.tracker import BodyTracker, init_starts
+from partlab.tracking.body.tracker import BodyTracker, _overlap_fraction, init_starts
 from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import Box
 from partlab.tracking.core.histogram import to_ycc
@@ -419,3 +419,34 @@ def test_a_track_started_standing_takes_its_walkers_speed_and_does_not_lag_onto_
             else:
                 assert all(-5.5 < v < -3.0 for v in vx), (seed, vx)
                 assert own >= 0.95 and other < 0.5, (seed, own, other)
+
+
+def _cut_by_the_edge(vx: float, vy: float, along: bool = True):
+    """The --init walker moved 16 px right, so that its person box is cut by the right border,
+    moving at ``(vx, vy)`` and judged once with ``leave_fraction`` 0.1 above the share of its box
+    in view: ``(that share, the tracker)``."""
+    frames, truths = _scene(n=1, walkers=(dict(x0=300, vx=0.0, shirt=(40, 40, 160), trousers=(120, 60, 30)),))
+    out = []
+    for fraction in (0.5, None):
+        p = BodyParams().updated({"detection.leave_fraction": fraction or out[0] + 0.1,
+                                  "detection.leave_along": along})
+        tracker = BodyTracker(p, np.random.default_rng(0), init=_init(truths[0]))
+        tracker.step(0, frames[0], None)
+        for f in tracker.people[1].filters.values():
+            f.state[0] += 16.0
+            f.set_velocity(np.array([vx, vy]))
+        out.append(_overlap_fraction(tracker.people[1].box(), Box(0, 0, W, H)))
+    tracker._end_tracks([tracker.people[1]], np.full((H, W), 255, np.uint8), W, H, index=10)
+    return out[0], tracker
+
+
+def test_a_track_cut_by_the_edge_it_walks_along_does_not_end():
+    """``detection.leave_along``: a box with less than ``leave_fraction`` in view ends, unless its
+    person walks along the border that cuts it (here down the right edge) or back in; moving out,
+    standing, or with the rule off, it ends as before."""
+    inside, _ = _cut_by_the_edge(0.0, 0.0)
+    assert 0.6 < inside < 0.9  # the walker's box is cut by the right border
+    for vx, vy in ((0.5, 4.0), (-2.0, 0.0)):  # down the edge; back into the frame
+        assert 1 in _cut_by_the_edge(vx, vy)[1].people
+    for vx, vy, along in ((2.0, 0.0, True), (0.0, 0.0, True), (0.5, 4.0, False)):
+        assert 1 not in _cut_by_the_edge(vx, vy, along)[1].people

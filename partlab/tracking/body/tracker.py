@@ -738,12 +738,34 @@ class BodyTracker:
         side = not along_y and ((box.x <= m * box.w and vx <= 0) or (W - box.x2 <= m * box.w and vx >= 0))
         return side or (not along_x and ((box.y <= m * box.h and vy <= 0) or (H - box.y2 <= m * box.h and vy >= 0)))
 
+    def _kept_at_edge(self, person: Person, box: Box, inside: float, W: int, H: int) -> bool:
+        """A box cut by the frame (``inside`` of it in view, under ``leave_fraction``) whose person
+        moves along the border that cuts it, or back into the frame, and with at least half of
+        ``leave_fraction`` in view: not leaving (``detection.leave_along``)."""
+        d = self.params.detection
+        if not d.leave_along or inside < 0.5 * d.leave_fraction:
+            return False
+        v = person.velocity()
+        if v is None:
+            v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
+        vx, vy = float(v[0]), float(v[1])
+        if max(abs(vx), abs(vy)) <= STILL * box.h:
+            return False  # standing: its box's share decides
+        out_x = -vx if box.x < 0 else (vx if box.x2 > W else None)  # speed out through a cutting side
+        out_y = -vy if box.y < 0 else (vy if box.y2 > H else None)
+        outward = [o for o in (out_x, out_y) if o is not None]
+        if not outward:
+            return False
+        along = [abs(vy) if out_x is not None else 0.0, abs(vx) if out_y is not None else 0.0]
+        return all(o <= 0 or o < max(along) for o in outward)
+
     def _end_tracks(self, active: list[Person], mask, W: int, H: int, index: int = 0) -> None:
         p = self.params
         frame_box = Box(0, 0, W, H)
         for person in active:
             box = person.box()
-            if box.area <= 0 or _overlap_fraction(box, frame_box) < p.detection.leave_fraction:
+            inside = _overlap_fraction(box, frame_box) if box.area > 0 else 0.0
+            if inside < p.detection.leave_fraction and not self._kept_at_edge(person, box, inside, W, H):
                 if person.lost_since is not None and p.detection.exit_margin > 0:
                     self.withdrawn.append((person.track_id, person.lost_since))  # coasted out: those rows too
                 self._retire(person, index, W, H, walked=True)
