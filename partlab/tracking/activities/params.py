@@ -25,6 +25,12 @@ class Region:
     # pixels whose hue is undefined (grey, dark) say nothing about colour: OpenCV S and V (0-255)
     min_saturation: float = number(60.0)
     min_value: float = number(40.0)
+    # with an empty-scene plate per view (a take's ``<stream>_background.png``), the silhouette the
+    # region is cut by and the clothes are read in is the plate's (core.background.plate_silhouette:
+    # a channel differing by more than this, after a 2 x 2 area average; the value limbs3d uses,
+    # sensor noise ~3 levels), not the run loop's adaptive mask: without either, the "clothes" of a
+    # 3-camera take were the room behind the person, 54 of 180 hue bins, the objects' cyan among them
+    plate_threshold: float = number(28.0, POSITIVE)
 
 
 @dataclass(frozen=True)
