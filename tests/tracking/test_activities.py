@@ -522,3 +522,24 @@ def test_a_take_with_an_empty_scene_image_reads_clothes_and_hands_against_the_pe
     assert hand.shares[np.r_[175:180, 0:5]].sum() == pytest.approx(0.31, abs=0.02)
     # eq. 28: the hand stretched out, its circle's boundary outside the person (0.5 + rho_min without a silhouette)
     assert hand.rho == pytest.approx(0.99, abs=0.01) and hand_bare.rho == pytest.approx(0.6)
+
+
+def test_the_clothes_reach_the_trousers_a_hanging_hand_rests_by():
+    """3-camera handshake seed 14, true hands: a person in a grey shirt and green trousers; the
+    clothes region over the chest only (3.6 head heights) saw no colour, and the trousers round the
+    hanging hand were read as an object picked up at each of its still moments."""
+    from partlab.tracking.activities.objects import body_colours
+    from partlab.tracking.activities.recognise import clothes_hues
+
+    frame = np.full((160, 160, 3), 110, np.uint8)
+    cv2.circle(frame, (70, 30), 10, SKIN, -1)  # the head
+    cv2.rectangle(frame, (52, 40), (87, 99), (150, 150, 150), -1)  # the grey shirt
+    cv2.rectangle(frame, (54, 100), (85, 159), (40, 180, 40), -1)  # the green trousers
+    person = np.zeros((160, 160), np.uint8)
+    person[20:160, 52:88] = 1
+    shares = body_colours(frame, person, Box(60, 20, 20, 20), P)
+    green = 60  # OpenCV hue bin of (40, 180, 40)
+    assert shares[green] == pytest.approx(0.25, abs=0.01)  # 32 x 40 px of the 52 x 98 region
+    assert green in clothes_hues(shares, P)
+    chest = body_colours(frame, person, Box(60, 20, 20, 20), replace(P, modes=replace(P.modes, clothes_reach=3.6)))
+    assert not chest.any()  # the shirt is grey: no colour over the chest
