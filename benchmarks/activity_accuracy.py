@@ -9,7 +9,8 @@ spread of per-seed recall, how often a handshake scene was called an exchange, a
 ``--cameras 3`` measures the 3-camera takes instead (``partlab synth --cameras 3``: standing and
 seated with a clap, handshake with a handshake and an exchange), hands from ``--tracker limbs3d``
 (the 3D heads and hands projected into every view; the colour around each hand fused over the
-views, eq. 29) from the truth's first frame.
+views, eq. 29) from the truth's first frame; the colour analysis reads each view's silhouettes
+against the take's empty-scene images, with tracked or true hands.
 
 ``--hands truth`` feeds the recognition the scene's true head and hand boxes instead of the limb
 tracker's (what the recognition gets right when the hands are right); ``--hands both`` runs both,
@@ -90,7 +91,7 @@ def run_take(name: str, seed: int, frames: int, cameras: int, hands: str,
     cams = {c.name: c for c in scene.cameras}
     params = model_params(None, "activities")
     if hands == "truth":
-        tracker = with_activities(TruthHands(scene.truth), params)
+        tracker = with_activities(TruthHands(scene.truth), params, scene.backgrounds)
     else:
         from partlab.tracking.limbs3d.tracker import Limbs3DTracker
 
@@ -99,7 +100,7 @@ def run_take(name: str, seed: int, frames: int, cameras: int, hands: str,
             limbs3d = limbs3d.updated({k: _value(limbs3d.get(k), v) for k, v in changes.items()})
         inner = Limbs3DTracker(limbs3d, np.random.default_rng(seed), cams, init=scene.init,
                                backgrounds=scene.backgrounds)
-        tracker = with_activities(inner, params)
+        tracker = with_activities(inner, params, scene.backgrounds)
     t0 = time.perf_counter()
     sets = (FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}) for i in range(frames))
     run_frames(tracker, sets, None)

@@ -133,5 +133,5 @@ def build(params, rngs, context):
     if "activities" in params:  # activities over the merged tracks, so they name the ids as written
         from partlab.tracking.activities import with_activities
 
-        return with_activities(combined, params["activities"])
+        return with_activities(combined, params["activities"], getattr(context, "backgrounds", None))
     return combined

@@ -468,3 +468,78 @@ def test_a_touch_of_a_frame_or_two_is_no_join():
     assert [(r.kind, r.start_frame, r.end_frame) for r in three.itertuples()] == [("handshake", 40, 42)]
     every = P.updated({"decision.min_touch_frames": 1})
     assert list(recognise(_touch(a, b, 40, 41), bare, centres, every)["kind"]) == ["handshake"]
+
+
+class _OneHead:
+    """A 'tracker' reporting one person's head and right hand at fixed boxes."""
+
+    events = None
+
+    def step(self, frames, foreground):
+        from partlab.tracking.tracks import TrackRecord
+
+        return [TrackRecord(frames.index, 1, "head", Box(60, 20, 20, 20)),
+                TrackRecord(frames.index, 1, "right_hand", Box(96, 70, 12, 12))]
+
+    def table(self, records):
+        from partlab.tracking.tracks import records_to_frame
+
+        return records_to_frame(records)
+
+
+def test_a_take_with_an_empty_scene_image_reads_clothes_and_hands_against_the_person_not_the_room():
+    """3-camera handshake seed 8: with no silhouettes, the room behind a person was read as their
+    clothes, the object's cyan among them, so the exchange was never seen. With the take's plate,
+    the clothes are the shirt's red alone, and a room's colour beside the hand is not around it."""
+    from partlab.tracking.activities import with_activities
+    from partlab.tracking.activities.recognise import clothes_hues
+
+    room = np.full((120, 160, 3), 110, np.uint8)
+    cv2.rectangle(room, (40, 40), (159, 119), (200, 200, 40), -1)  # a cyan cabinet behind the person
+    frame = room.copy()
+    cv2.rectangle(frame, (52, 40), (87, 119), (40, 40, 200), -1)  # the red shirt
+    cv2.circle(frame, (70, 30), 10, SKIN, -1)  # the head
+    cv2.rectangle(frame, (88, 72), (97, 79), (40, 40, 200), -1)  # the sleeve to the hand
+    cv2.circle(frame, (102, 76), 6, SKIN, -1)  # the hand, the cabinet round it
+
+    def run(backgrounds):
+        t = with_activities(_OneHead(), P, backgrounds)
+        run_frames(t, (FrameSet.single(i, frame) for i in range(3)), None)
+        return t
+
+    cyan, red = 90, 0  # OpenCV hue bins of (200, 200, 40) and (40, 40, 200)
+    bare, plate = run(None), run({"cam0": room})
+    worn_bare = clothes_hues(bare._clothes[1] / 3, P)
+    worn = clothes_hues(plate._clothes[1] / 3, P)
+    assert cyan in worn_bare and red in worn_bare  # the room read as clothes
+    assert red in worn and cyan not in worn
+    assert plate._clothes[1][red] / 3 == pytest.approx(0.67, abs=0.03)  # the shirt's share of the region
+    assert plate._clothes[1][cyan] == 0.0
+    hand_bare = bare._colours[(1, "right_hand")][0][0]
+    hand = plate._colours[(1, "right_hand")][0][0]
+    assert hand_bare.shares[cyan - 2:cyan + 3].sum() > 0.5  # the cabinet fills the hand's circle
+    assert hand.shares[cyan - 2:cyan + 3].sum() == 0.0  # cut by the silhouette: only the sleeve
+    assert hand.shares[np.r_[175:180, 0:5]].sum() == pytest.approx(0.31, abs=0.02)
+    # eq. 28: the hand stretched out, its circle's boundary outside the person (0.5 + rho_min without a silhouette)
+    assert hand.rho == pytest.approx(0.99, abs=0.01) and hand_bare.rho == pytest.approx(0.6)
+
+
+def test_the_clothes_reach_the_trousers_a_hanging_hand_rests_by():
+    """3-camera handshake seed 14, true hands: a person in a grey shirt and green trousers; the
+    clothes region over the chest only (3.6 head heights) saw no colour, and the trousers round the
+    hanging hand were read as an object picked up at each of its still moments."""
+    from partlab.tracking.activities.objects import body_colours
+    from partlab.tracking.activities.recognise import clothes_hues
+
+    frame = np.full((160, 160, 3), 110, np.uint8)
+    cv2.circle(frame, (70, 30), 10, SKIN, -1)  # the head
+    cv2.rectangle(frame, (52, 40), (87, 99), (150, 150, 150), -1)  # the grey shirt
+    cv2.rectangle(frame, (54, 100), (85, 159), (40, 180, 40), -1)  # the green trousers
+    person = np.zeros((160, 160), np.uint8)
+    person[20:160, 52:88] = 1
+    shares = body_colours(frame, person, Box(60, 20, 20, 20), P)
+    green = 60  # OpenCV hue bin of (40, 180, 40)
+    assert shares[green] == pytest.approx(0.25, abs=0.01)  # 32 x 40 px of the 52 x 98 region
+    assert green in clothes_hues(shares, P)
+    chest = body_colours(frame, person, Box(60, 20, 20, 20), replace(P, modes=replace(P.modes, clothes_reach=3.6)))
+    assert not chest.any()  # the shirt is grey: no colour over the chest

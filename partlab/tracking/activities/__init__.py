@@ -7,8 +7,10 @@ Read :mod:`.objects` (the colour around each hand, sec. 7.2-7.3, eq. 28-29), :mo
 """
 
 
-def with_activities(tracker, params):
-    """``tracker`` with activity recognition (its ``events`` become the activities table)."""
+def with_activities(tracker, params, backgrounds=None):
+    """``tracker`` with activity recognition (its ``events`` become the activities table);
+    ``backgrounds``: per stream the take's empty-scene image, whose silhouettes the colour analysis
+    then reads (else the run loop's foreground masks)."""
     from partlab.tracking.activities.recognise import ActivityTracker
 
-    return ActivityTracker(tracker, params)
+    return ActivityTracker(tracker, params, backgrounds)

@@ -152,12 +152,13 @@ def hand_colour(frame: np.ndarray, foreground: np.ndarray | None, hand: Box, par
 
 def body_colours(frame: np.ndarray, foreground: np.ndarray | None, head: Box, params: ActivityParams) -> np.ndarray:
     """``(180,)`` hue shares of the person's clothes: the silhouette's saturated, non-skin pixels in
-    the region below the head (chest and arms). A colour the person wears is not an object they
-    hold: the paper removes the sleeve through eq. 28's boundary vector; we remove every colour of
-    the clothes (an object of the shirt's own hue is then not seen, a limitation docs/ states)."""
+    the region below the head (chest, arms and the top of the trousers, ``modes.clothes_reach``).
+    A colour the person wears is not an object they hold: the paper removes the sleeve through
+    eq. 28's boundary vector; we remove every colour of the clothes (an object of the shirt's own
+    hue is then not seen, a limitation docs/ states)."""
     H, W = frame.shape[:2]
     x0, x1 = int(max(0, head.x - 0.8 * head.w)), int(min(W, head.x + 1.8 * head.w))
-    y0, y1 = int(max(0, head.y + 1.1 * head.h)), int(min(H, head.y + 3.6 * head.h))
+    y0, y1 = int(max(0, head.y + 1.1 * head.h)), int(min(H, head.y + params.modes.clothes_reach * head.h))
     if x1 - x0 < 3 or y1 - y0 < 3:
         return np.zeros(HUE_BINS)
     crop = frame[y0:y1, x0:x1]

@@ -25,6 +25,12 @@ class Region:
     # pixels whose hue is undefined (grey, dark) say nothing about colour: OpenCV S and V (0-255)
     min_saturation: float = number(60.0)
     min_value: float = number(40.0)
+    # with an empty-scene plate per view (a take's ``<stream>_background.png``), the silhouette the
+    # region is cut by and the clothes are read in is the plate's (core.background.plate_silhouette:
+    # a channel differing by more than this, after a 2 x 2 area average; the value limbs3d uses,
+    # sensor noise ~3 levels), not the run loop's adaptive mask: without either, the "clothes" of a
+    # 3-camera take were the room behind the person, 54 of 180 hue bins, the objects' cyan among them
+    plate_threshold: float = number(28.0, POSITIVE)
 
 
 @dataclass(frozen=True)
@@ -42,6 +48,12 @@ class Modes:
     # a colour covering at least this share of the region below the person's head (their clothes,
     # averaged over the run) is not taken for an object
     clothes_share: float = number(0.04, FRACTION)
+    # that region (``objects.body_colours``) reaches from 1.1 to this many head heights below the
+    # head's top: the chest, the arms and the top of the trousers, by which a hand hangs. 3.6 (the
+    # chest only) left a person's green trousers to be read as an object at each still moment of
+    # their hanging hand (3-camera handshake seed 14, true hands, with the takes' silhouettes: two
+    # false picks, 0.04 round the hand before, 0.14 after)
+    clothes_reach: float = number(6.0, POSITIVE)
     # two cameras may see one colour this many degrees apart (their white balance differs: a 10 %
     # cast on red moves a yellow by about 10 degrees); colours of different views this close are
     # one colour when a hand's views are fused (eq. 29)

@@ -19,6 +19,7 @@ from collections import defaultdict
 from collections.abc import Mapping
 from dataclasses import replace
 
+import cv2
 import numpy as np
 import pandas as pd
 
@@ -35,6 +36,7 @@ from partlab.tracking.activities.objects import (
 )
 from partlab.tracking.activities.params import ActivityParams
 from partlab.tracking.activities.table import Verdict, absent, mass, one_hand, two_hands
+from partlab.tracking.core.background import half_size, plate_silhouette
 from partlab.tracking.frame import FrameSet
 from partlab.tracking.tracks import TrackRecord
 
@@ -50,9 +52,11 @@ LOST = "lost"  # the state of a target the tracker no longer sees (limbs' state 
 class ActivityTracker:
     """A tracker plus activity recognition over the hands it reports."""
 
-    def __init__(self, inner, params: ActivityParams):
+    def __init__(self, inner, params: ActivityParams, backgrounds: Mapping[str, np.ndarray] | None = None):
         self.inner = inner
         self.activity_params = params
+        # per stream the empty-scene plate at half resolution (a take's backgrounds, if it has them)
+        self._plates = {s: half_size(b) for s, b in (backgrounds or {}).items() if b is not None}
         self.params = getattr(inner, "params", None)
         self._colours: dict[Key, dict[int, list[HandColour]]] = defaultdict(lambda: defaultdict(list))
         self._centres: dict[Key, dict[int, tuple[float, float, float]]] = defaultdict(dict)
@@ -63,6 +67,7 @@ class ActivityTracker:
 
     def step(self, frames: FrameSet, foreground: Mapping[str, np.ndarray | None]) -> list[TrackRecord]:
         rows = self.inner.step(frames, foreground)
+        foreground = {s: self._foreground(s, v.color, foreground.get(s)) for s, v in frames.views.items()}
         for r in rows:
             if r.part not in HAND_PARTS + ("head",) or r.box.w <= 0 or r.box.h <= 0 or r.state == LOST:
                 continue  # a lost target's box is where it was last seen, not where it is
@@ -83,6 +88,16 @@ class ActivityTracker:
                 self._centres[key][r.frame] = (r.box.x + r.box.w / 2, r.box.y + r.box.h / 2, max(r.box.w, r.box.h))
                 self._where[key][r.frame] = seen.where
         return rows
+
+    def _foreground(self, stream: str, color: np.ndarray | None, mask: np.ndarray | None) -> np.ndarray | None:
+        """The silhouettes of one view the colour analysis reads: the plate's where the take has an
+        empty-scene image of the view (the person against the room, ``region.plate_threshold``),
+        else the run loop's ``mask`` (its adaptive background model; None without one)."""
+        plate = self._plates.get(stream)
+        if color is None or plate is None or plate.shape != (color.shape[0] // 2, color.shape[1] // 2, 3):
+            return mask
+        sil = plate_silhouette(half_size(color), plate, self.activity_params.region.plate_threshold)
+        return cv2.resize(sil, (color.shape[1], color.shape[0]), interpolation=cv2.INTER_NEAREST)
 
     def table(self, records: list[TrackRecord]) -> pd.DataFrame:
         out = self.inner.table(records)

@@ -22,5 +22,5 @@ def build(params, rngs, context):
     if "activities" in params:  # carried objects and activities over the hands it tracks
         from partlab.tracking.activities import with_activities
 
-        return with_activities(view, params["activities"])
+        return with_activities(view, params["activities"], getattr(context, "backgrounds", None))
     return view

@@ -32,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 from partlab.tracking.camera import Camera
+from partlab.tracking.core.background import half_size, plate_silhouette
 from partlab.tracking.core.box import Box
 from partlab.tracking.core.skin import SkinModel, find_blobs, train_skin_model
 from partlab.tracking.frame import FrameSet
@@ -132,18 +133,14 @@ class Limbs3DTracker:
     @staticmethod
     def _half(image: np.ndarray) -> np.ndarray:
         """Silhouettes are found at half resolution (a 2 x 2 area average also halves the noise)."""
-        return cv2.resize(image, (image.shape[1] // 2, image.shape[0] // 2), interpolation=cv2.INTER_AREA)
+        return half_size(image)
 
     def _silhouette(self, stream: str, color: np.ndarray, foreground) -> np.ndarray:
         """``(H/2, W/2) uint8`` 0/1 person mask of one view."""
         plate = self.plates.get(stream)
         h, w = color.shape[0] // 2, color.shape[1] // 2
         if plate is not None and plate.shape == (h, w, 3):
-            diff = cv2.absdiff(self._half(color), plate)
-            b, g, r = cv2.split(diff)
-            level = self.params.observations.plate_threshold
-            sil = cv2.threshold(cv2.max(cv2.max(b, g), r), level, 1, cv2.THRESH_BINARY)[1]
-            return cv2.morphologyEx(sil, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))
+            return plate_silhouette(self._half(color), plate, self.params.observations.plate_threshold)
         if foreground is None:
             return np.zeros((h, w), np.uint8)
         return cv2.resize((np.asarray(foreground) > 0).astype(np.uint8), (w, h), interpolation=cv2.INTER_NEAREST)
