@@ -431,6 +431,24 @@ class EditCount:
         return 100.0 * self.edits / self.truth_boxes if self.truth_boxes else float("nan")
 
 
+def _frame_assignments(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str):
+    """Per frame of either table, ``(truth boxes, proposals, IoUs of the assigned pairs)`` for
+    ``part``: the one-to-one assignment of largest total IoU that the edits are counted over."""
+    truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
+    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
+    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
+    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
+    for f in set(t_by) | set(k_by):
+        t = t_by.get(f, np.empty((0, 4)))
+        k = k_by.get(f, np.empty((0, 4)))
+        iou = np.zeros(0)
+        if len(t) and len(k):
+            full = iou_xywh(t, k)
+            rows, cols = linear_sum_assignment(full, maximize=True)
+            iou = full[rows, cols]
+        yield len(t), len(k), iou
+
+
 def count_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = "person",
                 keyframes: int = 0, threshold: float = EDIT_IOU) -> EditCount:
     """Corrections that turn ``proposals`` into ``truth`` for ``part`` (see :class:`EditCount`).
@@ -442,22 +460,13 @@ def count_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = 
     corrected in the id column, which this measure does not count.
     """
     truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
-    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
-    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
-    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
     moved = drawn = deleted = 0
-    for f in set(t_by) | set(k_by):
-        t = t_by.get(f, np.empty((0, 4)))
-        k = k_by.get(f, np.empty((0, 4)))
-        matched = 0
-        if len(t) and len(k):
-            iou = iou_xywh(t, k)
-            rows, cols = linear_sum_assignment(iou, maximize=True)
-            matched = int((iou[rows, cols] >= threshold).sum())
-        pairs = min(len(t), len(k))
+    for n_truth, n_props, iou in _frame_assignments(truth_df, proposals_df, part):
+        matched = int((iou >= threshold).sum())
+        pairs = min(n_truth, n_props)
         moved += pairs - matched
-        drawn += len(t) - pairs
-        deleted += len(k) - pairs
+        drawn += n_truth - pairs
+        deleted += n_props - pairs
     edits = moved + drawn + deleted + int(keyframes)
     return EditCount(edits, len(truth), int(keyframes), moved, drawn, deleted)
 
@@ -479,19 +488,9 @@ def soft_edits(truth_df: pd.DataFrame, proposals_df: pd.DataFrame, part: str = "
     """
     lo, hi = SOFT_EDIT_BAND
     truth = truth_df[truth_df["part"] == part] if "part" in truth_df else truth_df
-    props = proposals_df[proposals_df["part"] == part] if "part" in proposals_df else proposals_df
-    t_by = {f: g[XYWH].to_numpy(float) for f, g in truth.groupby("frame")}
-    k_by = {f: g[XYWH].to_numpy(float) for f, g in props.groupby("frame")}
     total = 0.0
-    for f in set(t_by) | set(k_by):
-        t = t_by.get(f, np.empty((0, 4)))
-        k = k_by.get(f, np.empty((0, 4)))
-        right = 0.0
-        if len(t) and len(k):
-            iou = iou_xywh(t, k)
-            rows, cols = linear_sum_assignment(iou, maximize=True)
-            right = float(np.clip((iou[rows, cols] - lo) / (hi - lo), 0.0, 1.0).sum())
-        total += max(len(t), len(k)) - right
+    for n_truth, n_props, iou in _frame_assignments(truth_df, proposals_df, part):
+        total += max(n_truth, n_props) - float(np.clip((iou - lo) / (hi - lo), 0.0, 1.0).sum())
     return total, len(truth)
 
 
