@@ -215,6 +215,15 @@ def _nearest_border(box: Box, W: int, H: int) -> str:
     return min(gaps, key=gaps.get)
 
 
+def _motion(person) -> tuple[float, float]:
+    """A person's per-frame motion: its person box's recent median (``Person.velocity``), else the
+    mean of its parts' filter velocities."""
+    v = person.velocity()
+    if v is None:
+        v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
+    return float(v[0]), float(v[1])
+
+
 def _overlap_fraction(a: Box, b: Box) -> float:
     """Share of ``a``'s area covered by ``b``."""
     return a.intersection(b) / a.area if a.area > 0 else 0.0
@@ -727,10 +736,7 @@ class BodyTracker:
         if m <= 0:
             return False
         box = self._reported_person_box(person).clip(W, H)
-        v = person.velocity()
-        if v is None:
-            v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
-        vx, vy = float(v[0]), float(v[1])
+        vx, vy = _motion(person)
         # walking along a border is not walking out of it (PETS09: walkers at the bottom edge, their
         # feet cut off, going sideways at 14 px a frame ended as "out" when their support lagged)
         along_x = abs(vx) > max(abs(vy), STILL * box.h)  # moves sideways: along the top or bottom border
@@ -745,10 +751,7 @@ class BodyTracker:
         d = self.params.detection
         if not d.leave_along or inside < 0.5 * d.leave_fraction:
             return False
-        v = person.velocity()
-        if v is None:
-            v = np.mean([f.state[4:6] for f in person.filters.values()], axis=0)
-        vx, vy = float(v[0]), float(v[1])
+        vx, vy = _motion(person)
         if max(abs(vx), abs(vy)) <= STILL * box.h:
             return False  # standing: its box's share decides
         out_x = -vx if box.x < 0 else (vx if box.x2 > W else None)  # speed out through a cutting side
