@@ -138,6 +138,7 @@ register(TrackerEntry(
 # slot 14 (the issue that added it): far from the slots the other trackers take in order
 register_parameters(ParameterEntry("limbs3d", "partlab.tracking.limbs3d.params:Limbs3DParams", rng_slot=14))
 register(TrackerEntry(
-    "limbs3d", "heads and hands in 3D from two or more calibrated cameras (candidates from pairs of views)",
-    "partlab.tracking.limbs3d:build", ("limbs3d",), ("head", "left_hand", "right_hand"),
+    "limbs3d", "heads and hands in 3D from two or more calibrated cameras (candidates from pairs of views), "
+    "with their activities", "partlab.tracking.limbs3d:build", ("limbs3d", "activities"),
+    ("head", "left_hand", "right_hand"),
     needs=frozenset({"color", "calibration"}), min_streams=2))

@@ -70,3 +70,25 @@ def test_limbs3d_runs_through_the_run_loop_and_refuses_one_view(tmp_path):
     (out / "cam1.mp4").unlink()
     with pytest.raises(UserError, match="at least 2 streams"):
         track(open_take(out), "limbs3d", init=read_tracks_csv(out / "init.csv"))
+
+
+def test_partlab_track_of_a_take_with_limbs3d_writes_its_activities(tmp_path, capsys):
+    """``--tracker limbs3d --events`` recognises the take's activities (sec. 7 over the 3D hands),
+    as ``limbs`` does in one camera: the standing take's clap (truth frames 63-79) is found and
+    ``partlab eval --events`` matches it."""
+    import pandas as pd
+
+    from partlab.cli import main
+
+    take = render_take("standing", tmp_path / "take", 3, seed=0, n_frames=90, width=320, height=240,
+                       chessboard=False)
+    found = tmp_path / "events.csv"
+    assert main(["track", str(take), "--tracker", "limbs3d", "--init", str(take / "init.csv"), "--seed", "1",
+                 "--events", str(found), "-o", str(tmp_path / "tracks.csv")]) == 0
+    events = pd.read_csv(found)
+    assert list(events["kind"]) == ["clap"]
+    clap = events.iloc[0]
+    assert 60 <= clap.start_frame <= 70 and 75 <= clap.end_frame <= 85
+    capsys.readouterr()
+    assert main(["eval", str(take / "events.csv"), str(found), "--events"]) == 0
+    assert "clap      1          1        1        1.0     1.0" in capsys.readouterr().out

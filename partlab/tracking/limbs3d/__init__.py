@@ -16,8 +16,14 @@ def build(params, rngs, context):
     cameras = {s: c for s, c in context.cameras.items() if c is not None}
     if len(cameras) < 2:
         raise UserError(f"tracker 'limbs3d' needs two or more calibrated views, the take has {len(cameras)}")
+    backgrounds = getattr(context, "backgrounds", None)
     try:
-        return Limbs3DTracker(params["limbs3d"], rngs["limbs3d"], cameras, init=context.init_table(),
-                              backgrounds=getattr(context, "backgrounds", None))
+        tracker = Limbs3DTracker(params["limbs3d"], rngs["limbs3d"], cameras, init=context.init_table(),
+                                 backgrounds=backgrounds)
     except ValueError as exc:
         raise UserError(f"bad init table: {exc}") from None
+    if "activities" in params:  # carried objects and activities, fused over the views (eq. 29)
+        from partlab.tracking.activities import with_activities
+
+        return with_activities(tracker, params["activities"], backgrounds)
+    return tracker
