@@ -285,3 +285,98 @@ def test_a_track_re_acquired_standing_learns_its_walkers_speed_again():
     assert velocity[True] <= -3.5
     assert velocity[False] >= -2.5
     assert abs(behind[True]) <= 1.5
+
+
+def _two_in_dark_jackets(xa: float, xb: float) -> np.ndarray:
+    """Two people in the same dark jackets, A in blue jeans and B in grey trousers (BGR)."""
+    f = np.full((240, 360, 3), 150, np.uint8)
+    for x, legs in ((xa, (170, 100, 40)), (xb, (70, 70, 70))):
+        x = int(round(x))
+        f[60:78, x + 8:x + 22] = (90, 140, 200)  # head
+        f[78:112, x:x + 30] = (35, 35, 40)  # jacket
+        f[112:160, x + 2:x + 28] = legs
+    return f
+
+
+def test_of_two_tracks_on_one_person_the_one_given_on_another_person_goes_and_yields():
+    """Two walkers in the same dark jackets, one in blue jeans (A), one in grey trousers (B), both
+    given by their first boxes. Then both tracks sit on A (where PETS09's persons 9 and 15 met, the
+    track of the one was carried onto the other). With ``duplicate_margin`` the track whose first
+    models match A worse (B's, by its legs) is the one that goes lost, whoever a detection matched
+    last; with 0 the one matched less recently goes (here A's own track). With ``lost_yields`` the
+    lost one does not take A's next detection from A's track, even when it overlaps it more."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    first = _two_in_dark_jackets(100, 220)
+    later = _two_in_dark_jackets(100, 220)
+    ycc0, ycc = cv2.cvtColor(first, cv2.COLOR_BGR2YCrCb), cv2.cvtColor(later, cv2.COLOR_BGR2YCrCb)
+    lost, taken, sims = {}, {}, {}
+    for margin, yields in ((0.1, True), (0.0, True), (0.1, False)):
+        params = BodyParams().updated({"detector.duplicate_margin": margin, "detector.lost_yields": yields})
+        t = BodyTracker(params, np.random.default_rng(0), init=[])
+        t.frame_size = (360, 240)
+        a = t.start_track(1, {"person": Box(100, 60, 30, 100)}, ycc0, None, 0)
+        b = t.start_track(2, {"person": Box(220, 60, 30, 100)}, ycc0, None, 0)
+        for f in b.filters.values():  # B's track carried onto A, 2 px to the right of A's own
+            f.shift(np.array([-118.0, 0.0]))
+        for f in a.filters.values():
+            f.shift(np.array([-2.0, 0.0]))
+        shared = t._reported_person_box(a)
+        sims[margin, yields] = (t.cue._first_similarity(a, shared, ycc), t.cue._first_similarity(b, shared, ycc))
+        t.cue.last_match.update({1: 0, 2: 3})  # B's track took A's last detection
+        t.cue.detector.detect = lambda frame, regions: np.zeros((0, 5))
+        t.cue.step(6, later, ycc, None)
+        lost[margin, yields] = sorted(k for k, q in t.people.items() if q.lost_since is not None)
+        # A's next detection, where B's lost track sits (it overlaps it more than A's own track)
+        on_b = t._reported_person_box(b)
+        det = np.array([[on_b.x, on_b.y, on_b.w, on_b.h, 1.0]])
+        t.cue.detector.detect = lambda frame, regions, det=det: det
+        t.cue.step(9, later, ycc, None)
+        taken[margin, yields] = (t.cue.last_match[1], t.cue.last_match[2], b.lost_since is not None)
+    rho_a, rho_b = sims[0.1, True]
+    assert rho_a >= 0.9 and rho_b <= rho_a - 0.2  # measured: 1.00 against 0.50
+    assert lost[0.1, True] == [2]
+    assert lost[0.0, True] == [1]  # recency: A's own track goes
+    # yielding: A's track takes the detection and B's stays lost; without, B's takes it (A's is
+    # left unmatched, and after ``reacquire_after`` frames jumps to a free detection elsewhere)
+    assert taken[0.1, True] == (9, 3, True)
+    assert taken[0.1, False][:2] == (0, 9)
+
+
+def test_a_track_due_for_re_acquisition_claims_its_persons_detection_from_a_track_given_on_another():
+    """The same two people; B's track is carried onto A and holds A's detection, while A's own
+    track coasted 35 px to the left and no detection has matched it for ``reacquire_after`` frames.
+    With ``reacquire_claims`` A's track, whose first models match the detection at 1.00 against
+    B's 0.50, takes it (jumps there) and B's track goes lost; without, there is no free detection
+    to re-acquire and B's track keeps A's person."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    first = _two_in_dark_jackets(100, 220)
+    ycc0 = cv2.cvtColor(first, cv2.COLOR_BGR2YCrCb)
+    out = {}
+    for claims in (True, False):
+        params = BodyParams().updated({"detector.reacquire_claims": claims})
+        t = BodyTracker(params, np.random.default_rng(0), init=[])
+        t.frame_size = (360, 240)
+        a = t.start_track(1, {"person": Box(100, 60, 30, 100)}, ycc0, None, 0)
+        b = t.start_track(2, {"person": Box(220, 60, 30, 100)}, ycc0, None, 0)
+        for f in b.filters.values():
+            f.shift(np.array([-120.0, 0.0]))
+        for f in a.filters.values():
+            f.shift(np.array([-35.0, 0.0]))
+        on_a = t._reported_person_box(b)
+        det = np.array([[on_a.x, on_a.y, on_a.w, on_a.h, 1.0]])
+        t.cue.detector.detect = lambda frame, regions, det=det: det
+        index = params.detector.reacquire_after
+        index += -index % params.detector.every  # a frame the cue scans
+        t.cue.last_match.update({1: 0, 2: index - 3})
+        t.cue.step(index, first, ycc0, None)
+        out[claims] = (t._reported_person_box(a).centre[0] - on_a.centre[0], a.lost_since, b.lost_since)
+    dx, a_lost, b_lost = out[True]
+    assert abs(dx) < 3 and a_lost is None and b_lost is not None  # A's track on A, B's lost
+    dx, a_lost, b_lost = out[False]
+    assert dx < -30 and b_lost is None  # A's track left where it coasted, B's on A

@@ -113,6 +113,7 @@ class DetectionCue:
         self.scans = 0
         self.detections = np.zeros((0, 5))
         self.reid_candidates: list[Candidate] = []  # free detections matching a dormant track, scans running
+        self.by_identity: set[int] = set()  # duplicates the first models sent lost at the last scan
 
     def step(self, index: int, frame: np.ndarray, ycc, mask: np.ndarray | None,
              scan: np.ndarray | None = None) -> None:
@@ -132,8 +133,7 @@ class DetectionCue:
         dets = self.detector.detect(frame, regions)
         self.detections = dets
         track_boxes = np.array([b.as_tuple() for b in boxes]).reshape(-1, 4)
-        pairs = associate(track_boxes, dets, self.p.match_iou, self._affinity(people, boxes, dets, ycc),
-                          self.p.match_similarity, self.p.similarity_weight)
+        pairs = self._associate(people, track_boxes, dets, self._affinity(people, boxes, dets, ycc))
         used = set()
         contested = self._contested(track_boxes, dets, pairs)
         for i, j in pairs:
@@ -153,12 +153,36 @@ class DetectionCue:
             used.add(j)
         matched = {i for i, _ in pairs}
         free = [j for j in range(len(dets)) if j not in used]
-        free = self._reacquire(index, [q for i, q in enumerate(people) if i not in matched], dets, free, ycc)
+        held = {j: people[i] for i, j in pairs}
+        free = self._reacquire(index, [q for i, q in enumerate(people) if i not in matched], dets, free, ycc, held)
         if t.auto:
             self._confirm(index, dets, free, ycc, mask)
         else:
             free = self._reidentify(index, dets, free, ycc)
-        self._end(index)
+        self._end(index, ycc)
+
+    def _associate(self, people: list, tracks: np.ndarray, dets: np.ndarray,
+                   affinity: np.ndarray | None) -> list[tuple[int, int]]:
+        """Tracks to detections (Hungarian on IoU, gated by ``affinity``); with ``lost_yields``,
+        the others first, then the tracks yielding (lost on another's person) among the detections
+        left that none of the others overlaps at ``match_iou``."""
+        p = self.p
+        lost = np.array([q.yielding for q in people], dtype=bool)
+        if not p.lost_yields or not lost.any() or lost.all() or not len(dets):
+            return associate(tracks, dets, p.match_iou, affinity, p.match_similarity, p.similarity_weight)
+
+        def subset(rows: np.ndarray, cols: np.ndarray) -> list[tuple[int, int]]:
+            a = None if affinity is None else affinity[np.ix_(rows, cols)]
+            found = associate(tracks[rows], dets[cols], p.match_iou, a, p.match_similarity, p.similarity_weight)
+            return [(int(rows[i]), int(cols[j])) for i, j in found]
+
+        live = np.flatnonzero(~lost)
+        pairs = subset(live, np.arange(len(dets)))
+        claimed = (iou_xywh(tracks[live], dets[:, :4]) >= p.match_iou).any(axis=0)
+        left = np.array([j for j in range(len(dets)) if not claimed[j]], dtype=int)
+        if len(left):
+            pairs += subset(np.flatnonzero(lost), left)
+        return pairs
 
     def _contested(self, tracks: np.ndarray, dets: np.ndarray, pairs: list[tuple[int, int]]) -> set[tuple[int, int]]:
         """``swap_guard``: the pairs whose detection overlaps another track at least ``swap_guard``
@@ -255,13 +279,17 @@ class DetectionCue:
         if follows:  # the head moves with the torso's correction, keeping its size and place on it
             person.filters["head"].shift(torso.state[0:2] - before)
 
-    def _reacquire(self, index: int, unmatched: list, dets: np.ndarray, free: list[int], ycc) -> list[int]:
+    def _reacquire(self, index: int, unmatched: list, dets: np.ndarray, free: list[int], ycc,
+                   held: dict | None = None) -> list[int]:
         """Lost tracks, and tracks unmatched for ``reacquire_after`` frames, jump to a free detection
         near their prediction whose torso region matches the torso's model, standing (and learning
-        its velocity again, ``dynamics.relearn_velocity``); the free rest."""
+        its velocity again, ``dynamics.relearn_velocity``); with ``reacquire_claims``, also to one a
+        track holds (``held``: detection index -> track) whose first models match it worse by
+        ``duplicate_margin`` (that track goes lost). The free rest."""
         t, p = self.tracker, self.p
+        held = dict(held or {}) if p.reacquire_claims and p.duplicate_margin > 0 else {}
         for person in unmatched:
-            if not free:
+            if not free and not held:
                 break
             lost = person.lost_since is not None
             if not lost and index - self.last_match.get(person.track_id, index) < p.reacquire_after:
@@ -270,13 +298,17 @@ class DetectionCue:
             cx, cy = reported.centre
             best, best_rho = None, p.reacquire_similarity
             f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
-            for j in free:
+            for j in [*free, *(held if person.first else ())]:
                 det = Box(*dets[j, :4])
                 dx, dy = det.centre[0] - cx, det.centre[1] - cy
                 if np.hypot(dx, dy) > p.reacquire_distance * det.h:
                     continue
-                if any(det.iou(t._reported_person_box(q)) >= p.match_iou for q in t.people.values() if q is not person):
+                holder = held.get(j)
+                if any(det.iou(t._reported_person_box(q)) >= p.match_iou for q in t.people.values()
+                       if q is not person and q is not holder):
                     continue  # someone else's
+                if holder is not None and self._claims(person, holder, det, ycc) is not person:
+                    continue  # the holder's as much as ours
                 target = _target(f.box, reported, det)
                 state = np.array([[*target.centre, target.w, target.h, 0.0, 0.0]], dtype=np.float32)
                 rho = float(f.similarities(as_array(ycc), state)[0])
@@ -284,6 +316,10 @@ class DetectionCue:
                     best, best_rho = j, rho
             if best is None:
                 continue
+            holder = held.pop(best, None)
+            if holder is not None:  # it was on someone else's person: it coasts, lost, and yields
+                if holder.lost_since is None:
+                    holder.lost_since = holder.yields_from = index
             for g in person.filters.values():
                 g.set_velocity(np.zeros(2))
             if t.params.dynamics.relearn_velocity:  # standing there: learns its walker's speed as a new track
@@ -412,28 +448,33 @@ class DetectionCue:
                 return False
         return True
 
-    def _end(self, index: int) -> None:
-        """Duplicates end (the one matched less recently, then the younger); automatic tracks no
-        detection has matched for ``undetected_frames`` frames end."""
+    def _end(self, index: int, ycc=None) -> None:
+        """Duplicates end (the one whose first models match their shared region worse, or else
+        the one matched less recently, then the younger); automatic tracks no detection has
+        matched for ``undetected_frames`` frames end."""
         t, p = self.tracker, self.p
         ids = sorted(t.people)
         if p.duplicate_iou < 1 and len(ids) > 1:
             boxes = np.array([minimum_bounding_rectangle(f.box for f in t.people[k].filters.values()).as_tuple()
                               for k in ids])
-            for k in self._duplicates(ids, iou_xywh(boxes, boxes)):
+            for k in self._duplicates(ids, iou_xywh(boxes, boxes), ycc):
                 if t.auto:
                     self._drop(k)
                 elif t.people[k].lost_since is None:  # a given person is not dropped: it coasts, lost
                     t.people[k].lost_since = index
+                    if k in self.by_identity:
+                        t.people[k].yields_from = index
         if t.auto and p.undetected_frames > 0:
             for k in sorted(t.people):
                 if index - self.last_match.get(k, index) >= p.undetected_frames:
                     self._drop(k)
 
-    def _duplicates(self, ids: list[int], iou: np.ndarray) -> set[int]:
+    def _duplicates(self, ids: list[int], iou: np.ndarray, ycc=None) -> set[int]:
         """Of each pair of tracks overlapping at ``duplicate_iou`` or more (neither behind the
-        other), the one a detection matched less recently, then the younger."""
+        other), the one whose first models match the region they share worse by ``duplicate_margin``
+        (:meth:`_whose`), else the one a detection matched less recently, then the younger."""
         t, gone = self.tracker, set()
+        self.by_identity = set()  # the ones the first models decided
         for a in range(len(ids)):
             for b in range(a + 1, len(ids)):
                 ka, kb = ids[a], ids[b]
@@ -441,9 +482,37 @@ class DetectionCue:
                     continue
                 if t.people[ka].occluded_by is not None or t.people[kb].occluded_by is not None:
                     continue
+                owner = self._whose(t.people[ka], t.people[kb], ycc)
+                if owner is not None:
+                    loser = kb if owner is t.people[ka] else ka
+                    gone.add(loser)
+                    self.by_identity.add(loser)
+                    continue
                 rank_a, rank_b = (self.last_match.get(ka, -1), -ka), (self.last_match.get(kb, -1), -kb)
                 gone.add(ka if rank_a < rank_b else kb)
         return gone
+
+    def _claims(self, a, b, det: Box, ycc):
+        """Of tracks ``a`` and ``b`` (both with first models), the one whose first models match the
+        detection ``det`` better by ``duplicate_margin``, or None."""
+        if not a.first or not b.first:
+            return None
+        arr = as_array(ycc)
+        sa, sb = self._first_similarity(a, det, arr), self._first_similarity(b, det, arr)
+        if abs(sa - sb) < self.p.duplicate_margin:
+            return None
+        return a if sa > sb else b
+
+    def _whose(self, a, b, ycc):
+        """``duplicate_margin``: of two tracks on one person, the one whose first models (the boxes
+        it was given) match the region the two share (their mean person box) better by the margin;
+        None when neither does, or a track has no first models (found automatically)."""
+        if self.p.duplicate_margin <= 0 or ycc is None or not a.first or not b.first:
+            return None
+        t = self.tracker
+        ra, rb = t._reported_person_box(a), t._reported_person_box(b)
+        shared = Box((ra.x + rb.x) / 2, (ra.y + rb.y) / 2, (ra.w + rb.w) / 2, (ra.h + rb.h) / 2)
+        return self._claims(a, b, shared, ycc)
 
     def _drop(self, track_id: int) -> None:
         t = self.tracker

@@ -471,6 +471,33 @@ class BodyDetector:
     # ends; a track given with --init is not ended but goes lost (coasts, may be re-acquired).
     # 1 turns it off.
     duplicate_iou: float = number(0.5, FRACTION)
+    # Which of two duplicates goes (tracks given with --init): the one whose first models (torso
+    # and hip-leg of the boxes it was started from) match the region the two share worse, by at
+    # least ``duplicate_margin`` (mean Bhattacharyya coefficient); closer than that, the rule above.
+    # Where two walkers meet and one track is carried onto the other person, the detection
+    # recency says nothing about whose person it is (both tracks sit on one person and take its
+    # detections in turn), while the started models do: on PETS09 two walkers in dark jackets,
+    # blue jeans against dark trousers, standing side by side for 100 frames, match their own
+    # first models at 0.85-0.93 and each other's at 0.45-0.65. 0: off (recency alone).
+    duplicate_margin: float = number(0.1, FRACTION)
+    # A track the first models sent lost (a duplicate or a claim above: it sat on someone else's
+    # person) yields to the others while that loss lasts: it is not paired with a detection that
+    # another track overlaps at ``match_iou`` or more (those are assigned first), and its torso
+    # probe does not bring it back where it would sit on a live track (IoU of the person boxes at
+    # least ``duplicate_iou``): the exclusion principle (MacCormick & Blake 1999, which Migniot &
+    # Ababsa apply to several people), one observation for one target. Without it the duplicate
+    # that went lost comes back onto the same person at the next detection or probe. A track lost
+    # by the recency rule (two walkers the first models cannot tell apart) does not yield: two
+    # walkers in one coat starting side by side must both keep their detections. False: off.
+    lost_yields: bool = flag(True)
+    # A track due for re-acquisition (lost, or unmatched for ``reacquire_after`` frames) may also
+    # claim a detection another track holds, when its first models match that detection better
+    # than the holder's by ``duplicate_margin`` (both given with --init): it jumps there as on a free
+    # detection, and the holder, on someone else's person, goes lost. Where one track was carried
+    # onto the other's person at a meeting while that one coasted past (PETS09's persons 9 and 15
+    # stop to talk), the detection goes on matching the wrong track by overlap and no duplicate
+    # ever forms. False: only free detections are re-acquired.
+    reacquire_claims: bool = flag(True)
     # Automatic mode: a track no detection has matched for ``undetected_frames`` frames ends (a ghost
     # of the background model, a shadow). 0: never for this reason (foreground support still ends
     # tracks).

@@ -133,6 +133,13 @@ class Person:
     revived: int | None = None  # frame it was re-identified (``detector.reid_hits``), if it was
     steps: deque = field(default_factory=lambda: deque(maxlen=3))  # torso displacements of its first measured frames
     learns_from: int = 0  # frame its velocity started from zero (its start; a re-acquisition standing)
+    yields_from: int | None = None  # frame it went lost on someone else's person (``detector.lost_yields``)
+
+    @property
+    def yielding(self) -> bool:
+        """Lost because its first models said the person it sat on is another track's (a duplicate
+        or a claim, ``detector.duplicate_margin``), and still in that loss."""
+        return self.lost_since is not None and self.lost_since == self.yields_from
 
     def velocity(self) -> np.ndarray | None:
         """Median per-frame motion of the person box's centre over its recent *clean* frames
@@ -633,10 +640,20 @@ class BodyTracker:
         if mask is not None and _support(mask, found) < 2 * p.detection.support_min:
             return
         delta = state[0:2] - f.state[0:2]
+        if p.detector.lost_yields and person.yielding and self._on_another(person, delta):
+            return  # that is someone else's person (the exclusion principle)
         for g in person.filters.values():
             g.shift(delta)
         person.lost_since = None
         person.unsupported = 0
+
+    def _on_another(self, person: Person, delta: np.ndarray) -> bool:
+        """Whether the person's box moved by ``delta`` would overlap the box of another track that
+        is not lost (nor behind someone) at ``detector.duplicate_iou`` or more."""
+        b = person.box()
+        moved = Box(b.x + float(delta[0]), b.y + float(delta[1]), b.w, b.h)
+        return any(moved.iou(q.box()) >= self.params.detector.duplicate_iou for q in self.people.values()
+                   if q is not person and q.lost_since is None and q.occluded_by is None)
 
     def _probe_occluded(self, person: Person, ycc: np.ndarray) -> None:
         """An occluded person whose torso shows clearly again (similarity at least
