@@ -98,6 +98,24 @@ def test_a_hand_cut_off_from_its_body_is_measured_from_its_persons_top():
     assert both.below.tolist() == [5.0, 20.0] and both.below_person.tolist() == [55.0, 20.0]
 
 
+def test_a_fragment_is_measured_from_the_top_of_its_persons_stacked_components():
+    """A silhouette broken into a head (top row 10) and a belly (top row 50) component, with a hand
+    at the hip in a fragment of its own: the nearest larger component is the belly's (8 px away,
+    the head's 13), so the hand is 43 rows below its person's top instead of 83; with ``stack`` the
+    highest of the components whose columns overlap the belly's, the head's, is taken. Another
+    person beside them (higher, top row 2, columns that overlap neither) is not taken."""
+    sil = np.zeros((120, 200), np.uint8)
+    sil[10:30, 40:70] = 1  # head: 600 px
+    sil[50:110, 35:75] = 1  # belly: 2400 px
+    sil[90:97, 80:87] = 1  # the hand, a fragment
+    sil[2:60, 120:150] = 1  # another person (its head and chest)
+    hand = np.array([[83.0, 93.0]])
+    assert observe_view(sil, hand, fragment=0.25).below.tolist() == [43.0]
+    assert observe_view(sil, hand, fragment=0.25, stack=True).below.tolist() == [83.0]
+    both = observe_view(sil, hand, fragment=0.25, either=True, stack=True)
+    assert both.below.tolist() == [3.0] and both.below_person.tolist() == [83.0]  # its own top: row 90
+
+
 def test_with_fragment_either_p_o_takes_the_better_of_the_two_references():
     from partlab.tracking.limbs3d.priors import ViewObservation
 
@@ -564,3 +582,45 @@ def test_a_hand_lost_with_its_combined_pair_is_held_at_its_home():
     assert before.min() > 370
     assert after.max() < 330
     assert (before - after).min() > 60
+
+
+def test_a_hand_at_the_hip_of_a_fragmented_silhouette_keeps_its_true_pair():
+    """Standing, 2 cameras (the first two of the benchmark's 4-camera render of seed 5): camera 0's
+    plate silhouette of the person breaks into head, chest and belly components, and the right hand
+    at the hip is a fragment of its own whose nearest larger component is the belly's. Measured
+    from the belly's top its Dv differs from camera 1's by 640-800 mm, its true pair gets p_o 0,
+    and the hand, lost at frame 103, is held 277-419 mm off in frames 100-130. With
+    ``priors.fragment_stack`` (the highest of the components stacked over the belly's: the head's)
+    the true pair is kept."""
+    scene = make_multiview_scene("standing", 4, seed=5, n_frames=150)
+    frames = range(100, 131)
+    before = _part_error(scene, Limbs3DParams().updated({"priors.fragment_stack": False}), 2, 1, "right_hand",
+                         frames, seed=5)
+    after = _part_error(scene, Limbs3DParams().updated({"priors.fragment_stack": True}), 2, 1, "right_hand",
+                        frames, seed=5)
+    assert len(before) == len(after) == 31
+    assert before.min() > 250
+    assert after.max() < 30  # 4-18 mm
+
+
+def test_with_two_views_a_clapping_hand_leaves_the_ghost_and_is_found_again():
+    """Standing, 2 cameras (the first two of the benchmark's 4-camera render of seed 3): at the
+    clap's release the left hand leaves at ~140 mm a frame; at frame 90 its true pair is beyond the
+    250 mm gate, and from 92 camera 0 no longer sees it. With the defaults it then sits on the ghost
+    made of camera 0's blob of the right hand (which the right hand's true pair uses) and camera 1's
+    blob of the left hand: 395-492 mm off in frames 91-110. ``dynamics.hand_own_blobs`` (a hand's
+    candidate sharing a blob with its other hand's claim 150 mm away is a ghost) keeps it off the
+    ghost (232-289 mm: its depth along camera 1's line is still the lagging one), and
+    ``dynamics.refind_gate`` puts it on its true pair at frame 90 (220 -> 23 mm off), so its
+    single-view depth starts from there (frames 90-121: mean 233 -> 148 mm)."""
+    scene = make_multiview_scene("standing", 4, seed=3, n_frames=150)
+    base = {"priors.fragment_stack": True}
+    ghost = _part_error(scene, Limbs3DParams().updated(base), 2, 1, "left_hand", range(89, 122), seed=3)
+    own = {**base, "dynamics.hand_own_blobs": 150.0}
+    kept = _part_error(scene, Limbs3DParams().updated(own), 2, 1, "left_hand", range(89, 122), seed=3)
+    found = _part_error(scene, Limbs3DParams().updated({**own, "dynamics.refind_gate": 500.0}), 2, 1, "left_hand",
+                        range(89, 122), seed=3)
+    assert len(ghost) == len(kept) == len(found) == 33
+    assert ghost[2:22].min() > 390 and kept[2:22].max() < 300  # frames 91-110
+    assert kept[1] > 200 and found[1] < 50  # frame 90
+    assert kept.mean() > 220 and found.mean() < 160

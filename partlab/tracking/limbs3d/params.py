@@ -89,6 +89,17 @@ class Limbs3DPriors:
     # components' tops is not lost (standing 3 cameras seed 8 with fragment alone: right hand 184 mm,
     # 40 with both)
     fragment_either: bool = flag(True)
+    # with fragment > 0: a fragment's person is the highest of the larger components whose columns
+    # overlap those of the nearest one (priors.observe_view; our addition). A person whose clothes
+    # match the background breaks into head, chest and belly components stacked in one view, and the
+    # nearest to a hand at the hip was the belly's (standing seed 5, 2 cameras, camera 0: the right
+    # hand's true pair had Dv -640..-800 mm, p_o 0, for 50 frames; the hand was lost and held
+    # 277-419 mm off). Two people side by side do not overlap; the highest larger component within
+    # 40 px instead (tried) took the other person's and cost handshake seed 4 ~20 mm at 2 and 4
+    # cameras. 2026-12-06 (docs/measurements/limbs3d.md, seeds 0-9): standing 2 cameras 39.9 -> 34.5
+    # mm (seed 5 85.7 -> 32.3), every other take of standing, seated and handshake at 2-4 cameras
+    # within 0.5 mm. False = the nearest one (before)
+    fragment_stack: bool = flag(True)
     # eq. 26 (fitted): spread of the distance between the two lines of sight (mm). Blob centroids
     # are not projections of one 3D point (the head's hair, sec. 6.3), yet on the synthetic seated
     # takes 90 % of true pairs lie within 3-10 mm, while a tenth of false pairs lie within 22-38 mm;
@@ -232,10 +243,36 @@ class Limbs3DDynamics:
     # from the ghost drifts along its one view's line of sight, and the hands' homes, relative to
     # it, drift with it (docs/measurements/limbs3d.md, 2026-12-06, branch hs3d)
     head_own_blobs: bool = flag(False)
+    # a hand uses no candidate that shares a blob with the candidate another tracked hand or head of
+    # its person claims (the one nearest its prediction, within candidate_gate; of as many views or
+    # more) and lies more than this many mm from that claim, when it is farther from this hand's
+    # prediction than the claim is from its claimant's (tracker._ghost_of_claim; our addition, sec.
+    # 6.4's ghosts): with two views a hand hidden in one of them sat on the ghost made of the other
+    # hand's blob there and its own blob in the other view (standing 2 cameras seeds 3, 5, 7: 250-460
+    # mm off); p_b cannot reject it with two views. Only for takes of at most
+    # hand_own_blobs_cameras views: with three, two hands on one line of sight in one view share a
+    # blob truly, and the 3-camera handshake lost 28-88 mm a take (2026-12-06, session hs3d). Off by
+    # default: 2026-12-06 (docs/measurements/limbs3d.md, session hs3d2), with fragment_stack, standing
+    # 2 cameras seeds 3 and 5 -18 and -7 mm but seed 9 +12 (a clap's two hands on one line of sight in
+    # camera 0: the lagging hand's true pair shares the other's blob and is dropped). 0 = off
+    hand_own_blobs: float = number(0.0)
+    hand_own_blobs_cameras: int = number(2, POSITIVE_COUNT)
     # a lost target (held where it was lost) does not take candidates from a tracked one by being
     # nearer to them (our addition): a hand lost during a fast clap is held where it fell behind,
     # often nearer the other hand's candidates than that hand's own lagging prediction
     lost_yield: bool = flag(True)
+    # a normal hand with no candidate it may use within candidate_gate of its prediction is put on
+    # the nearest one of prior >= states.start_prior within this distance (mm) that is nearer to it
+    # than to every other target (a lost one where it is held included), with fewer than three
+    # views (tracker._refind; our addition; with three or more, line_of_sight re-finds a hand and
+    # this made the 3-camera handshake worse, seeds 2 and 4 +18 and +23 mm): a hand leaving a clap at
+    # ~140 mm a frame is 300-400 mm from its lagging estimate when next seen by two views (standing
+    # 2 cameras seed 3: left hand frame 90, 220 -> 23 mm off). Off by default (2026-12-06,
+    # docs/measurements/limbs3d.md, 2 cameras, seeds 0-9, with fragment_stack): standing 34.5 -> 34.7
+    # mm (seed 3 -2.8, 4 -3.7, 0 and 8 +3), seated 15.9 -> 16.7 (seed 4 +12: a hand put on a candidate
+    # of the other hand's; with hand_own_blobs as well +144 mm and a hand on another hand), handshake
+    # within 3.4 mm a take. 0 = off
+    refind_gate: float = number(0.0)
     # a combined filter spreads its particles this much wider so it sees both modes
     combined_noise_scale: float = number(1.3, POSITIVE)
     # a lost target's particles spread this wide (mm) around where it is looked for

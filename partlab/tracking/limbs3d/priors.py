@@ -49,13 +49,18 @@ class ViewObservation:
 
 
 def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0,
-                 fragment: float = 0.0, either: bool = False) -> ViewObservation:
+                 fragment: float = 0.0, either: bool = False, stack: bool = False) -> ViewObservation:
     """The silhouette measures of one view (``silhouette``: ``(H, W)`` mask, nonzero = person;
     ``centres`` in silhouette pixels; ``scale``: image pixels per silhouette pixel). A blob in a
     component smaller than ``fragment`` times the largest (a hand reaching across a table, cut
     off from its body in this view) is measured from the top of the nearest larger component
     (horizontally), its person's; 0 = from its own component's top. With ``either``, ``below`` is
-    from its own component's top and ``below_person`` from its person's (p_o takes the better)."""
+    from its own component's top and ``below_person`` from its person's (p_o takes the better).
+    With ``stack``, a fragment's person is the highest of the larger components whose columns
+    overlap those of the nearest one: a person whose clothes match the background breaks into a
+    head, a chest and a belly component stacked one above the other, and the nearest of them to a
+    hand at the hip may be the belly's, whose top is far below the person's; two people side by
+    side do not overlap."""
     sil = (np.asarray(silhouette) > 0).astype(np.uint8)
     centres = np.asarray(centres, float).reshape(-1, 2)
     h, w = sil.shape
@@ -72,6 +77,10 @@ def observe_view(silhouette: np.ndarray, centres: np.ndarray, scale: float = 1.0
         if lab > 0 and fragment > 0 and lab not in big:
             left, width = stats[big, cv2.CC_STAT_LEFT], stats[big, cv2.CC_STAT_WIDTH]
             lab = big[np.argmin(np.maximum(np.maximum(left - x, x - (left + width)), 0))]
+            if stack:  # the highest of the larger components whose columns overlap the nearest one's
+                lo, hi = stats[lab, cv2.CC_STAT_LEFT], stats[lab, cv2.CC_STAT_LEFT] + stats[lab, cv2.CC_STAT_WIDTH]
+                over = big[(left < hi) & (left + width > lo)]
+                lab = over[np.argmin(stats[over, cv2.CC_STAT_TOP])]
         top = float(stats[lab, cv2.CC_STAT_TOP]) if lab > 0 else top_all
         top_own = float(stats[own, cv2.CC_STAT_TOP]) if own > 0 else top_all
         below[k] = (y - (top_own if either else top)) * scale

@@ -215,7 +215,7 @@ class Limbs3DTracker:
             blind = stream in self.plates and sil.mean() > p.observations.blind_fill
             centres.append(np.zeros((0, 2)) if blind else blobs.centres)
             views.append(observe_view(sil, centres[-1] / 2.0, scale=2.0, fragment=p.priors.fragment,
-                                      either=p.priors.fragment_either))
+                                      either=p.priors.fragment_either, stack=p.priors.fragment_stack))
         self._centres = centres
         return centres, views
 
@@ -254,10 +254,11 @@ class Limbs3DTracker:
         preds = np.array([self.targets[k].filter.estimate for k in active]).reshape(-1, 3)
         lost = np.array([m.state(k) == LimbState.LOST for k in active], bool)
         points, weights = self.candidates(centres, views, preds[~lost])
-        self._claims: list = []  # (person, candidate): each tracked target's nearest candidate (_borrowed)
+        self._claims: list = []  # (person, candidate, target, distance): each tracked target's nearest candidate
         if len(points) and len(active):
             dist = np.linalg.norm(points[:, None] - preds[None], axis=-1)
-            self._claims = [(self.targets[k].track_id, int(np.argmin(dist[:, a]))) for a, k in enumerate(active)
+            self._claims = [(self.targets[k].track_id, int(np.argmin(dist[:, a])), k, float(dist[:, a].min()))
+                            for a, k in enumerate(active)
                             if not lost[a] and dist[:, a].min() < p.dynamics.candidate_gate]
         observations: dict[int, Observation] = {}
         heads = {t.track_id: t.position for t in self.targets.values() if t.part == "head" and t.position is not None}
@@ -273,6 +274,7 @@ class Limbs3DTracker:
             use, use_w = points[mine], weights[mine]
             gate = p.dynamics.candidate_gate * (1 + growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
+            self._refind(t, state, a, preds, use, use_w, gate)
             use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
                                                     weights, heads.get(t.track_id))
             est = t.filter.update(use, use_w, gate)
@@ -324,6 +326,31 @@ class Limbs3DTracker:
         est = np.asarray(head, float) + t.home
         t.filter.reset(est, self.params.dynamics.lost_search)
         return est
+
+    def _refind(self, t: _Target, state: LimbState, a: int, preds: np.ndarray, use: np.ndarray, use_w: np.ndarray,
+                gate: float) -> None:
+        """A normal hand with no candidate it may use (``use``, ``use_w``: no other target's
+        prediction nearer, within reach of its head) within ``gate`` of its prediction ``preds[a]``
+        is put (its filter and ``preds[a]``) on the nearest of prior at least ``states.start_prior``
+        within ``dynamics.refind_gate`` that is also nearer to it than to every other target's
+        estimate (a lost one's, where it is held: a tracked hand does not yield to lost ones). A hand
+        leaving a clap at ~140 mm a frame is 300-400 mm from its lagging estimate when next seen
+        from two views (standing seed 3, 2 cameras). With three views or more (``_line_of_sight``)
+        :meth:`_through_own_blob` re-finds hands instead."""
+        d = self.params.dynamics
+        if (d.refind_gate <= gate or self._line_of_sight or t.part == "head" or state != LimbState.NORMAL
+                or not len(use)):
+            return
+        dist = np.linalg.norm(use - preds[a], axis=1)
+        ok = (dist < d.refind_gate) & (use_w >= self.params.states.start_prior)
+        others = [o.position for o in self.targets.values() if o is not t and o.position is not None]
+        if others:  # nearer it than every other target, a lost one where it is held included
+            ok &= dist < np.linalg.norm(use[:, None] - np.array(others)[None], axis=-1).min(axis=1)
+        if (dist < gate).any() or not ok.any():
+            return
+        j = np.flatnonzero(ok)[np.argmin(dist[ok])]
+        t.filter.reset(use[j])
+        preds[a] = use[j]
 
     def _come_alive(self, index: int) -> None:
         """Targets whose init frame is ``index`` get their filter (and their ``home``: an init point
@@ -560,7 +587,32 @@ class Limbs3DTracker:
             use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
         if d.head_own_blobs and t.part == "head" and len(points):
             use &= ~self._borrowed(t, len(points))
+        if (d.hand_own_blobs > 0 and len(self.cameras) <= d.hand_own_blobs_cameras and t.part != "head"
+                and len(points) and mine is not None):
+            use &= ~self._ghost_of_claim(t, points, mine)
         return use
+
+    def _ghost_of_claim(self, t: _Target, points: np.ndarray, mine: np.ndarray) -> np.ndarray:
+        """``(K,)`` whether each candidate shares a blob with the candidate another tracked target of
+        the same person claims (``_claims``) of as many views or more, lies more than ``dynamics.hand_own_blobs``
+        mm from it, and is farther from this hand's prediction (``mine``) than the claimed one is
+        from its claimant's: one blob seen at two places far apart is one target's image, and the
+        pair it makes with this hand's blob of another view a ghost on that blob's line of sight
+        (sec. 6.4)."""
+        members = self.last.get("members") or []
+        out = np.zeros(len(points), bool)
+        if len(members) != len(points):
+            return out
+        views = [len({split_key(k)[0] for k in m}) for m in members]
+        far = self.params.dynamics.hand_own_blobs
+        for _, i, key, d_claim in getattr(self, "_claims", []):
+            if self.targets[key] is t or self.targets[key].track_id != t.track_id:
+                continue
+            for j in range(len(points)):
+                if (j != i and views[j] <= views[i] and members[j] & members[i] and mine[j] > d_claim
+                        and np.linalg.norm(points[j] - points[i]) > far):
+                    out[j] = True
+        return out
 
     def _borrowed(self, t: _Target, n: int) -> np.ndarray:
         """``(n,)`` whether each of the ``n`` merged candidates shares a blob with the candidate
@@ -572,7 +624,7 @@ class Limbs3DTracker:
         if len(members) != n:
             return out
         views = [len({split_key(k)[0] for k in m}) for m in members]
-        for track_id, i in getattr(self, "_claims", []):
+        for track_id, i, *_ in getattr(self, "_claims", []):
             if track_id == t.track_id:
                 continue
             for j in range(n):
