@@ -261,16 +261,17 @@ def small_arm_scene(n=24):
 def test_a_small_hand_sharing_its_forearm_colour_is_kept_and_seen_at_the_arm_end():
     frames, truth = small_arm_scene()
     init = truth[truth.frame == 0]
-    out = run(LimbTracker(P, np.random.default_rng(3), init=init), frames)
+    kept = P.updated({"skin.keep_spread": 50.0})
+    out = run(LimbTracker(kept, np.random.default_rng(3), init=init), frames)
     err, m = centre_error(out, truth)
     hands = m.part.str.endswith("hand")
     assert (m.state[hands] == "normal").all()
     assert err[hands].max() < 5.0
-    # the 14 px boxes are under skin.keep_min_side: not kept, the refit sees none of the hands
-    old = run(LimbTracker(P.updated({"skin.keep_spread": 0.0}), np.random.default_rng(3), init=init), frames)
+    # the 14 px boxes are under skin.keep_min_side: not kept (the default), the refit sees none of the hands
+    old = run(LimbTracker(P, np.random.default_rng(3), init=init), frames)
     assert (old[old.part.str.endswith("hand") & (old.frame >= 10)].state == "lost").all()
     # kept, but seen at their blobs' centres: up the forearms
-    mid = run(LimbTracker(P.updated({"blobs.tip_kept": False}), np.random.default_rng(3), init=init), frames)
+    mid = run(LimbTracker(kept.updated({"blobs.tip_kept": False}), np.random.default_rng(3), init=init), frames)
     err0, m0 = centre_error(mid, truth)
     assert err0[m0.part.str.endswith("hand") & (m0.frame >= 10)].min() > 10.0
 
