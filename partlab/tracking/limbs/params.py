@@ -165,6 +165,12 @@ class LimbBlobs:
     # briefly (one-camera clap seed 3: 49-64 against 30-80; with: 28-62); desk 320x240 seed 2's
     # left hand (kept) mean rate 0.14 with blob centres, 0.95 with ends.
     tip_kept: bool = flag(True)
+    # ... and, while not lost, every small hand of a person one of whose hands was kept: the
+    # kept colour is the person's skin, so their other bare forearm shows too (with keep_spread
+    # 50, held-out handshake 18: person 2's right hand, hidden at the start, was tracked 10-14 px
+    # up its forearm and missed the handshake; with: found). A lost hand keeps blob centres: with
+    # arm ends it took the elbow end of the other forearm (exchange seeds 2, 6 lost).
+    tip_person: bool = flag(True)
     # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
     tip_gate: float = number(1.0)
 
@@ -320,6 +326,7 @@ class LimbParams(Parameters):
         "tip_radius": "blobs.tip_radius",
         "tip_min_side": "blobs.tip_min_side",
         "tip_kept": "blobs.tip_kept",
+        "tip_person": "blobs.tip_person",
         "tip_gate": "blobs.tip_gate",
         "start_prior": "states.start_prior",
         "start_frames": "states.start_frames",

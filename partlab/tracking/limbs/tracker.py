@@ -473,9 +473,18 @@ class LimbTracker:
             return None
         side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
         b = self.params.blobs
-        arm_ends = b.tip_kept and all((self.targets[m].track_id, self.targets[m].part) in self._arm_ends
-                                      for m in members)
+        arm_ends = b.tip_kept and all(self._sees_arm_ends(m) for m in members)
         return side if b.tip_span > 0 and (side >= b.tip_min_side or arm_ends) else None
+
+    def _sees_arm_ends(self, t: int) -> bool:
+        """A small hand sees arm ends where its own init box's colours were kept, or (with
+        ``blobs.tip_person``), while it is not lost, where one of its person's hands' was: the
+        kept colour is the person's skin, so their other bare forearm shows with its hand too."""
+        tgt = self.targets[t]
+        if (tgt.track_id, tgt.part) in self._arm_ends:
+            return True
+        return self.params.blobs.tip_person and self.machine.state(t) != LimbState.LOST and \
+            any(i == tgt.track_id for i, _ in self._arm_ends)
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
