@@ -121,11 +121,11 @@ class LimbSkin:
     # bare forearms (one-camera activity scenes, 720x480) shares its colour with its forearm (the
     # bin's pixels 3-30 times the box's: kept; otherwise lost at frame 4, the refit seeing under
     # 5% of it), not with the floor or the sleeve at its edge (600-9000 times: not kept, or the
-    # floor turned skin). At 50 (with blobs.tip_kept), activity scenes seeds 0-9: clap recall
-    # 0.80 -> 0.90, exchange 0.50 -> 0.70, handshake 0.90 -> 1.00; but held-out seeds 10-19:
-    # handshake 0.64 / 0.70 -> 0.50 / 0.60 (the kept colour turns the same person's other,
-    # not-kept forearm into skin: that hand is seen mid-forearm, or a lost hand finds it), and
-    # desk 320x240 (12 seeds) left hand mean rate 0.890 -> 0.968, right 0.819 -> 0.806; so off.
+    # floor turned skin). At 50 (with blobs.tip_kept, tip_person), activity scenes seeds 0-9:
+    # clap recall 0.80 -> 0.90, exchange 0.50 -> 0.60, handshake 0.90 -> 1.00, none worse; but
+    # held-out seeds 10-19 lose precision (clap 1.00 -> 0.91, place 0.90 -> 0.75, exchange 1.00
+    # -> 0.86; every recall the same or better), and desk 320x240 (12 seeds) left hand mean rate
+    # 0.890 -> 0.968, right 0.819 -> 0.806; so off.
     keep_spread: float = number(0.0)
     # keep the colours of init boxes the init table marks hidden (occluded >= 0.5)? A hand
     # behind its body has a box of clothes (the exchange scenes' far hands: the shirt's bins
