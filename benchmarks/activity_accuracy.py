@@ -17,7 +17,7 @@ tracker's (what the recognition gets right when the hands are right); ``--hands 
 which separates the recognition's errors from the hand tracker's.
 
     python benchmarks/activity_accuracy.py [--seeds 0-9] [--size 720x480] [--frames 150] [--hands tracked|truth|both]
-                                           [--cameras 3] [--set GROUP.NAME=VALUE ...]
+                                           [--cameras 3] [--set GROUP.NAME=VALUE ...] [--dump DIR]
 """
 
 from __future__ import annotations
@@ -26,6 +26,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -113,19 +114,42 @@ def _value(default, text: str):
     return type(default)(float(text))
 
 
+def one_camera_model(changes: dict | None) -> SimpleNamespace | None:
+    """The limb tracker's and the recognition's parameters with ``changes`` (``{"group.field":
+    value}``, each read as a limb parameter where ``limbs`` has that group, else as an
+    activities one), as a model :func:`build_tracker` reads; None without changes."""
+    if not changes:
+        return None
+    params = {k: model_params(None, k) for k in ("limbs", "activities")}
+    for dotted, text in changes.items():
+        key = "limbs" if hasattr(params["limbs"], dotted.partition(".")[0]) else "activities"
+        params[key] = params[key].updated({dotted: _value(params[key].get(dotted), text)})
+    return SimpleNamespace(params=params)
+
+
 def run_one(name: str, seed: int, frames: int, width: int, height: int,
-            hands: str = "tracked") -> tuple[pd.DataFrame, pd.DataFrame, float]:
+            hands: str = "tracked", changes: dict | None = None,
+            dump: Path | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
     scene = make_scene(name, seed=seed, n_frames=frames, width=width, height=height)
+    model = one_camera_model(changes)
     if hands == "truth":
         from partlab.tracking.activities import with_activities
 
-        tracker = with_activities(TruthHands(scene.truth), model_params(None, "activities"))
+        tracker = with_activities(TruthHands(scene.truth), model_params(model, "activities"))
     else:
-        tracker = build_tracker("limbs", seed=seed, context=TrackContext(init=scene.init, fps=scene.fps))
+        tracker = build_tracker("limbs", model=model, seed=seed,
+                                context=TrackContext(init=scene.init, fps=scene.fps))
     body = model_params(None, "body")
     t0 = time.perf_counter()
-    run_frames(tracker, (FrameSet.single(i, f) for i, f in enumerate(scene.frames)), lambda s: BackgroundModel(body))
-    return scene.events, tracker.events, (time.perf_counter() - t0) / frames
+    out = run_frames(tracker, (FrameSet.single(i, f) for i, f in enumerate(scene.frames)),
+                     lambda s: BackgroundModel(body))
+    spf = (time.perf_counter() - t0) / frames
+    if dump is not None:  # tracks, truth and events of the scene, to trace an event by hand
+        dump.mkdir(parents=True, exist_ok=True)
+        out.to_csv(dump / f"{name}_{seed}_{hands}_tracks.csv", index=False)
+        scene.truth.to_csv(dump / f"{name}_{seed}_truth.csv", index=False)
+        tracker.events.to_csv(dump / f"{name}_{seed}_{hands}_events.csv", index=False)
+    return scene.events, tracker.events, spf
 
 
 def handshakes_called_exchanges(truth: pd.DataFrame, pred: pd.DataFrame) -> int:
@@ -168,8 +192,11 @@ def main() -> int:
     ap.add_argument("--hands", choices=("tracked", "truth", "both"), default="tracked",
                     help="the hands the recognition reads: the limb tracker's, the scene's truth, or both runs")
     ap.add_argument("--set", nargs="*", default=[], metavar="GROUP.NAME=VALUE",
-                    help="limbs3d parameters other than the defaults (multi-camera takes; e.g. "
-                         "dynamics.line_of_sight=0)")
+                    help="parameters other than the defaults: limbs3d's (multi-camera takes; e.g. "
+                         "dynamics.line_of_sight=0), or on one camera the limb tracker's or the "
+                         "recognition's (e.g. skin.keep_min_side=12)")
+    ap.add_argument("--dump", type=Path, default=None,
+                    help="one camera: write each scene's tracks, truth and events here as CSV")
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
     for hands in (("tracked", "truth") if args.hands == "both" else (args.hands,)):
@@ -183,7 +210,8 @@ def report(args, w: int, h: int, hands: str) -> None:
     for seed in _seeds(args.seeds):  # seed by seed, so that a run cut short covers every scene
         for name in SCENES if args.cameras == 1 else SCENES_3D:
             if args.cameras == 1:
-                truth, pred, s = run_one(name, seed, args.frames, w, h, hands)
+                truth, pred, s = run_one(name, seed, args.frames, w, h, hands,
+                                         dict(a.split("=", 1) for a in args.set), args.dump)
             else:
                 truth, pred, s = run_take(name, seed, args.frames, args.cameras, hands,
                                           dict(a.split("=", 1) for a in args.set))

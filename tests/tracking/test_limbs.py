@@ -237,6 +237,45 @@ def test_a_hand_on_its_forearm_is_tracked_at_the_arm_end_not_the_blob_centre():
     assert err0[m0.part.str.endswith("hand")].max() > 10.0
 
 
+def small_arm_scene(n=24):
+    """Bare forearms, 14 px hands: the person's hands (radius 7) end forearms of their own skin
+    colour 60 px long; the head is another skin tone. The refit sees the hands' colour mostly on
+    the forearms, outside every box (the one-camera activity scenes' standing people)."""
+    face = (80, 120, 180)
+    frames, rows = [], []
+    for t in range(n):
+        f = np.full((200, 260, 3), BG, np.uint8)
+        cv2.rectangle(f, (105, 50), (155, 185), SHIRT, -1)
+        head, lh, rh = (130, 32), (172, 160), (int(88 - t), 160)
+        cv2.circle(f, head, 16, face, -1)
+        for el, hand in (((96, 95), rh), ((164, 95), lh)):
+            cv2.line(f, el, hand, SKIN, 12)
+            cv2.circle(f, hand, 7, SKIN, -1)
+        frames.append(f)
+        rows += [(t, 7, "head", head[0] - 16, head[1] - 16, 32, 32),
+                 (t, 7, "left_hand", lh[0] - 7, lh[1] - 7, 14, 14),
+                 (t, 7, "right_hand", rh[0] - 7, rh[1] - 7, 14, 14)]
+    return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def test_a_small_hand_sharing_its_forearm_colour_is_kept_and_seen_at_the_arm_end():
+    frames, truth = small_arm_scene()
+    init = truth[truth.frame == 0]
+    kept = P.updated({"skin.keep_spread": 50.0})
+    out = run(LimbTracker(kept, np.random.default_rng(3), init=init), frames)
+    err, m = centre_error(out, truth)
+    hands = m.part.str.endswith("hand")
+    assert (m.state[hands] == "normal").all()
+    assert err[hands].max() < 5.0
+    # the 14 px boxes are under skin.keep_min_side: not kept (the default), the refit sees none of the hands
+    old = run(LimbTracker(P, np.random.default_rng(3), init=init), frames)
+    assert (old[old.part.str.endswith("hand") & (old.frame >= 10)].state == "lost").all()
+    # kept, but seen at their blobs' centres: up the forearms
+    mid = run(LimbTracker(kept.updated({"blobs.tip_kept": False}), np.random.default_rng(3), init=init), frames)
+    err0, m0 = centre_error(mid, truth)
+    assert err0[m0.part.str.endswith("hand") & (m0.frame >= 10)].min() > 10.0
+
+
 def test_a_clapping_pair_does_not_split_onto_the_blob_where_a_lost_hand_is_looked_for():
     # another person's hand 25 px below where the clapping hands meet, hidden until frame 24 (its
     # filter is lost from frame ~5 and looks for it where it started): when it shows, the pair's

@@ -120,6 +120,34 @@ def test_keep_mass_keeps_a_box_colour_that_fills_more_of_the_frame_elsewhere():
         train_skin_model([f], box, bins=32, keep_mass=1.5)
 
 
+def test_keep_spread_keeps_a_small_hand_sharing_its_forearm_colour_but_not_the_floors():
+    # one camera, 15 px hands of people standing with bare forearms (the synthetic exchange and
+    # clap scenes at 720x480): the forearm shares the hand's colour, so the plain ratio sees
+    # none of the hand; the box is under keep_min_side (17), so it used not to be kept and the
+    # hand was lost at frame 4. Its colour is ~6 box areas in the frame (hand and forearm):
+    # kept. Another small hand of a colour the floor has too (~300 box areas): not kept.
+    hand, floor_hand, bg, shirt = SKIN_BGR[0], SKIN_BGR[2], (90, 110, 70), SKIN_BGR[3]
+    f = np.full((240, 320, 3), bg, np.uint8)
+    f[:120, 200:] = floor_hand  # the floor: 120 x 120 px of the second hand's colour
+    f[40:100, 20:35] = hand  # a bare forearm, 15 x 60
+    cv2.ellipse(f, (27, 107), (7, 7), 0, 0, 360, hand, -1)  # its hand below it
+    cv2.ellipse(f, (127, 107), (7, 7), 0, 0, 360, floor_hand, -1)  # the other hand
+    f[20:80, 120:135] = shirt  # a brown sleeve, behind which a hidden hand's box lies
+    boxes = [np.array([[20, 100, 15, 15], [120, 100, 15, 15], [120, 45, 15, 15]], float)]
+    args = dict(bins=32, keep_mass=0.8, keep_recall=0.1, keep_min_side=17, prior=SkinModel.default(32, blur=1))
+    before = train_skin_model([f], boxes, **args)
+    kept: list[bool] = []
+    after = train_skin_model([f], boxes, keep_spread=50, kept=kept, keepable=[True, True, False], **args)
+    assert before.probability(_px(hand))[0, 0] < 0.5  # the hand unseen: lost at frame 4
+    assert after.probability(_px(hand))[0, 0] == 1.0
+    assert after.probability(_px(floor_hand))[0, 0] < 0.5  # the floor stays no skin
+    assert after.probability(_px(shirt))[0, 0] < 0.5  # a hidden hand's box is never kept
+    assert kept == [True, False, False]
+    # every box kept may keep the sleeve: the hidden box's bins would have been kept
+    every = train_skin_model([f], boxes, keep_spread=50, **args)
+    assert every.probability(_px(shirt))[0, 0] == 1.0
+
+
 def test_find_blobs_region_by_region_equals_the_whole_mask():
     from partlab.tracking.limbs.people import merge_boxes
 

@@ -148,7 +148,9 @@ def _check_frame(frame: np.ndarray) -> np.ndarray:
 
 def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinModel | None = None,
                      prior_weight: float = 20.0, inner: float = 1.0, keep_mass: float = 0.0,
-                     keep_recall: float = 0.5, threshold: float = 0.5, keep_min_side: float = 0.0) -> SkinModel:
+                     keep_recall: float = 0.5, threshold: float = 0.5, keep_min_side: float = 0.0,
+                     keep_spread: float = 0.0, kept: list[bool] | None = None,
+                     keepable: list[bool] | None = None) -> SkinModel:
     """Fit P(skin | Y, Cr, Cb) from corrected head/hand boxes (the prior's blur is kept).
 
     ``frames``: BGR frames; ``boxes``: for each frame a ``(K, 4)`` array of ``x, y, w, h``
@@ -170,6 +172,18 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
     sees keep the ratio's answer. Boxes with a side under ``keep_min_side`` pixels are not
     kept: a distant walker's 8-pixel hand is mostly edge pixels blurred with the background,
     whose bins would turn the floor into skin.
+
+    ``keep_spread`` (0: off): ... but then only those of their bins with at least
+    ``1 / keep_spread`` of the bin's pixels in the frames inside the box: a hand's own colour,
+    shared with its bare forearm (a bin's pixels 3-30 times the box's), not the floor's, a
+    wall's or the sleeve's at the box's edge (hundreds to thousands of times): a small box is
+    kept by what its own colours are in the frame, not refused for its size.
+
+    ``kept``: a list that receives, for every box with both sides at least 2 pixels (frame by
+    frame, in order), whether its bins were kept (a box whose colour is shared by what is around
+    it, such as its bare forearm). ``keepable``: for the same boxes, whether each may be kept
+    at all (default: all); a box that is a skin sample but not kept is, say, a hand its user
+    marked hidden behind the body, whose box shows clothes.
     """
     if not 0.0 <= keep_mass <= 1.0:
         raise ValueError(f"keep_mass must be in [0, 1], got {keep_mass}")
@@ -178,7 +192,7 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
         raise ValueError(f"prior has {prior.bins} bins, expected {bins}")
     skin = np.zeros((ybins, bins, bins), np.float64)
     total = np.zeros((ybins, bins, bins), np.float64)
-    box_hists: list[np.ndarray] = []
+    box_hists: list[tuple[np.ndarray, bool] | None] = []  # (histogram, small: kept only by the spread test)
     n_frames = 0
     hist_args = ([0, 1, 2], [ybins, bins, bins], [0, 256, 0, 256, 0, 256])
     for frame, fboxes in zip(frames, boxes):
@@ -193,8 +207,10 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
             cv2.ellipse(one, (int(round(x + w / 2)), int(round(y + h / 2))),
                         (max(int(inner * w / 2), 1), max(int(inner * h / 2), 1)), 0, 0, 360, 255, -1)
             mask |= one
-            if keep_mass > 0 and min(w, h) >= keep_min_side:
-                box_hists.append(cv2.calcHist([ycrcb], hist_args[0], one, *hist_args[1:]).ravel())
+            small = min(w, h) < keep_min_side
+            may_keep = keepable is None or bool(keepable[len(box_hists)])
+            box_hists.append((cv2.calcHist([ycrcb], hist_args[0], one, *hist_args[1:]).ravel(), small)
+                             if may_keep and keep_mass > 0 and (not small or keep_spread > 0) else None)
         skin += cv2.calcHist([ycrcb], hist_args[0], mask, *hist_args[1:])
     if n_frames == 0:
         raise ValueError("train_skin_model needs at least one frame")
@@ -202,12 +218,25 @@ def train_skin_model(frames, boxes, bins: int = 32, ybins: int = 8, prior: SkinM
         raise ValueError("no skin pixels inside the given boxes")
     table = (skin + prior_weight * prior.table) / (total + prior_weight)
     keep = np.zeros(table.size, bool)
-    for hist in box_hists:
-        if hist.sum() == 0 or hist[table.ravel() >= threshold].sum() >= keep_recall * hist.sum():
+    seen = table.ravel() >= threshold
+    for item in box_hists:
+        if kept is not None:
+            kept.append(False)
+        if item is None:
+            continue
+        hist, small = item
+        if hist.sum() == 0 or hist[seen].sum() >= keep_recall * hist.sum():
             continue
         order = np.argsort(-hist, kind="stable")
         n = int(np.searchsorted(np.cumsum(hist[order]), keep_mass * hist.sum())) + 1
-        keep[order[:n]] = True
+        bins_kept = order[:n]
+        if small:  # only the bins the box holds a share of: its own colour, not the floor's
+            bins_kept = bins_kept[total.ravel()[bins_kept] <= keep_spread * hist[bins_kept]]
+            if not (~seen[bins_kept]).any():
+                continue
+        keep[bins_kept] = True
+        if kept is not None:
+            kept[-1] = True
     table = np.where(keep.reshape(table.shape), np.maximum(table, prior.table), table)
     return SkinModel(np.clip(table, 0.0, 1.0).astype(np.float32), prior.blur)
 

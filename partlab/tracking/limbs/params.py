@@ -116,6 +116,22 @@ class LimbSkin:
     # pixels of their own (walker left hand 0.75 at frame 105 with them kept, 1.00 without), and
     # at 320x240 (desk hands 13-16 px) it went with blobs.tip_min_side.
     keep_min_side: float = number(17.0)
+    # ... and, for smaller boxes, the colour bins holding at least 1/keep_spread of the bin's
+    # pixels in the frame (0: none kept, the default): a 14-15 px hand of a person standing with
+    # bare forearms (one-camera activity scenes, 720x480) shares its colour with its forearm (the
+    # bin's pixels 3-30 times the box's: kept; otherwise lost at frame 4, the refit seeing under
+    # 5% of it), not with the floor or the sleeve at its edge (600-9000 times: not kept, or the
+    # floor turned skin). At 50 (with blobs.tip_kept, tip_person), activity scenes seeds 0-9:
+    # clap recall 0.80 -> 0.90, exchange 0.50 -> 0.60, handshake 0.90 -> 1.00, none worse; but
+    # held-out seeds 10-19 lose precision (clap 1.00 -> 0.91, place 0.90 -> 0.75, exchange 1.00
+    # -> 0.86; every recall the same or better), and desk 320x240 (12 seeds) left hand mean rate
+    # 0.890 -> 0.968, right 0.819 -> 0.806; so off.
+    keep_spread: float = number(0.0)
+    # keep the colours of init boxes the init table marks hidden (occluded >= 0.5)? A hand
+    # behind its body has a box of clothes (the exchange scenes' far hands: the shirt's bins
+    # pass keep_spread). They stay skin samples: left out altogether, the walker's hidden left
+    # hand's box cost seed 3's hands (left mean rate 0.517 -> 0.416).
+    keep_hidden: bool = flag(False)
     # opening kernel (pixels) applied to the skin mask before blobs; 1 = none
     open: int = number(3, POSITIVE_COUNT)
 
@@ -143,6 +159,18 @@ class LimbBlobs:
     # support box around it, whose corners become "ends" (desk seed 7 lost both hands; at 14 px
     # the 12-seed 320x240 rates stayed 0.92 / 0.75, other seeds failing).
     tip_min_side: float = number(17.0)
+    # ... and smaller hands whose init box's colours the skin refit had to keep
+    # (skin.keep_spread): their colour is their bare forearm's, so their blob is hand and
+    # forearm and the hand its end. Without: a clap's kept hands sat mid-forearm and met too
+    # briefly (one-camera clap seed 3: 49-64 against 30-80; with: 28-62); desk 320x240 seed 2's
+    # left hand (kept) mean rate 0.14 with blob centres, 0.95 with ends.
+    tip_kept: bool = flag(True)
+    # ... and, while not lost, every small hand of a person one of whose hands was kept: the
+    # kept colour is the person's skin, so their other bare forearm shows too (with keep_spread
+    # 50, held-out handshake 18: person 2's right hand, hidden at the start, was tracked 10-14 px
+    # up its forearm and missed the handshake; with: found). A lost hand keeps blob centres: with
+    # arm ends it took the elbow end of the other forearm (exchange seeds 2, 6 lost).
+    tip_person: bool = flag(True)
     # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
     tip_gate: float = number(1.0)
 
@@ -287,6 +315,8 @@ class LimbParams(Parameters):
         "skin_keep_mass": "skin.keep_mass",
         "skin_keep_recall": "skin.keep_recall",
         "skin_keep_min_side": "skin.keep_min_side",
+        "skin_keep_spread": "skin.keep_spread",
+        "skin_keep_hidden": "skin.keep_hidden",
         "skin_open": "skin.open",
         "blob_alpha": "blobs.alpha",
         "min_blob_area": "blobs.min_area",
@@ -295,6 +325,8 @@ class LimbParams(Parameters):
         "tip_far": "blobs.tip_far",
         "tip_radius": "blobs.tip_radius",
         "tip_min_side": "blobs.tip_min_side",
+        "tip_kept": "blobs.tip_kept",
+        "tip_person": "blobs.tip_person",
         "tip_gate": "blobs.tip_gate",
         "start_prior": "states.start_prior",
         "start_frames": "states.start_frames",

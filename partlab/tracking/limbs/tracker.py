@@ -208,6 +208,8 @@ class LimbTracker:
         self.people_from = "foreground"
         self._ended: dict[int, _Target] = {}  # trackers ended off people (their events still name them)
         rows = None if init is None else normalise_tracks(init)
+        self._hidden_init: set[tuple[int, str]] = set()  # init boxes the table marks occluded
+        self._arm_ends: set[tuple[int, str]] = set()  # small hands that see arm ends (blobs.tip_kept)
         if rows is not None:
             self._next_person = int(rows["track_id"].max()) + 1 if len(rows) else 0
             rows = rows[rows["part"].isin(LIMB_PARTS)]
@@ -219,6 +221,9 @@ class LimbTracker:
             for r in first.itertuples(index=False):
                 self._init.setdefault(int(r.frame), []).append(
                     (int(r.track_id), str(r.part), np.array([r.x, r.y, r.w, r.h], float)))
+                hidden = float(getattr(r, "occluded", 0.0) or 0.0)
+                if hidden == hidden and hidden >= 0.5:  # NaN: not said
+                    self._hidden_init.add((int(r.track_id), str(r.part)))
 
     # -- public ----------------------------------------------------------------------------
     def set_people(self, boxes) -> None:
@@ -290,10 +295,19 @@ class LimbTracker:
             # the given boxes show these people's skin against this scene: a Bayes skin model
             # (skin.train_skin_model) rejects skin-coloured wood, floors and walls that the rule
             # accepts, because their colours fill far more of the frame than the boxes.
+            # a box the init table marks hidden (occluded >= 0.5: a hand behind its body) shows
+            # clothes: its colours are never kept (skin.keep_hidden)
+            keepable = [p.skin.keep_hidden or s[:2] not in self._hidden_init for s in starting]
+            kept: list[bool] = []
             self.skin = train_skin_model([frame], [np.array([b for _, _, b in starting])],
                                          bins=self.skin.bins, ybins=p.skin.ybins, prior=self.skin,
                                          keep_mass=p.skin.keep_mass, keep_recall=p.skin.keep_recall,
-                                         threshold=p.skin.threshold, keep_min_side=p.skin.keep_min_side)
+                                         threshold=p.skin.threshold, keep_min_side=p.skin.keep_min_side,
+                                         keep_spread=p.skin.keep_spread, kept=kept, keepable=keepable)
+            # a small hand whose colours had to be kept shares them with its bare forearm: its
+            # blob is hand and forearm, and the hand is its end (blobs.tip_kept)
+            self._arm_ends |= {(t, part) for (t, part, b), k in zip(starting, kept)
+                               if k and part != "head" and min(b[2], b[3]) < p.blobs.tip_min_side}
         people = self._people(foreground, frame.shape[:2])
         fg = None if foreground is None else self._support(np.asarray(foreground) > 0, index)
         rois = None if people is None else merge_boxes(np.vstack([people, self._support_boxes(index)]),
@@ -458,7 +472,19 @@ class LimbTracker:
         if any(self.targets[m].part not in hands for m in members):
             return None
         side = float(round(np.mean([sum(self.targets[m].size) / 2 for m in members])))
-        return side if self.params.blobs.tip_span > 0 and side >= self.params.blobs.tip_min_side else None
+        b = self.params.blobs
+        arm_ends = b.tip_kept and all(self._sees_arm_ends(m) for m in members)
+        return side if b.tip_span > 0 and (side >= b.tip_min_side or arm_ends) else None
+
+    def _sees_arm_ends(self, t: int) -> bool:
+        """A small hand sees arm ends where its own init box's colours were kept, or (with
+        ``blobs.tip_person``), while it is not lost, where one of its person's hands' was: the
+        kept colour is the person's skin, so their other bare forearm shows with its hand too."""
+        tgt = self.targets[t]
+        if (tgt.track_id, tgt.part) in self._arm_ends:
+            return True
+        return self.params.blobs.tip_person and self.machine.state(t) != LimbState.LOST and \
+            any(i == tgt.track_id for i, _ in self._arm_ends)
 
     def _head_of(self, t: int) -> np.ndarray | None:
         """Current estimate of the head of tracker ``t``'s person (None if no tracked head)."""
