@@ -498,6 +498,14 @@ class BodyDetector:
     # stop to talk), the detection goes on matching the wrong track by overlap and no duplicate
     # ever forms. False: only free detections are re-acquired.
     reacquire_claims: bool = flag(True)
+    # A yielding track (``lost_yields``), or one whose torso probe has just ended that loss in this
+    # frame, touching a track measured in this frame is the one behind (sec. 4.3.1), whatever the
+    # scores: it is not measured, its scores are those of its last measured frame, on the person
+    # it was sent off. Without it those stale scores, higher than those of the track that has just
+    # claimed its person back, put that one behind: it coasts off its person on its old velocity,
+    # and the yielding track keeps that person (PETS09 seed 1, frames 42-43). A track lost for
+    # other reasons is judged by its scores as before. False: the scores decide as for any two.
+    yielding_behind: bool = flag(True)
     # Automatic mode: a track no detection has matched for ``undetected_frames`` frames ends (a ghost
     # of the background model, a shadow). 0: never for this reason (foreground support still ends
     # tracks).
