@@ -702,7 +702,7 @@ class BodyTracker:
                 sa = min(a.scores.get(n, 1.0) for n in touching_a)
                 sb = min(b.scores.get(n, 1.0) for n in touching_b)
                 stale = self._yields_to(a, b), self._yields_to(b, a)
-                if stale[0] != stale[1]:  # a yielding track's scores are stale: it is the one behind
+                if stale[0] != stale[1]:  # a just released track's scores are stale: it is the one behind
                     behind, front = (a, b) if stale[0] else (b, a)
                 elif abs(sa - sb) < p.occlusion.margin:
                     continue
@@ -718,11 +718,10 @@ class BodyTracker:
                     f.coast()
 
     def _yields_to(self, a: Person, b: Person) -> bool:
-        """``detector.yielding_behind``: ``a`` yields (``lost_yields``; or its probe has just ended
-        that loss, unmeasured) and ``b`` is measured this frame."""
+        """``detector.released_behind``: ``a``'s probe has just ended its yielding loss (it was not
+        measured) and ``b`` is measured this frame."""
         d = self.params.detector
-        return (d.yielding_behind and d.lost_yields and (a.yielding or a.released)
-                and b.lost_since is None and bool(b.observed))
+        return d.released_behind and d.lost_yields and a.released and b.lost_since is None and bool(b.observed)
 
     def _touching(self, boxes_a: dict[str, Box], boxes_b: dict[str, Box]) -> tuple[set, set]:
         """Parts of two persons that overlap by more than ``occlusion_overlap`` of the smaller."""
