@@ -391,6 +391,44 @@ def test_a_person_is_put_behind_another_only_when_their_similarities_differ_beyo
     assert behind[0.02, 0.80] == behind["default", 0.80] == (None, 1)
 
 
+def test_a_track_just_released_from_yielding_is_behind_the_measured_track_it_touches():
+    """``detector.released_behind``: track 2 went lost on track 1's person (the first models said
+    so, ``lost_yields``) and its torso probe has just ended that loss; its scores (0.99) are those
+    of its last measured frame, track 1's (0.86) of this frame, just after it claimed its person
+    back. Without the option the stale scores put track 1 behind track 2 (PETS09 seed 1, frame 43:
+    track 1 then coasts off its person and track 2 keeps it); with it track 2 is the one behind.
+    A track still lost (yielding or not) is judged by its scores either way."""
+    from partlab.tracking.core.histogram import to_ycc as ycc_of
+
+    frame = np.full((H, W, 3), 90, np.uint8)
+    frame[50:160, 100:130] = (40, 40, 160)
+    frame[50:160, 112:142] = (40, 140, 40)
+    ycc = ycc_of(frame)
+    behind = {}
+    for on in (True, False):
+        params = BodyParams().updated({"detector.released_behind": on})
+        for state in ("released", "yielding", "lost"):
+            t = BodyTracker(params, np.random.default_rng(0), init=[])
+            a = t.start_track(1, {"person": Box(100, 50, 30, 110)}, ycc, None, 0)
+            b = t.start_track(2, {"person": Box(112, 50, 30, 110)}, ycc, None, 0)
+            for person, score in ((a, 0.86), (b, 0.99)):
+                person.scores = {n: score for n in person.filters}
+                person.prev = {n: f.state.copy() for n, f in person.filters.items()}
+            a.observed = {n: None for n in a.filters}  # track 1 measured this frame, track 2 not
+            if state == "released":
+                b.yields_from, b.released = 40, True
+            elif state == "yielding":
+                b.lost_since = b.yields_from = 40
+            else:
+                b.lost_since = 40
+            t._resolve_inter_person_occlusion([a, b])
+            behind[on, state] = (a.occluded_by, b.occluded_by)
+    assert behind[True, "released"] == (None, 1)
+    assert behind[False, "released"] == (2, None)
+    for state in ("yielding", "lost"):
+        assert behind[True, state] == behind[False, state] == (2, None)
+
+
 def test_a_track_started_standing_takes_its_walkers_speed_and_does_not_lag_onto_the_one_behind():
     """``dynamics.start_velocity_frames``: two walkers in the same coat start overlapping, the front
     one (track 2) walking left at 5 px a frame, the one behind at 2 (PETS09 persons 3 and 4 at frame

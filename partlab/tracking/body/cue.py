@@ -364,6 +364,8 @@ class DetectionCue:
             matches.append((j, det, best))
         kept = []
         for j, det, tid in matches:
+            if tid not in t.dormant:
+                continue  # revived at another detection of this scan
             before = [c for c in self.reid_candidates if c.track_id == tid and c.last_scan == self.scans - 1]
             near = associate_near(np.array([c.box.as_tuple() for c in before]).reshape(-1, 4),
                                   np.array([det.as_tuple()]), self.p.confirm_distance)

@@ -134,6 +134,7 @@ class Person:
     steps: deque = field(default_factory=lambda: deque(maxlen=3))  # torso displacements of its first measured frames
     learns_from: int = 0  # frame its velocity started from zero (its start; a re-acquisition standing)
     yields_from: int | None = None  # frame it went lost on someone else's person (``detector.lost_yields``)
+    released: bool = False  # its torso probe ended a yielding loss this frame (not measured)
 
     @property
     def yielding(self) -> bool:
@@ -429,6 +430,7 @@ class BodyTracker:
         # predict every part; decide who is hidden; measure the others
         for person in active:
             person.observed.clear()
+            person.released = False
             person.prev = {n: f.state.copy() for n, f in person.filters.items()}
             person.failed = ()
             person.adjusted = False
@@ -644,6 +646,7 @@ class BodyTracker:
             return  # that is someone else's person (the exclusion principle)
         for g in person.filters.values():
             g.shift(delta)
+        person.released = person.yielding
         person.lost_since = None
         person.unsupported = 0
 
@@ -698,9 +701,13 @@ class BodyTracker:
                 a.touching = b.touching = True
                 sa = min(a.scores.get(n, 1.0) for n in touching_a)
                 sb = min(b.scores.get(n, 1.0) for n in touching_b)
-                if abs(sa - sb) < p.occlusion.margin:
+                stale = self._yields_to(a, b), self._yields_to(b, a)
+                if stale[0] != stale[1]:  # a just released track's scores are stale: it is the one behind
+                    behind, front = (a, b) if stale[0] else (b, a)
+                elif abs(sa - sb) < p.occlusion.margin:
                     continue
-                behind, front = (a, b) if sa < sb else (b, a)
+                else:
+                    behind, front = (a, b) if sa < sb else (b, a)
                 behind.occluded_by = front.track_id
                 behind.observed.clear()
                 v = behind.velocity()
@@ -709,6 +716,12 @@ class BodyTracker:
                     if v is not None:
                         f.set_velocity(v)
                     f.coast()
+
+    def _yields_to(self, a: Person, b: Person) -> bool:
+        """``detector.released_behind``: ``a``'s probe has just ended its yielding loss (it was not
+        measured) and ``b`` is measured this frame."""
+        d = self.params.detector
+        return d.released_behind and d.lost_yields and a.released and b.lost_since is None and bool(b.observed)
 
     def _touching(self, boxes_a: dict[str, Box], boxes_b: dict[str, Box]) -> tuple[set, set]:
         """Parts of two persons that overlap by more than ``occlusion_overlap`` of the smaller."""
