@@ -197,16 +197,55 @@ def test_still_moments_and_contacts_from_tracks():
 
 def test_3d_touches_come_from_whichever_view_saw_each_hand():
     # two people's right hands 60 mm apart over frames 10-19 (else 600 mm); view cam0 sees hand 1
-    # only, cam1 sees hand 2 only: in 3D they touch although no view shows both
+    # only, cam1 sees hand 2 only: in 3D they touch although no view shows both (hand 2 leaves at
+    # 190 mm a frame: a faster jump is a tracker's, ``decision.stay_jump``)
     rows = []
     for f in range(30):
-        gap = 60.0 if 10 <= f <= 19 else 600.0
+        gap = 60.0 if 10 <= f <= 19 else min(600.0, 60.0 + 190.0 * (f - 19)) if f > 19 else 600.0
         rows.append(dict(frame=f, track_id=1, part="right_hand", x=100, y=100, w=10, h=10, camera="cam0",
                          X=0.0, Y=0.0, Z=1000.0))
         rows.append(dict(frame=f, track_id=2, part="right_hand", x=300, y=100, w=10, h=10, camera="cam1",
                          X=gap, Y=0.0, Z=1000.0))
     found = contacts(pd.DataFrame(rows), P)
     assert found[["start_frame", "end_frame", "kind"]].values.tolist() == [[10, 19, "handshake"]]
+
+
+def test_a_3d_touch_is_read_from_the_hand_that_stayed_when_the_other_jumps_off_or_is_lost():
+    # limbs3d, 3-camera handshake seed 2 (mm): the two right hands meet at (15, 15, 1060) at 31;
+    # the tracker splits them wrongly at 32, throwing person 2's 300 mm off in a frame, while
+    # person 1's stays at the meeting until 50 and then leaves (truth 27-48). Then a handover
+    # (seed 3): the hands 128 mm apart from 76, the taker's lost from 80, the giver's held out
+    # where it was until 89 (truth 75-87)
+    def row(f, t, part, xyz):
+        return dict(frame=f, track_id=t, part=part, x=100 * t, y=100, w=10, h=10, camera="cam0",
+                    X=xyz[0], Y=xyz[1], Z=xyz[2])
+
+    rows = []
+    for f in range(20, 70):
+        p1 = (15.0, 15.0, 1060.0) if 31 <= f <= 50 else (15.0 + 80 * (f - 50), 15.0, 1060.0) if f > 50 \
+            else (15.0 - 60 * (31 - f), 15.0 - 40 * (31 - f), 1060.0)
+        p2 = (15.0, 18.0, 1058.0) if f == 31 else (276.0, 121.0, 1145.0) if f > 31 \
+            else (15.0 + 60 * (31 - f), 18.0 + 40 * (31 - f), 1058.0)
+        rows += [row(f, 1, "right_hand", p1), row(f, 2, "right_hand", p2)]
+    for f in range(70, 100):
+        give = (102.0, 196.0, 1034.0) if 76 <= f <= 89 else (102.0 - 80 * (f - 89), 196.0, 1034.0) if f > 89 \
+            else (102.0 - 60 * (76 - f), 196.0, 1034.0)
+        rows.append(row(f, 1, "left_hand", give))
+        if f < 80:
+            take = (200.0, 230.0, 960.0) if f >= 76 else (200.0 + 60 * (76 - f), 230.0, 960.0)
+            rows.append(row(f, 2, "right_hand", take))
+    tracks = pd.DataFrame(rows)
+    found = contacts(tracks, P)
+    spans = sorted(found[["start_frame", "end_frame", "kind"]].values.tolist())
+    assert spans == [[31, 50, "handshake"], [76, 89, "handshake"]]
+    assert temporal_iou((31, 50), (27, 48)) >= 0.5 and temporal_iou((76, 89), (75, 87)) >= 0.5
+    off = contacts(tracks, replace(P, decision=replace(P.decision, stayed_hand=False)))
+    assert sorted(off[["start_frame", "end_frame"]].values.tolist()) == [[31, 31], [76, 79]]
+    assert temporal_iou((76, 79), (75, 87)) < 0.5
+    # the same tracks seen from one camera (no X, Y, Z): unchanged
+    flat = contacts(tracks.drop(columns=["X", "Y", "Z"]).assign(camera=""), P)
+    assert flat.equals(contacts(tracks.drop(columns=["X", "Y", "Z"]).assign(camera=""),
+                                replace(P, decision=replace(P.decision, stayed_hand=False))))
 
 
 def test_what_one_view_shows_all_along_is_told_from_what_every_view_lost():

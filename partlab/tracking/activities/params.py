@@ -122,6 +122,16 @@ class Decision:
     # hysteresis: a touch lasts until the hands are this many times the touching distance apart
     # (a clap's hands part a little between the beats; a shaking pair's boxes jitter)
     release_ratio: float = number(1.4, POSITIVE)
+    # with 3D positions (a multi-camera tracker), while one of two touching hands is unseen, or
+    # its estimate jumped away faster than a hand moves (more than ``stay_jump`` times
+    # ``contact_mm`` in one frame), the touch is read from the other hand: it lasts while that
+    # hand stays within its reach (``contact_mm`` / 2) of where it was at the last frame both
+    # touched. limbs3d's false splits of two joined hands (3-camera handshake seed 2: one hand
+    # thrown 300 mm off in a frame, the other still at the meeting) and hands it loses at a
+    # handover (seed 3) cut touches short. Off, and always with one camera: unseen frames neither
+    # end nor extend a touch, and any seen frame with the hands apart ends it (``touch_runs``)
+    stayed_hand: bool = flag(True)
+    stay_jump: float = number(1.5, POSITIVE)
     # joins of the same two hands this close in time are one activity (three claps, a shake with
     # a few contacts): frames between one separation and the next join
     merge_gap: int = number(30, POSITIVE_COUNT)
