@@ -624,3 +624,23 @@ def test_with_two_views_a_clapping_hand_leaves_the_ghost_and_is_found_again():
     assert ghost[2:22].min() > 390 and kept[2:22].max() < 300  # frames 91-110
     assert kept[1] > 200 and found[1] < 50  # frame 90
     assert kept.mean() > 220 and found.mean() < 160
+
+
+def test_a_pair_of_two_peoples_hands_far_on_one_persons_side_sends_the_other_hand_home():
+    """Handshake, 4 cameras (seed 7): when the hands parted, person 2's right hand took person 1's
+    (person 1's tracker lagged 230-360 mm off), followed it to person 1 and was combined with it
+    from frame 75 to 131, 930-1040 mm from person 2's head and ~230 mm nearer person 1's: on person
+    1's hand, 584-745 mm from its own in frames 90-130 (the benchmark's hand on another hand). With
+    ``states.foreign_pair_frames`` the pair splits and the hand goes back to its home (not taken
+    from the frames it spent nearer person 1's head): 245-257 mm off in frames 90-94; its home is
+    where it was before the handshake and its hand is not seen there, so it drifts back to 530-575
+    mm off, no longer on person 1's hand."""
+    scene = make_multiview_scene("handshake", 4, seed=7, n_frames=150)
+    frames = range(90, 131)
+    before = _part_error(scene, Limbs3DParams(), 4, 2, "right_hand", frames, seed=7)
+    after = _part_error(scene, Limbs3DParams().updated({"states.foreign_pair_frames": 5}), 4, 2, "right_hand",
+                        frames, seed=7)
+    assert len(before) == len(after) == 41
+    assert before.min() > 580
+    assert after[:5].max() < 260
+    assert before.mean() - after.mean() > 80

@@ -320,6 +320,16 @@ class Limbs3DStates:
     # 0-19, seated 0-9, at 2-4 cameras) the same to 0.1 mm: no pair is lost combined there. False =
     # main before
     combined_lost_home: bool = flag(True)
+    # a combined pair of two people's hands nearer one person's head than the other's by more than
+    # foreign_margin mm for this many frames in a row splits, the farther person's hand going back to
+    # its home, which is not taken from frames in which the hand is nearer another person's head than
+    # its own (tracker._foreign_pair; our addition: after a handshake each hand goes back to its own
+    # person, sec. 7.1). Handshake 4 cameras seed 7: person 2's right hand took person 1's when the
+    # hands parted (person 1's tracker lagged 230-360 mm off), followed it to person 1 and was
+    # combined with it for 56 frames, 930-1040 mm from person 2's head and ~230 mm nearer person 1's.
+    # 0 = off
+    foreign_pair_frames: int = number(0, COUNT)
+    foreign_margin: float = number(200.0, POSITIVE)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of

@@ -76,6 +76,7 @@ class _Target:
     # other target near (dynamics.line_of_sight: where a hand seen by one view goes back to)
     home: np.ndarray | None = None
     returning: bool = False  # it left a combined pair and has not been tracked alone from pairs since
+    foreign_pair: int = 0  # (a pair's leader) frames in a row nearer one head (states.foreign_pair_frames)
     parting: list = field(default_factory=list)  # distances of a combined pair's single-view mode, frame by frame
     history: list = field(default_factory=list)
 
@@ -278,7 +279,8 @@ class Limbs3DTracker:
             use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
                                                     weights, heads.get(t.track_id))
             est = t.filter.update(use, use_w, gate)
-            if alone and heads.get(t.track_id) is not None:
+            foreign = self._foreign(t, state, est, heads)
+            if alone and not foreign and heads.get(t.track_id) is not None:
                 t.home, t.returning = est - heads[t.track_id], False
             t.missed = t.missed + 1 if t.filter.confidence < p.states.lost_likelihood else 0
             est = self._back_home(t, est, heads.get(t.track_id))
@@ -291,8 +293,9 @@ class Limbs3DTracker:
             obs = {"position": tuple(est), "likelihood": t.filter.confidence, "labelled": t.labelled,
                    "unseen": unseen}
             if m.state(k) == LimbState.COMBINED:
-                obs["modes"] = self._combined_modes(t, est, np.flatnonzero(mine), points, weights, centres,
-                                                    np.delete(preds, a, axis=0), self._pair_heads(k, heads))
+                obs["modes"] = self._foreign_pair(t, k, est, heads, self._combined_modes(
+                    t, est, np.flatnonzero(mine), points, weights, centres, np.delete(preds, a, axis=0),
+                    self._pair_heads(k, heads)))
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -326,6 +329,43 @@ class Limbs3DTracker:
         est = np.asarray(head, float) + t.home
         t.filter.reset(est, self.params.dynamics.lost_search)
         return est
+
+    def _foreign(self, t: _Target, state: LimbState, est: np.ndarray, heads: dict) -> bool:
+        """Whether hand ``t`` (tracked, ``states.foreign_pair_frames`` > 0) is estimated nearer
+        another person's head than its own (``heads``: the head estimates by person): its home is
+        not taken from such a frame (:meth:`_foreign_pair` sends it there)."""
+        own = heads.get(t.track_id)
+        if (not self.params.states.foreign_pair_frames or t.part == "head" or state != LimbState.NORMAL
+                or own is None):
+            return False
+        others = [h for tid, h in heads.items() if tid != t.track_id]
+        return bool(others) and min(np.linalg.norm(np.subtract(h, est)) for h in others) < np.linalg.norm(est - own)
+
+    def _foreign_pair(self, t: _Target, k: int, est: np.ndarray, heads: dict, modes: tuple) -> tuple:
+        """The modes of combined pair ``k`` (leader ``t``) of two people's hands, or, once its estimate
+        has been nearer one person's head than the other's by more than ``states.foreign_margin`` mm
+        for ``states.foreign_pair_frames`` frames in a row, the estimate and the farther person's hand's
+        home (relative to its head): the pair splits, that hand going home (the direction cue,
+        ``states.split_heads``, gives each hand its own side). Handshake 4 cameras seed 7: person 2's
+        right hand took person 1's when the hands parted (person 1's tracker lagged 230-360 mm off),
+        followed it to person 1 and was combined with it 930-1040 mm from person 2's head, 230 mm
+        nearer person 1's, for 56 frames. A home is not taken from a frame in which the hand is
+        nearer another person's head than its own (:meth:`_foreign`): it had been, from there."""
+        st = self.params.states
+        partner = self.machine.partner(k)
+        o = self.targets[partner] if partner is not None else None
+        if (not st.foreign_pair_frames or o is None or o.track_id == t.track_id or t.part == "head"
+                or t.track_id not in heads or o.track_id not in heads):
+            t.foreign_pair = 0
+            return modes
+        d_t = float(np.linalg.norm(est - heads[t.track_id]))
+        d_o = float(np.linalg.norm(est - heads[o.track_id]))
+        t.foreign_pair = t.foreign_pair + 1 if abs(d_t - d_o) > st.foreign_margin else 0
+        far = t if d_t > d_o else o
+        if t.foreign_pair < st.foreign_pair_frames or far.home is None:
+            return modes
+        t.foreign_pair = 0
+        return (tuple(est), tuple(heads[far.track_id] + far.home))
 
     def _refind(self, t: _Target, state: LimbState, a: int, preds: np.ndarray, use: np.ndarray, use_w: np.ndarray,
                 gate: float) -> None:
