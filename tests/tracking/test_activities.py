@@ -509,6 +509,28 @@ def test_a_touch_of_a_frame_or_two_is_no_join():
     assert list(recognise(_touch(a, b, 40, 41), bare, centres, every)["kind"]) == ["handshake"]
 
 
+def test_one_persons_hand_found_again_beside_the_other_makes_no_clap():
+    """``decision.clap_found_frames`` (5): one camera, exchange seed 15 with skin.keep_spread 50:
+    person 2's right hand, lost from frame 4, was found at frame 47 19 px from their left hand, a
+    false clap 47-49; hands seen coming together (or lost for fewer frames) still clap."""
+    from partlab.tracking.activities.recognise import recognise
+
+    a, b = (2, "left_hand"), (2, "right_hand")
+    left = {f: (410.0, 405.0, 15.0) for f in range(100)}
+    right = {f: (409.0, 386.0, 15.0) if f >= 47 else (404.0, 330.0, 15.0) for f in range(100)}
+    found = {a: left, b: {f: c for f, c in right.items() if not 4 <= f <= 46}}
+    bare = {k: {f: [_seen("", 0, 0.0)] for f in c} for k, c in found.items()}
+    assert recognise(_touch(a, b, 47, 49), bare, found, P).empty
+    # the rule off: a clap (as before)
+    off = recognise(_touch(a, b, 47, 49), bare, found, P.updated({"decision.clap_found_frames": 0}))
+    assert [(r.kind, r.start_frame, r.end_frame) for r in off.itertuples()] == [("clap", 47, 49)]
+    # seen all along, or unseen for 4 frames before the touch only: a clap
+    for hidden in (range(0), range(43, 47)):
+        seen = {a: left, b: {f: c for f, c in right.items() if f not in hidden}}
+        bare = {k: {f: [_seen("", 0, 0.0)] for f in c} for k, c in seen.items()}
+        assert list(recognise(_touch(a, b, 47, 49), bare, seen, P)["kind"]) == ["clap"]
+
+
 class _OneHead:
     """A 'tracker' reporting one person's head and right hand at fixed boxes."""
 

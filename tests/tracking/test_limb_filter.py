@@ -118,6 +118,22 @@ def test_an_arm_long_blob_gives_its_two_hand_sized_ends_and_a_hand_its_centre():
     assert np.allclose(blob_tips(hand, 16, 1.6, 2.5, 0.8), [[80, 50]], atol=0.5)
 
 
+def test_a_blob_cut_by_the_observed_regions_edge_gives_its_end_away_from_the_cut():
+    def arm(m):  # a hand of radius 8 at (100, 60) and its forearm, cut square at x = 70
+        cv2.line(m, (70, 60), (100, 60), 255, 12)
+        cv2.circle(m, (100, 60), 8, 255, -1)
+    pts = _blob(arm)
+    cut = pts[:, 0] <= 71  # the pixels next to skin that is not observed
+    plain = blob_tips(pts, side=16, span=1.6, far=2.5, radius=0.8)
+    assert len(plain) == 2 and plain[:, 0].min() < 80  # without the cut: the cut is an end too
+    tips = blob_tips(pts, side=16, span=1.6, far=2.5, radius=0.8, cut=cut)
+    assert tips.shape == (1, 2) and np.allclose(tips[0], (100, 60), atol=3.0)
+    # a shorter piece (under tip_span): its centre lies towards the cut, the end away from it is the hand
+    short = _blob(lambda m: (cv2.line(m, (88, 60), (100, 60), 255, 12), cv2.circle(m, (100, 60), 8, 255, -1)))
+    assert blob_tips(short, 16, 1.6, 2.5, 0.8)[0, 0] < 97
+    assert np.allclose(blob_tips(short, 16, 1.6, 2.5, 0.8, cut=short[:, 0] <= 89)[0], (100, 60), atol=2.5)
+
+
 def test_two_forearms_meeting_at_a_clap_give_the_meeting_point_as_a_third_end():
     def v(m):
         cv2.line(m, (20, 100), (80, 40), 255, 12)

@@ -261,19 +261,41 @@ def small_arm_scene(n=24):
 def test_a_small_hand_sharing_its_forearm_colour_is_kept_and_seen_at_the_arm_end():
     frames, truth = small_arm_scene()
     init = truth[truth.frame == 0]
-    kept = P.updated({"skin.keep_spread": 50.0})
+    kept = P.updated({"skin.keep_spread": 50.0})  # the default
     out = run(LimbTracker(kept, np.random.default_rng(3), init=init), frames)
     err, m = centre_error(out, truth)
     hands = m.part.str.endswith("hand")
     assert (m.state[hands] == "normal").all()
     assert err[hands].max() < 5.0
-    # the 14 px boxes are under skin.keep_min_side: not kept (the default), the refit sees none of the hands
-    old = run(LimbTracker(P, np.random.default_rng(3), init=init), frames)
+    # the 14 px boxes are under skin.keep_min_side: without keep_spread not kept, the refit sees none of the hands
+    old = run(LimbTracker(P.updated({"skin.keep_spread": 0.0}), np.random.default_rng(3), init=init), frames)
     assert (old[old.part.str.endswith("hand") & (old.frame >= 10)].state == "lost").all()
     # kept, but seen at their blobs' centres: up the forearms
     mid = run(LimbTracker(kept.updated({"blobs.tip_kept": False}), np.random.default_rng(3), init=init), frames)
     err0, m0 = centre_error(mid, truth)
     assert err0[m0.part.str.endswith("hand") & (m0.frame >= 10)].min() > 10.0
+
+
+def test_a_still_persons_kept_hands_are_not_pulled_up_their_forearms_where_the_support_box_cuts_them():
+    # the person stands still from the first frame: the adaptive background has absorbed them (an
+    # empty foreground), so only the support box round each hand is observed, and it cuts the
+    # forearm's blob square; the cut is no hand's end (blobs.cut_ends)
+    frames, truth = small_arm_scene()
+    init = truth[truth.frame == 0]
+    kept = P.updated({"skin.keep_spread": 50.0})  # the default
+    absorbed = np.zeros(frames[0].shape[:2], np.uint8)
+
+    def run_absorbed(params):
+        tracker = LimbTracker(params, np.random.default_rng(3), init=init)
+        return records_to_frame([r for i, f in enumerate(frames) for r in tracker.step(i, f, absorbed)])
+
+    err, m = centre_error(run_absorbed(kept), truth)
+    hands = m.part.str.endswith("hand")
+    assert (m.state[hands] == "normal").all() and err[hands].max() < 3.0
+    # the cut taken for an end (or pulling the blob's centre): both hands ratchet up their forearms
+    err0, m0 = centre_error(run_absorbed(kept.updated({"blobs.cut_ends": False})), truth)
+    for part in ("left_hand", "right_hand"):
+        assert err0[(m0.part == part) & (m0.frame >= 20)].min() > 50.0
 
 
 def test_a_clapping_pair_does_not_split_onto_the_blob_where_a_lost_hand_is_looked_for():
@@ -327,6 +349,47 @@ def handover_scene(n=60):
         rows += [(t, 1, "head", h1[0] - 11, h1[1] - 11, 22, 22), (t, 2, "head", h2[0] - 11, h2[1] - 11, 22, 22),
                  (t, 1, "right_hand", r1[0] - 6, r1[1] - 6, 12, 12), (t, 2, "right_hand", r2[0] - 6, r2[1] - 6, 12, 12)]
     return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def clasp_scene(n=50, elbow=(138, 62)):
+    """Two people's right hands meet and clasp (one blob) over frames 15-35 while a piece of person
+    2's arm shows 38 px from the meeting point over frames 18-32 (the elbow of a bare arm reaching
+    out, as in the one-camera handshakes with skin.keep_spread 50); then the hands part."""
+    frames, rows = [], []
+    for t in range(n):
+        f = np.full((120, 200, 3), BG, np.uint8)
+        cv2.rectangle(f, (25, 35), (55, 115), SHIRT, -1)
+        cv2.rectangle(f, (145, 35), (175, 115), SHIRT, -1)
+        reach = min(t, 15) / 15 if t < 35 else max(0.0, 1 - (t - 35) / 15)
+        h1, h2 = (40, 25), (160, 25)
+        r1, r2 = (int(round(70 + 25 * reach)), 80), (int(round(130 - 25 * reach)), 80)
+        for c, r in ((h1, 11), (h2, 11), (r1, 6), (r2, 6)):
+            cv2.circle(f, c, r, SKIN, -1)
+        if 18 <= t <= 32:
+            cv2.circle(f, elbow, 6, SKIN, -1)
+        frames.append(f)
+        rows += [(t, 1, "head", h1[0] - 11, h1[1] - 11, 22, 22), (t, 2, "head", h2[0] - 11, h2[1] - 11, 22, 22),
+                 (t, 1, "right_hand", r1[0] - 6, r1[1] - 6, 12, 12), (t, 2, "right_hand", r2[0] - 6, r2[1] - 6, 12, 12)]
+    return frames, pd.DataFrame(rows, columns=["frame", "track_id", "part", "x", "y", "w", "h"])
+
+
+def test_two_peoples_clasped_hands_do_not_split_onto_an_arm_beyond_their_mode_search():
+    frames, truth = clasp_scene()
+    tr = LimbTracker(P, np.random.default_rng(0), init=truth[truth.frame == 0])
+    out = run(tr, frames)
+    st = out.set_index(["frame", "track_id", "part"])["state"]
+    assert all(st[(t, 2, "right_hand")] == "combined" for t in range(15, 35))
+    err, m = centre_error(out, truth)
+    assert err[(m.frame >= 40) & m.part.str.endswith("hand")].max() < 3.0
+    ev = tr.events
+    assert list(zip(ev.kind, ev.ended_by)) == [("handshake", "split")] and ev.end_frame.iloc[0] >= 38
+    # with a single hand's search (mode_search, 4 split distances) the pair splits onto the arm at
+    # once, person 2's hand 38 px off, and the join lasts 5 frames
+    old = LimbTracker(P.updated({"states.people_mode_search": 0.0}), np.random.default_rng(0),
+                      init=truth[truth.frame == 0])
+    err0, m0 = centre_error(run(old, frames), truth)
+    assert err0[(m0.frame >= 20) & (m0.frame <= 30) & (m0.track_id == 2) & (m0.part == "right_hand")].min() > 30
+    assert old.events.end_frame.iloc[0] <= 20
 
 
 def test_a_pair_whose_second_hand_goes_unseen_after_they_part_splits_with_that_hand_lost():

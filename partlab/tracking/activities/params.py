@@ -13,7 +13,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import ClassVar
 
-from partlab.tracking.core.params import FRACTION, POSITIVE, POSITIVE_COUNT, Parameters, flag, group_field, number
+from partlab.tracking.core.params import (
+    COUNT,
+    FRACTION,
+    POSITIVE,
+    POSITIVE_COUNT,
+    Parameters,
+    flag,
+    group_field,
+    number,
+)
 
 
 @dataclass(frozen=True)
@@ -119,6 +128,13 @@ class Decision:
     # 39-40 was read as the exchange, too short to match it (the exchange found instead as a
     # handover, 41-81). 1: every touch counts
     min_touch_frames: int = number(3, POSITIVE_COUNT)
+    # a touch of one person's two hands, one of which was unseen (lost, not bridged) over this many
+    # frames before it began, is no clap: the hands were not seen coming together, the tracker
+    # found a lost hand beside the other (one camera, skin.keep_spread 50, exchange seed 15: person
+    # 2's hidden right hand, lost from frame 4, and their left hand were both found on their body
+    # at frame 47, 19 px apart, a false clap 47-49). Its decision point before is unseen (a clap
+    # of confidence 0.3, not reported). 0: off
+    clap_found_frames: int = number(5, COUNT)
     # hysteresis: a touch lasts until the hands are this many times the touching distance apart
     # (a clap's hands part a little between the beats; a shaking pair's boxes jitter)
     release_ratio: float = number(1.4, POSITIVE)

@@ -466,6 +466,8 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
             worn = np.union1d(clothes.get(a[0], np.zeros(0, int)), clothes.get(b[0], np.zeros(0, int)))
             seen = [_without(_held_seen(colours.get(k, {}), lo, hi, away, params), worn)
                     for k in (a, b) for lo, hi, away in ((b0, b1, -1), (a0, a1, 1))]
+            if a[0] == b[0] and found_at_touch(centres.get(a, {}), centres.get(b, {}), start, params):
+                seen[0] = seen[2] = None  # not seen coming together: the tracker found a hand there
             if all(s is not None for s in seen):
                 ab, aa, bb, ba = seen
                 v = _two_hand_verdict(seen, a, b, ((b0, b1), (a0, a1)), centres, where or {}, params)
@@ -493,6 +495,14 @@ def _join_rows(joins: pd.DataFrame | None, colours, centres, params: ActivityPar
         busy[a].append((start, end))
         busy[b].append((start, end))
     return rows, busy
+
+
+def found_at_touch(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, params: ActivityParams) -> bool:
+    """Whether one of two hands was unseen over the ``decision.clap_found_frames`` frames before
+    their touch began (0: never): a hand the tracker found again beside the other (one person's
+    two lost hands found on their own body in one frame), not two hands seen coming together."""
+    k = params.decision.clap_found_frames
+    return k > 0 and any(all(f not in c for f in range(start - k, start)) for c in (ca, cb))
 
 
 def object_at_touch(seen: list[dict], touch: list[dict | None], params: ActivityParams) -> int | None:

@@ -35,7 +35,9 @@ class Candidates:
     """Candidate points of one frame: ``centres (K, 2)``, ``boxes (K, 4)``, ``areas (K,)``,
     their named prior terms ``terms[name] (K,)`` and the product ``priors (K,)`` (seed 000 eq. 19);
     ``parents (K,)``: the blob (index into the frame's :class:`Blobs`) each candidate comes from
-    (None: candidate k is blob k)."""
+    (None: candidate k is blob k); ``ends (K,) bool``: candidates that are a blob's end even where
+    the blob gives only one (the end of a blob cut by the edge of the observable region, away from
+    the cut; None: an end is one of two or more candidates of a blob)."""
 
     centres: np.ndarray
     boxes: np.ndarray
@@ -43,6 +45,7 @@ class Candidates:
     terms: dict[str, np.ndarray]
     priors: np.ndarray
     parents: np.ndarray | None = None
+    ends: np.ndarray | None = None
 
     def __len__(self) -> int:
         return int(self.priors.size)
@@ -111,7 +114,7 @@ def blob_points(blobs: Blobs) -> list[np.ndarray]:
 
 
 def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: float,
-              max_tips: int = 4) -> np.ndarray:
+              max_tips: int = 4, cut: np.ndarray | None = None) -> np.ndarray:
     """Hand-sized ends of one blob: ``(T, 2)`` points, or the blob's centre when it is compact.
 
     With short sleeves a hand and its forearm share one colour and form one blob (a desk
@@ -124,12 +127,30 @@ def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: 
     no end: its distance to the centre is a minimum along the outline. Each end's point is
     the centroid of the blob pixels within ``radius`` sides of it: a hand's centre when the
     end is a hand.
+
+    ``cut (n,) bool``: the blob's pixels at a cut, where it goes on as skin beyond the region
+    that is observed (a still person whom the background absorbed is seen only in a box round
+    each tracked target, which cuts their forearm square; :attr:`LimbBlobs.cut_ends`). An end
+    at a cut is no end of the arm, and the centre of a cut blob lies towards the cut: a blob
+    with cut pixels gives its ends away from the cut, or, where it has none (a short blob),
+    the centroid round its pixel farthest from the cut.
     """
     pts = np.asarray(points, float).reshape(-1, 2)
+    if cut is not None and np.any(cut) and not np.all(cut):
+        return _uncut_tips(pts, np.asarray(cut, bool), side, span, far, radius, max_tips)
     centre = pts.mean(axis=0)
     t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
     if np.hypot(*(pts - t1).T).max() < span * side:
         return centre[None]
+    tips = _tip_points(pts, side, span, far, max_tips)
+    return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
+
+
+def _tip_points(pts: np.ndarray, side: float, span: float, far: float, max_tips: int) -> np.ndarray:
+    """The outline points :func:`blob_tips` takes its ends round (of a blob at least ``span``
+    sides long)."""
+    centre = pts.mean(axis=0)
+    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
     ends = _outline_maxima(pts, centre, max(int(side / 2), 2))
     tips = [t1]
     mind = np.hypot(*(ends - t1).T)
@@ -141,7 +162,32 @@ def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: 
         mind = np.minimum(mind, np.hypot(*(ends - ends[k]).T))
     if len(tips) == 1:  # no outline end far enough (a ragged blob): its farthest pixel
         tips.append(pts[np.argmax(np.hypot(*(pts - t1).T))])
-    return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
+    return np.array(tips)
+
+
+def _uncut_tips(pts: np.ndarray, cut: np.ndarray, side: float, span: float, far: float, radius: float,
+                max_tips: int) -> np.ndarray:
+    """:func:`blob_tips` of a blob with ``cut`` pixels: its ends whose outline point lies farther
+    than ``CUT_GAP`` pixels from every cut pixel; none such (a short blob, or every end at the
+    cut), the centroid round its pixel farthest from the cut."""
+    x0, y0 = pts.min(axis=0).astype(int)
+    xy = pts.astype(int) - np.array([x0, y0])
+    img = np.ones((xy[:, 1].max() + 1, xy[:, 0].max() + 1), np.uint8)
+    img[xy[cut, 1], xy[cut, 0]] = 0
+    dist = cv2.distanceTransform(img, cv2.DIST_L2, 3)  # pixels to the nearest cut pixel
+
+    def centroid(q: np.ndarray) -> np.ndarray:
+        return pts[np.hypot(*(pts - q).T) <= radius * side].mean(axis=0)
+
+    centre = pts.mean(axis=0)
+    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
+    if np.hypot(*(pts - t1).T).max() >= span * side:
+        raw = _tip_points(pts, side, span, far, max_tips)
+        rxy = np.clip(raw.astype(int) - np.array([x0, y0]), 0, np.array(img.shape[::-1]) - 1)
+        keep = dist[rxy[:, 1], rxy[:, 0]] > CUT_GAP
+        if keep.any():
+            return np.array([centroid(t) for t in raw[keep]])
+    return centroid(pts[int(np.argmax(dist[xy[:, 1], xy[:, 0]]))])[None]
 
 
 def _outline_maxima(pts: np.ndarray, centre: np.ndarray, half_window: int) -> np.ndarray:
@@ -161,17 +207,26 @@ def _outline_maxima(pts: np.ndarray, centre: np.ndarray, half_window: int) -> np
     return c[r >= shifted.max(axis=0)]
 
 
-def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, params: LimbParams) -> Candidates:
+def tip_candidates(cands: Candidates, points: list[np.ndarray], side: float, params: LimbParams,
+                   cuts: list[np.ndarray] | None = None, span: float | None = None) -> Candidates:
     """Candidates of a hand of box side ``side``: each elongated blob replaced by its ends
-    (:func:`blob_tips`), which inherit the blob's prior terms."""
+    (:func:`blob_tips`), which inherit the blob's prior terms. ``cuts``: per blob, its pixels at
+    a cut (``blob_tips``' ``cut``); the tips of a blob with some are ends however many.
+    ``span``: instead of ``blobs.tip_span`` (infinite: blob centres, but a cut blob's end away
+    from the cut, for hands that see blob centres)."""
     if len(cands) == 0:
         return cands
-    centres, parents = [], []
+    centres, parents, ends = [], [], []
+    b = params.blobs
     for k, pts in enumerate(points):
-        tips = blob_tips(pts, side, params.blobs.tip_span, params.blobs.tip_far, params.blobs.tip_radius)
+        cut = None if cuts is None else cuts[k]
+        tips = blob_tips(pts, side, b.tip_span if span is None else span, b.tip_far, b.tip_radius, cut=cut)
         centres.append(tips)
         parents += [k] * len(tips)
-    return _expand(cands, np.concatenate(centres), np.asarray(parents, int), side)
+        ends += [cut is not None and bool(np.any(cut)) and not bool(np.all(cut))] * len(tips)
+    out = _expand(cands, np.concatenate(centres), np.asarray(parents, int), side)
+    return out if cuts is None else Candidates(out.centres, out.boxes, out.areas, out.terms, out.priors,
+                                               out.parents, np.asarray(ends, bool))
 
 
 def nearest_part_candidates(cands: Candidates, points: list[np.ndarray], near, side: float,
@@ -201,6 +256,10 @@ def nearest_per_parent(cands: Candidates, point) -> np.ndarray:
         idx = np.flatnonzero(cands.parents == k)
         keep[idx[np.argmin(d[idx])]] = True
     return keep
+
+
+#: pixels: an end whose outline point lies this near a blob's cut pixels is the cut (blob_tips)
+CUT_GAP = 2.0
 
 
 def _expand(cands: Candidates, centres: np.ndarray, parents: np.ndarray, side: float) -> Candidates:

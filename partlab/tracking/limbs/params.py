@@ -117,16 +117,17 @@ class LimbSkin:
     # at 320x240 (desk hands 13-16 px) it went with blobs.tip_min_side.
     keep_min_side: float = number(17.0)
     # ... and, for smaller boxes, the colour bins holding at least 1/keep_spread of the bin's
-    # pixels in the frame (0: none kept, the default): a 14-15 px hand of a person standing with
-    # bare forearms (one-camera activity scenes, 720x480) shares its colour with its forearm (the
-    # bin's pixels 3-30 times the box's: kept; otherwise lost at frame 4, the refit seeing under
-    # 5% of it), not with the floor or the sleeve at its edge (600-9000 times: not kept, or the
-    # floor turned skin). At 50 (with blobs.tip_kept, tip_person), activity scenes seeds 0-9:
-    # clap recall 0.80 -> 0.90, exchange 0.50 -> 0.60, handshake 0.90 -> 1.00, none worse; but
-    # held-out seeds 10-19 lose precision (clap 1.00 -> 0.91, place 0.90 -> 0.75, exchange 1.00
-    # -> 0.86; every recall the same or better), and desk 320x240 (12 seeds) left hand mean rate
-    # 0.890 -> 0.968, right 0.819 -> 0.806; so off.
-    keep_spread: float = number(0.0)
+    # pixels in the frame (0: none kept): a 14-15 px hand of a person standing with bare forearms
+    # (one-camera activity scenes, 720x480) shares its colour with its forearm (the bin's pixels
+    # 3-30 times the box's: kept; otherwise lost at frame 4, the refit seeing under 5% of it), not
+    # with the floor or the sleeve at its edge (600-9000 times: not kept, or the floor turned
+    # skin). On since 2026-12-06 (with blobs.tip_kept, tip_person, cut_ends and
+    # states.people_mode_search, activities decision.clap_found_frames): activity scenes seeds
+    # 0-9 clap recall 0.80 -> 1.00, handshake 0.90 / 0.90 -> 1.00 / 1.00, exchange 0.83 / 0.50 ->
+    # 0.78 / 0.70, place recall 0.90 -> 1.00; held out (10-19) no kind's precision or recall lower
+    # (handshake 0.64 / 0.70 -> 0.90 / 0.90, place 0.90 / 0.90 -> 1.00 / 1.00); desk 320x240 left
+    # hand 0.917 -> 1.000 at frame 105, right the same (docs/measurements/activities.md).
+    keep_spread: float = number(50.0)
     # keep the colours of init boxes the init table marks hidden (occluded >= 0.5)? A hand
     # behind its body has a box of clothes (the exchange scenes' far hands: the shirt's bins
     # pass keep_spread). They stay skin samples: left out altogether, the walker's hidden left
@@ -171,6 +172,22 @@ class LimbBlobs:
     # up its forearm and missed the handshake; with: found). A lost hand keeps blob centres: with
     # arm ends it took the elbow end of the other forearm (exchange seeds 2, 6 lost).
     tip_person: bool = flag(True)
+    # a blob that goes on as skin beyond the observed region (the foreground and the support
+    # boxes) is cut there: its end at the cut is no hand, and its centre lies towards the cut
+    # (limbs.filter.blob_tips). A still person whom the adaptive background absorbed is seen only
+    # in the support box round each hand, which cuts a kept hand's forearm square: the cut was an
+    # end, or pulled the blob's centre up the arm, and the estimate ratcheted up the forearm with
+    # its box (one-camera clap seed 6: 419 -> 384 px in 5 frames; exchange seed 13 with
+    # skin.keep_spread 50: 30 px up in 3 frames, a false place). For hands under tip_min_side
+    # (those that see arm ends because their colours were kept): for the desk's larger hands
+    # (720x480, 12 seeds) it lost right hands (0.917 at frame 105, mean 0.777, against 1.00 and
+    # 0.886), as a first try of dropping cut ends there had.
+    cut_ends: bool = flag(True)
+    # ... also for hands that see blob centres (a cut blob's end away from the cut instead of its
+    # centre). Off: with skin.keep_spread 50 it kept exchange seed 13's person 2 left hand (not
+    # kept) from creeping 25 px up its forearm, but where the cut blob held both hands of a clap
+    # the end away from the cut was the other hand (clap seed 1 lost).
+    cut_centres: bool = flag(False)
     # a tracked hand ignores arm ends farther than tip_gate sides from where it is predicted
     tip_gate: float = number(1.0)
 
@@ -196,6 +213,11 @@ class LimbStates:
     # a step; a desk clap's hands back at rest within two frames). 4 gave desk 720x480 right-hand
     # rate 0.83 vs 0.75 at 2, and walker left hand 1.00 vs 0.75.
     mode_search: float = number(4.0)
+    # ... and for a pair of two people's hands (a handshake, an exchange), within this many (0:
+    # mode_search): their hands part slowly, and far modes were the people's own arms (one-camera
+    # handshake seeds 10, 17, 18 with skin.keep_spread 50: the pair split at once, one hand onto its
+    # own elbow 37 px away or its person's other forearm 75 px away).
+    people_mode_search: float = number(1.2)
     # ... and not on the blob where a lost target is looked for (its last place, moved with its
     # head): two people's hands meeting in a handshake or an exchange split at once onto a lost
     # hand's blob 70 px away (the refit skin model barely sees that 14 px hand, so its own filter
@@ -352,4 +374,5 @@ class LimbParams(Parameters):
     }
     #: fields added after partlab 0.2 (no flat name)
     ADDED: ClassVar[tuple[str, ...]] = ("states.pair_lost_claims", "states.split_unseen",
-                                            "states.pair_span")
+                                            "states.pair_span", "blobs.cut_ends", "blobs.cut_centres",
+                                            "states.people_mode_search")

@@ -141,12 +141,15 @@ def _check_frame(frame: np.ndarray, foreground: np.ndarray | None) -> np.ndarray
 class _View:
     """One frame's observations: skin ``blobs``, their candidates ``cands``, the hue bin of every
     skin pixel ``skin_bins (H, W) int16`` (-1 elsewhere); found automatically, the person regions
-    ``people (P, 4)`` (:mod:`partlab.tracking.limbs.people`), else None."""
+    ``people (P, 4)`` (:mod:`partlab.tracking.limbs.people`), else None; ``cut (H, W) bool``:
+    pixels next to skin that is not observed (outside the foreground and every support box;
+    ``blobs.cut_ends``), None without a foreground mask."""
 
     blobs: Blobs
     cands: Candidates
     skin_bins: np.ndarray
     people: np.ndarray | None = None
+    cut: np.ndarray | None = None
 
 
 class _CandidateSets:
@@ -155,6 +158,8 @@ class _CandidateSets:
 
     def __init__(self, tracker: LimbTracker, view: _View, active: list[int]):
         self.tracker, self.cands, self.blobs, self.active = tracker, view.cands, view.blobs, active
+        self.cut = view.cut
+        self._cuts: list | None = None
         self._pixels: list | None = None  # each blob's pixels, read once when a hand needs its ends
         self._sets: dict = {}
         owner, within = tracker._owners(view.cands, active)
@@ -166,16 +171,38 @@ class _CandidateSets:
             self._pixels = blob_points(self.blobs)
         return self._pixels
 
+    def cuts(self) -> list[np.ndarray] | None:
+        """Per blob, its pixels at a cut (:attr:`_View.cut`); None where no blob is cut."""
+        if self.cut is None:
+            return None
+        if self._cuts is None:
+            self._cuts = [self.cut[p[:, 1].astype(int), p[:, 0].astype(int)] for p in self.points()]
+        return self._cuts if any(c.any() for c in self._cuts) else None
+
     def not_heads(self, c: Candidates) -> Candidates:
         return self.tracker._subset(c, ~self.heads[c.parents]) if c.parents is not None else c
 
     def by(self, t: int) -> tuple[Candidates, tuple[np.ndarray, np.ndarray]]:
-        side = self.tracker._hand_side(t)
-        if side not in self._sets:
-            c = self.cands if side is None else self.not_heads(
-                tip_candidates(self.cands, self.points(), side, self.tracker.params))
-            self._sets[side] = (c, self.tracker._owners(c, self.active))
-        return self._sets[side]
+        side = key = self.tracker._hand_side(t)
+        tgt = self.tracker.targets[t]
+        if side is None and self.tracker.params.blobs.cut_centres and tgt.part in ("left_hand", "right_hand") \
+                and self.cut is not None and self.tracker.machine.state(t) in (LimbState.NORMAL, LimbState.UNLABELLED):
+            # a hand that sees blob centres sees a cut blob's end away from the cut (while it
+            # tracks one hand: a combined pair's blob is two arms, a lost hand's search box cuts
+            # other arms)
+            key = ("cut", float(round(sum(tgt.size) / 2)))
+        if key not in self._sets:
+            if side is not None:  # small hands (kept, seeing arm ends) only: blobs.cut_ends
+                small = side < self.tracker.params.blobs.tip_min_side
+                c = self.not_heads(tip_candidates(self.cands, self.points(), side, self.tracker.params,
+                                                  self.cuts() if small else None))
+            elif key is not None and self.cuts() is not None:
+                c = tip_candidates(self.cands, self.points(), key[1], self.tracker.params, self.cuts(),
+                                   span=np.inf)
+            else:
+                c = self.cands
+            self._sets[key] = (c, self.tracker._owners(c, self.active))
+        return self._sets[key]
 
 
 class LimbTracker:
@@ -322,6 +349,10 @@ class LimbTracker:
         n_people = max(len({t.track_id for t in self.targets.values() if t.track_id is not None}), 1)
         blobs = find_blobs(skin_mask.astype(np.uint8), n_people, p.blobs.alpha, self._min_area(starting), rois)
         cands = candidate_terms(blobs, fg, skin_prob, p)
+        cut = None
+        if fg is not None and p.blobs.cut_ends:  # skin beyond the observed region: a blob cut there
+            hidden = ((skin_prob >= p.skin.threshold) & ~fg).astype(np.uint8)
+            cut = cv2.dilate(hidden, np.ones((3, 3), np.uint8)) > 0 if hidden.any() else None
         a = p.appearance
 
         def hue_bins(img: np.ndarray) -> np.ndarray:
@@ -334,7 +365,7 @@ class LimbTracker:
         # bins, so seed 003's whole-box hue histogram and back-projection would lock onto them.
         # The colour likelihood and the mean shift therefore run on the "skin-colour
         # probability map" (seed 003 sec. 3) of the skin model, not on raw hue.
-        return _View(blobs, cands, skin_bins, people)
+        return _View(blobs, cands, skin_bins, people, cut)
 
     def _people(self, foreground: np.ndarray | None, shape: tuple[int, int]) -> np.ndarray | None:
         """Found automatically, this frame's person regions: the boxes given by :meth:`set_people`,
@@ -358,7 +389,8 @@ class LimbTracker:
         obs_c = self._predict(t, state, seen, own_c, owners)
         on_end = False  # the hand is seen as the end of an arm-long blob
         if obs_c.parents is not None and state != LimbState.COMBINED and len(obs_c):
-            obs_c, on_end = self._nearest_ends(tgt, state, obs_c, own_c, before, prev, len(view.blobs))
+            obs_c, on_end = self._nearest_ends(tgt, state, obs_c, own_c, before, prev, len(view.blobs),
+                                               self._hand_side(t) is not None)
         tgt.filter.weigh(obs_c, view.skin_bins)
         modes = self._pair_modes(t, obs_c) if state == LimbState.COMBINED else ()
         if state != LimbState.LOST:
@@ -393,20 +425,29 @@ class LimbTracker:
         return self._owned(own_c, t, owners)
 
     def _nearest_ends(self, tgt: _Target, state: LimbState, obs_c: Candidates, own_c: Candidates,
-                      before: np.ndarray, prev: np.ndarray | None, n_blobs: int) -> tuple[Candidates, bool]:
+                      before: np.ndarray, prev: np.ndarray | None, n_blobs: int,
+                      tips: bool = True) -> tuple[Candidates, bool]:
         """One end per blob, the one nearest the predicted hand: the other end of its arm is its
         elbow, and a posterior split between both ends would put it mid-arm. Also whether the
-        nearest kept candidate is an arm's end."""
+        nearest kept candidate is an arm's end. ``tips``: the hand sees arm ends (else blob
+        centres, and a cut blob's end away from the cut, which ``tip_gate`` does not drop: a
+        centre never was)."""
         p = self.params
         at = tgt.filter.estimate if state == LimbState.LOST else \
             before if prev is None else before + p.dynamics.velocity_decay * (before - prev)
         ends = np.bincount(own_c.parents, minlength=n_blobs)[obs_c.parents] >= 2
+        if obs_c.ends is not None:  # the one end of a blob cut by the observed region's edge
+            cut_ends = obs_c.ends
+            gated = ends | cut_ends if tips else ends
+            ends = ends | cut_ends
+        else:
+            gated = ends
         keep = nearest_per_parent(obs_c, at)
         if state != LimbState.LOST:
             # an arm's end farther than tip_gate sides is another part of it (an elbow
             # when the hand end merged into another blob): not this hand
             far = np.hypot(*(obs_c.centres - at[None, :]).T) > p.blobs.tip_gate * max(tgt.size)
-            keep &= ~(ends & far)
+            keep &= ~(gated & far)
         obs_c, ends = self._subset(obs_c, keep), ends[keep]
         on_end = bool(ends[int(np.argmin(np.hypot(*(obs_c.centres - at[None, :]).T)))]) if len(obs_c) else False
         return obs_c, on_end
@@ -414,7 +455,11 @@ class LimbTracker:
     def _pair_modes(self, t: int, obs_c: Candidates) -> tuple:
         """The two strongest posterior modes of a combined pair's filter, among its own blobs."""
         s = self.params.states
-        radius = s.mode_search * distance_threshold(s.split_distance, s.split_size, self._side(t))
+        partner = self.machine.partner(t)
+        ids = (self.targets[t].track_id, None if partner is None else self.targets[partner].track_id)
+        search = s.people_mode_search if s.people_mode_search > 0 and None not in ids and ids[0] != ids[1] \
+            else s.mode_search
+        radius = search * distance_threshold(s.split_distance, s.split_size, self._side(t))
         # a kernel as wide as the search: the particles sit on one mode, the other may be far
         f = self.targets[t].filter
         m = candidate_modes(f.particles[:, :2], f.weights, obs_c, radius, radius)
@@ -645,7 +690,8 @@ class LimbTracker:
     def _subset(cands: Candidates, keep: np.ndarray) -> Candidates:
         return Candidates(cands.centres[keep], cands.boxes[keep], cands.areas[keep],
                           {k: v[keep] for k, v in cands.terms.items()}, cands.priors[keep],
-                          None if cands.parents is None else cands.parents[keep])
+                          None if cands.parents is None else cands.parents[keep],
+                          None if cands.ends is None else cands.ends[keep])
 
     def _unclaimed(self, cands: Candidates, exclude: int | tuple, lost: bool = False,
                    pairs: bool = False) -> Candidates:
