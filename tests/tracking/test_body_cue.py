@@ -401,8 +401,8 @@ def test_a_track_measured_on_its_walker_is_not_re_acquired_by_the_one_following_
             tracker = BodyTracker(params, np.random.default_rng(seed), init=_init(truths[0], ids=(1,)))
             now = [0]
 
-            def detect(frame, regions, now=now):
-                if now[0] < params.detector.reacquire_after:
+            def detect(frame, regions, now=now, after=params.detector.reacquire_after):
+                if now[0] < after:
                     return np.zeros((0, 5))
                 b = truths[now[0]][2]["person"]
                 return np.array([[b.x, b.y, b.w, b.h, 1.0]])
