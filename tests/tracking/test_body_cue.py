@@ -8,10 +8,12 @@ from partlab.labelling.synth import make_scene
 from partlab.labelling.synth import scenarios as S
 from partlab.labelling.synth.motion import walk
 from partlab.tracking.body.tracker import BodyTracker
+from partlab.tracking.core.background import BackgroundModel
 from partlab.tracking.core.box import iou_xywh
 from partlab.tracking.core.people import associate, associate_near
 from partlab.tracking.params import BodyParams
-from tests.tracking.test_body import _run
+from partlab.tracking.tracks import records_to_frame
+from tests.tracking.test_body import _init, _rate, _run, _scene
 
 
 def _crossing(rng, camera, n_frames, fps):
@@ -380,3 +382,42 @@ def test_a_track_due_for_re_acquisition_claims_its_persons_detection_from_a_trac
     assert abs(dx) < 3 and a_lost is None and b_lost is not None  # A's track on A, B's lost
     dx, a_lost, b_lost = out[False]
     assert dx < -30 and b_lost is None  # A's track left where it coasted, B's on A
+
+
+def test_a_track_measured_on_its_walker_is_not_re_acquired_by_the_one_following_on_its_path():
+    """``reacquire_against``: two walkers in one coat walk left at 5 px a frame, one 42 px behind
+    the other (PETS09 persons 3 and 4 from frame 528); only the front one is given. The detector
+    never sees the front walker and, from frame 12 on, sees the one behind. The front track,
+    measured on its walker but unmatched for ``reacquire_after`` frames, is due for re-acquisition:
+    without the option it jumps back onto the walker following it (the detection is free, near and
+    of the same colours) and follows him; with it, the detection lies on the path its walker took
+    in the last ``reacquire_after`` frames, against its motion, and the track stays."""
+    coat = dict(shirt=(40, 40, 150), trousers=(60, 60, 60))
+    frames, truths = _scene(n=36, walkers=(dict(x0=220, vx=-5.0, **coat), dict(x0=262, vx=-5.0, **coat)))
+    out = {}
+    for against in (0.0, 0.5):
+        params = BodyParams().updated({"detector.reacquire_against": against})
+        for seed in (0, 1):
+            tracker = BodyTracker(params, np.random.default_rng(seed), init=_init(truths[0], ids=(1,)))
+            now = [0]
+
+            def detect(frame, regions, now=now, after=params.detector.reacquire_after):
+                if now[0] < after:
+                    return np.zeros((0, 5))
+                b = truths[now[0]][2]["person"]
+                return np.array([[b.x, b.y, b.w, b.h, 1.0]])
+
+            tracker.cue.detector.detect = detect
+            bgm = BackgroundModel(params)
+            rows = []
+            for i, f in enumerate(frames):
+                now[0] = i
+                rows.extend(tracker.step(i, f, bgm.apply(f)))
+            tracks = records_to_frame(rows)
+            out[against, seed] = (_rate(tracks, truths, 1, "person", 1)[0], _rate(tracks, truths, 1, "person", 2)[0])
+    for seed in (0, 1):
+        own, other = out[0.0, seed]
+        # measured 0.33 and 0.67: it jumped onto the walker behind at frame 12 and followed him
+        assert own < 0.4 and other > 0.6, (seed, own, other)
+        own, other = out[0.5, seed]
+        assert own >= 0.95 and other < 0.1, (seed, own, other)  # measured 1.0 and 0.0

@@ -296,6 +296,7 @@ class DetectionCue:
                 continue
             reported = t._reported_person_box(person)
             cx, cy = reported.centre
+            heading = self._heading(person, reported)
             best, best_rho = None, p.reacquire_similarity
             f = person.filters["torso" if "torso" in person.filters else next(iter(person.filters))]
             for j in [*free, *(held if person.first else ())]:
@@ -303,6 +304,8 @@ class DetectionCue:
                 dx, dy = det.centre[0] - cx, det.centre[1] - cy
                 if np.hypot(dx, dy) > p.reacquire_distance * det.h:
                     continue
+                if heading is not None and self._on_its_path(heading, dx, dy, det):
+                    continue  # behind a walker its track was measured on: the one following it
                 holder = held.get(j)
                 if any(det.iou(t._reported_person_box(q)) >= p.match_iou for q in t.people.values()
                        if q is not person and q is not holder):
@@ -332,6 +335,34 @@ class DetectionCue:
             self.last_match[person.track_id] = index
             free = [j for j in free if j != best]
         return free
+
+    def _heading(self, person, reported: Box) -> np.ndarray | None:
+        """``reacquire_against``: the velocity of a track measured up to now on its walker alone (not
+        lost, not behind someone, no coasting stretch open, touching nobody, its torso matching its
+        model at least ``occlusion.release_similarity``, a clear match) that moves more than ``STILL``
+        of its height a frame; None for the others (re-acquired anywhere near)."""
+        from partlab.tracking.body.tracker import STILL, _motion
+
+        if self.p.reacquire_against <= 0 or person.lost_since is not None or person.occluded_by is not None:
+            return None
+        if person.coast_start is not None or person.touching:
+            return None  # coasting, or sharing its walker with another track: either may be the wrong one
+        anchor = "torso" if "torso" in person.filters else next(iter(person.filters))
+        if person.scores.get(anchor, 0.0) < self.tracker.params.occlusion.release_similarity:
+            return None
+        v = np.array(_motion(person))
+        if float(np.hypot(*v)) <= STILL * reported.h:
+            return None
+        return v
+
+    def _on_its_path(self, velocity: np.ndarray, dx: float, dy: float, det: Box) -> bool:
+        """``reacquire_against``: a detection ``(dx, dy)`` from the track's centre lies behind it,
+        against its ``velocity``, by more than ``reacquire_against`` of its width, and no further
+        than the track walked in the last ``reacquire_after`` frames: on the path its walker took
+        while the track went on measuring them, where the walker following them is now."""
+        speed = float(np.hypot(*velocity))
+        back = -(dx * velocity[0] + dy * velocity[1]) / speed
+        return self.p.reacquire_against * det.w < back <= self.p.reacquire_after * speed
 
     def _reidentify(self, index: int, dets: np.ndarray, free: list[int], ycc) -> list[int]:
         """``reid_hits``: a free detection no tracked person covers, where a dormant track's person
