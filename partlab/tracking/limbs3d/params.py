@@ -327,9 +327,32 @@ class Limbs3DStates:
     # person, sec. 7.1). Handshake 4 cameras seed 7: person 2's right hand took person 1's when the
     # hands parted (person 1's tracker lagged 230-360 mm off), followed it to person 1 and was
     # combined with it for 56 frames, 930-1040 mm from person 2's head and ~230 mm nearer person 1's.
-    # 0 = off
+    # Off by default (2026-12-06, session hs3d4, with lost_claim_frames): seeds 0-9, 4 cameras seed 7
+    # 106.6 -> 92.8 mm (no longer on another hand), 3 cameras seed 6 -0.6; held-out seeds 10-19 worse:
+    # 4 cameras seed 16 72.4 -> 90.0 mm and one more swap (person 1's head ~300 mm off, the right hand's
+    # home not taken while it reached for the exchange, nearer that head, and the hand sent back to a
+    # stale one), seeds 12, 18, 19 -0.1 to -1.2. 0 = off
     foreign_pair_frames: int = number(0, COUNT)
     foreign_margin: float = number(200.0, POSITIVE)
+    # a lost hand takes, once one has been there this many frames in a row, a candidate of prior >=
+    # start_prior spanning lost_claim_views views or more, within dynamics.hand_reach of its head,
+    # nearer it than every other person's head by lost_claim_margin mm, at least lost_claim_side mm on
+    # the hand's side of its head (along the horizontal line from its person's other hand to it at
+    # their init frame), that no tracked target's prediction is within dynamics.candidate_gate of
+    # (tracker._orphan; our addition: the lost state retrieves the track, sec. 5.2). Handshake 4
+    # cameras seed 4: person 2's right hand was lost at frame 68 and held ~600 mm off while its true
+    # candidate lay 30-40 mm from its hand from frame 113, until its left hand took it (a hand on
+    # another hand). Without the side, the 3-camera seed 2's lost right hand took its left hand's
+    # candidate, ~245 mm on the left of the head (the right hand's own lay ~250 mm on the right).
+    # 2026-12-06 (docs/measurements/limbs3d.md, session hs3d4), seeds 0-9: handshake 4 cameras 54.7 ->
+    # 51.1 mm (seed 4 92.6 -> 55.8, no longer on another hand), 3 cameras 49.5 -> 48.9 (seed 7 50.2
+    # -> 44.6), every other take the same (2 cameras: every candidate spans two views); standing and
+    # seated at 3 and 4 cameras the same; held-out handshake seeds 10-19 at 3 and 4 cameras the same.
+    # 0 = off
+    lost_claim_frames: int = number(3, COUNT)
+    lost_claim_views: int = number(3, POSITIVE_COUNT)
+    lost_claim_margin: float = number(200.0)
+    lost_claim_side: float = number(100.0)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of
