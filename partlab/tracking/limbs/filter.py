@@ -136,21 +136,22 @@ def blob_tips(points: np.ndarray, side: float, span: float, far: float, radius: 
     the centroid round its pixel farthest from the cut.
     """
     pts = np.asarray(points, float).reshape(-1, 2)
-    if cut is not None and np.any(cut) and not np.all(cut):
-        return _uncut_tips(pts, np.asarray(cut, bool), side, span, far, radius, max_tips)
     centre = pts.mean(axis=0)
-    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
-    if np.hypot(*(pts - t1).T).max() < span * side:
+    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]  # the pixel farthest from the centre
+    long = bool(np.hypot(*(pts - t1).T).max() >= span * side)
+    if cut is not None and np.any(cut) and not np.all(cut):
+        raw = _tip_points(pts, centre, t1, side, span, far, max_tips) if long else None
+        return _uncut_tips(pts, np.asarray(cut, bool), raw, side, radius)
+    if not long:
         return centre[None]
-    tips = _tip_points(pts, side, span, far, max_tips)
+    tips = _tip_points(pts, centre, t1, side, span, far, max_tips)
     return np.array([pts[np.hypot(*(pts - t).T) <= radius * side].mean(axis=0) for t in tips])
 
 
-def _tip_points(pts: np.ndarray, side: float, span: float, far: float, max_tips: int) -> np.ndarray:
+def _tip_points(pts: np.ndarray, centre: np.ndarray, t1: np.ndarray, side: float, span: float, far: float,
+                max_tips: int) -> np.ndarray:
     """The outline points :func:`blob_tips` takes its ends round (of a blob at least ``span``
-    sides long)."""
-    centre = pts.mean(axis=0)
-    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
+    sides long; ``centre`` its centroid, ``t1`` its pixel farthest from it)."""
     ends = _outline_maxima(pts, centre, max(int(side / 2), 2))
     tips = [t1]
     mind = np.hypot(*(ends - t1).T)
@@ -165,11 +166,11 @@ def _tip_points(pts: np.ndarray, side: float, span: float, far: float, max_tips:
     return np.array(tips)
 
 
-def _uncut_tips(pts: np.ndarray, cut: np.ndarray, side: float, span: float, far: float, radius: float,
-                max_tips: int) -> np.ndarray:
-    """:func:`blob_tips` of a blob with ``cut`` pixels: its ends whose outline point lies farther
-    than ``CUT_GAP`` pixels from every cut pixel; none such (a short blob, or every end at the
-    cut), the centroid round its pixel farthest from the cut."""
+def _uncut_tips(pts: np.ndarray, cut: np.ndarray, raw: np.ndarray | None, side: float, radius: float) -> np.ndarray:
+    """:func:`blob_tips` of a blob with ``cut`` pixels (``raw``: its ends' outline points,
+    :func:`_tip_points`, None for a short blob): its ends whose outline point lies farther than
+    ``CUT_GAP`` pixels from every cut pixel; none such (a short blob, or every end at the cut),
+    the centroid round its pixel farthest from the cut."""
     x0, y0 = pts.min(axis=0).astype(int)
     xy = pts.astype(int) - np.array([x0, y0])
     img = np.ones((xy[:, 1].max() + 1, xy[:, 0].max() + 1), np.uint8)
@@ -179,10 +180,7 @@ def _uncut_tips(pts: np.ndarray, cut: np.ndarray, side: float, span: float, far:
     def centroid(q: np.ndarray) -> np.ndarray:
         return pts[np.hypot(*(pts - q).T) <= radius * side].mean(axis=0)
 
-    centre = pts.mean(axis=0)
-    t1 = pts[np.argmax(((pts - centre) ** 2).sum(axis=1))]
-    if np.hypot(*(pts - t1).T).max() >= span * side:
-        raw = _tip_points(pts, side, span, far, max_tips)
+    if raw is not None:
         rxy = np.clip(raw.astype(int) - np.array([x0, y0]), 0, np.array(img.shape[::-1]) - 1)
         keep = dist[rxy[:, 1], rxy[:, 0]] > CUT_GAP
         if keep.any():
