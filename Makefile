@@ -8,6 +8,10 @@ PY := $(VENV)/bin/python
 HOST ?= 127.0.0.1
 PORT ?= 8501
 export PARTLAB_DATA ?= $(CURDIR)/partlab-data
+# Installs take the versions in constraints.txt (what the tests and measurements ran with);
+# `make test CONSTRAINTS=` installs the newest releases pyproject.toml allows instead.
+CONSTRAINTS ?= constraints.txt
+PIP_C := $(if $(CONSTRAINTS),-c $(CONSTRAINTS))
 
 .PHONY: run test venv peers clean
 
@@ -15,13 +19,13 @@ $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 
-# Re-install whenever pyproject.toml changes.
-$(VENV)/.installed: pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install --quiet -e .
+# Re-install whenever pyproject.toml or constraints.txt changes.
+$(VENV)/.installed: pyproject.toml $(CONSTRAINTS) | $(VENV)/bin/python
+	$(PY) -m pip install --quiet $(PIP_C) -e .
 	touch $@
 
-$(VENV)/.installed-test: pyproject.toml $(VENV)/.installed
-	$(PY) -m pip install --quiet -e '.[test]'
+$(VENV)/.installed-test: pyproject.toml $(CONSTRAINTS) $(VENV)/.installed
+	$(PY) -m pip install --quiet $(PIP_C) -e '.[test]'
 	# HOTA (optional): trackeval's metadata pins opencv-python, which would overwrite our headless
 	# OpenCV in cv2/; its metrics only need numpy and scipy, so install it without dependencies.
 	$(PY) -m pip install --quiet --no-deps 'trackeval==1.3.0'
