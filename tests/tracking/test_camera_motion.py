@@ -162,3 +162,41 @@ def test_while_the_camera_pans_people_are_looked_for_where_the_scene_moves():
             seen.append(any(r.intersection(walker) >= 0.5 * walker.area for r in scanned[-1][1]))
     assert tracker.camera.moving and len(seen) >= 10
     assert np.mean(seen) >= 0.8
+
+
+def test_while_the_camera_pans_a_measurement_that_leaves_the_walker_for_still_ground_is_undone():
+    """``background.camera_keep_motion``: the camera pans after a walker (nearly still in the image,
+    walking in the scene); a colour measurement that slid the track 40 px off him onto still
+    background (OTB Human3 frame 99: towards a crosser, across the ground between them) leaves
+    less of its box moving in the scene than his own scene motion would: it is undone, the parts
+    coast from where they were and stay on him. A measurement on him is kept; off, nothing is undone."""
+    import pandas as pd
+
+    from partlab.tracking.core.background import BackgroundModel
+    from partlab.tracking.measures import right_box_one
+
+    frames, truths = _panning_scene(n=30)  # the still figure and the sign come in from the right, ahead
+    b = truths[0]["person"]
+    init = pd.DataFrame([dict(frame=0, track_id=1, part="person", x=b.x, y=b.y, w=b.w, h=b.h)])
+    for margin, undone in ((0.2, True), (0.0, False)):
+        tracker = BodyTracker(BodyParams().updated({"background.camera_keep_motion": margin}),
+                              np.random.default_rng(0), init=init)
+        model = BackgroundModel(tracker.params)
+        for i, f in enumerate(frames):
+            tracker.step(i, f, model.apply(f))
+        person = tracker.people[1]
+        assert tracker.camera.moving and right_box_one(person.box(), truths[-1]["person"])
+        v = tracker.scene_velocity(person.centres)
+        assert v is not None and 2.5 < v[0] < 4.5  # he walks right in the scene; the pan carries the image left
+        person.prev = {n: f.state.copy() for n, f in person.filters.items()}
+        assert not tracker._keeps_scene_motion(person)  # measured on him: kept
+        for f in person.filters.values():
+            f.shift(np.array([40.0, 0.0]))  # slid off him onto the still background
+        assert tracker._keeps_scene_motion(person) is undone
+        moved_back = person.filters["torso"].state[0] - person.prev["torso"][0]
+        if undone:
+            assert abs(moved_back) < 3  # coasted on from where it was: his image motion ~0.4 px a frame
+            assert right_box_one(person.box(), truths[-1]["person"])
+        else:
+            assert moved_back == 40.0
+            assert not right_box_one(person.box(), truths[-1]["person"])

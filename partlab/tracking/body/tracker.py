@@ -37,7 +37,7 @@ import numpy as np
 from partlab.tracking.body.cue import DetectionCue, _layout, _placed, border_gaps
 from partlab.tracking.body.decomposition import decompose, minimum_bounding_rectangle, shrink_part
 from partlab.tracking.body.detection import edge_contrast, person_blobs
-from partlab.tracking.body.part_filter import PartFilter, surround_counts
+from partlab.tracking.body.part_filter import PartFilter, state_to_box, surround_counts
 from partlab.tracking.core.box import Box, iou_xywh
 from partlab.tracking.core.camera_motion import CameraMotion, MotionSettings
 from partlab.tracking.core.lazy_ycc import LazyYcc, as_array
@@ -51,6 +51,8 @@ if TYPE_CHECKING:
 
 #: a person moving less than this share of its box height a frame stands still (at a border: leaving)
 STILL = 0.01
+#: frames of camera shifts kept (``BodyTracker.scene_velocity`` reads those of a person's last clean frames)
+SHIFTS = 64
 
 
 @dataclass
@@ -275,6 +277,7 @@ class BodyTracker:
                                                    residual=bg.camera_residual))
                        if bg.camera_motion > 0 else None)
         self.moving_mask: np.ndarray | None = None  # while the camera moves: what moves in the scene
+        self.shifts: dict[int, np.ndarray] = {}  # frame -> the camera's shift (zero while not moving), recent
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -415,6 +418,10 @@ class BodyTracker:
         self.frame_size = (W, H)
         self.frames_seen += 1
         mask = self._follow_camera(frame, foreground)
+        if self.camera is not None:  # the last SHIFTS frames' shifts, for motion in the scene
+            self.shifts[index] = self.camera.shift.copy() if self.camera.moving else np.zeros(2)
+            for k in [k for k in self.shifts if k <= index - SHIFTS]:
+                del self.shifts[k]
         support = mask if mask is not None else self.moving_mask  # foreground support of tracks
         moving = self.camera is not None and self.camera.moving
         new_ids = set()
@@ -585,6 +592,8 @@ class BodyTracker:
                 torso = f.state.copy()
             person.observed[name] = q = f.appearance(ycc)
             person.scores[name] = f.score(q)
+        if visible and self._keeps_scene_motion(person):
+            return
         if person.hidden_parts:
             # hidden parts follow the visible parts' motion (they belong to one body); when all
             # are hidden, the person's own recent motion
@@ -599,6 +608,33 @@ class BodyTracker:
                 f.coast()
             if not visible:
                 self._probe_hidden(person, ycc)
+
+    def _keeps_scene_motion(self, person: Person) -> bool:
+        """``background.camera_keep_motion``: while the camera moves, a measurement that left the
+        person where less moves in the scene (the share of its person box in the moving mask) than
+        where its own motion in the scene (:meth:`scene_velocity` of its last clean frames) plus the
+        camera's shift would have put it, by more than ``camera_keep_motion``, is undone: every part
+        goes back to where it was and coasts this frame there, its models not updated. Where two
+        walkers pass each other, the colour models slide off the tracked one towards the other
+        across the still ground between them. Whether it was undone."""
+        margin = self.params.background.camera_keep_motion
+        mask = self.moving_mask
+        if margin <= 0 or mask is None or self.camera is None or not self.camera.moving or not person.prev:
+            return False
+        v = self.scene_velocity(person.centres)
+        if v is None:
+            return False
+        now = v + self.camera.shift
+        before = minimum_bounding_rectangle(state_to_box(s) for s in person.prev.values())
+        coasted = Box(before.x + float(now[0]), before.y + float(now[1]), before.w, before.h)
+        if _support(mask, coasted) <= _support(mask, person.box()) + margin:
+            return False
+        for name, f in person.filters.items():
+            f.state = person.prev[name].copy()
+            f.set_velocity(now)
+            f.coast()
+        person.observed.clear()
+        return True
 
     def _probe_anchor(self, person: Person, ycc: np.ndarray, mask: np.ndarray | None = None):
         """The person's torso (or only part) model searched for around its state: ``(filter,
@@ -885,6 +921,22 @@ class BodyTracker:
     def _rewinds(self, mask: np.ndarray | None) -> bool:
         """``background.camera_rewind`` applies: the support is the moving camera's scene motion."""
         return self.params.background.camera_rewind and mask is not None and mask is self.moving_mask
+
+    def scene_velocity(self, centres) -> np.ndarray | None:
+        """Median per-frame motion in the scene of ``(frame, cx, cy)`` entries: each step's image
+        motion less the camera's shifts over it (:attr:`shifts`); None if fewer than three or a
+        step's shifts are no longer known."""
+        if len(centres) < 3:
+            return None
+        c = np.asarray(centres, dtype=np.float64)
+        steps = []
+        for (f0, x0, y0), (f1, x1, y1) in zip(c[:-1], c[1:]):
+            frames = range(int(f0) + 1, int(f1) + 1)
+            if any(k not in self.shifts for k in frames):
+                return None
+            carried = np.sum([self.shifts[k] for k in frames], axis=0)
+            steps.append((np.array([x1 - x0, y1 - y0]) - carried) / (f1 - f0))
+        return np.median(np.asarray(steps), axis=0)
 
     def _rewind(self, person: Person, index: int) -> np.ndarray:
         """``background.camera_rewind``: a person that just went lost coasts on from where it was
