@@ -340,7 +340,7 @@ def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
     out = handovers(rows, P)
     assert len(out) == 1  # the handshake over the handover is its touch, not an activity of its own
     ex = out[0]
-    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 125)
+    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 100)  # ``handover_giver``
     assert (ex["track_id_a"], ex["part_a"], ex["track_id_b"], ex["part_b"]) == (1, "right_hand", 2, "left_hand")
     assert ex["confidence"] == pytest.approx(0.7)
     # the taker may have stood still just before the giver did (its pick is read after it)
@@ -361,6 +361,19 @@ def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
     # two picks of the colour: the nearer in time takes it, the other stays a pick
     out = handovers([rows[0], _one_hand("pick", 112, 125, 3, green), _one_hand("pick", 103, 120, 2, green)], P)
     assert sorted((r["kind"], r["track_id_b"]) for r in out) == [("exchange", 2), ("pick", 0)]
+
+
+def test_a_handover_lasts_while_the_giver_holds_the_object_out_not_while_the_taker_stands_after():
+    # limbs3d, 3-camera handshake seed 8: the giver's place 99-111 (the true exchange 97-110), the
+    # taker's pick 118-138, where it stood still with the object after it had been passed: one
+    # exchange 99-138 before ``handover_giver`` (IoU 0.32), 99-111 now
+    rows = [_one_hand("place", 99, 111, 1, 89, part="left_hand"), _one_hand("pick", 118, 138, 2, 90)]
+    assert [(r["kind"], r["start_frame"], r["end_frame"]) for r in handovers(rows, P)] == [("exchange", 99, 111)]
+    off = P.updated({"decision.handover_giver": False})
+    assert [(r["start_frame"], r["end_frame"]) for r in handovers(rows, off)] == [(99, 138)]
+    # still moments that overlap: the exchange spans both
+    both = [rows[0], _one_hand("pick", 105, 120, 2, 90)]
+    assert [(r["start_frame"], r["end_frame"]) for r in handovers(both, P)] == [(99, 120)]
 
 
 def test_temporal_matching():

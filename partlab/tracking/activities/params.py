@@ -223,6 +223,11 @@ class Decision:
     # frames later (a handover whose hands the tracker never brings together: a short moment where
     # nobody seems to hold it) was given, one exchange; a handshake of the two over it is dropped
     handover_gap: int = number(15, POSITIVE_COUNT)
+    # a handover whose taker stood still only after the giver's still moment ended lasts as the
+    # giver's: the object was passed while the giver held it out, and the taker's stop after is
+    # holding it (limbs3d, 3-camera handshake seed 8: place 99-111, pick 118-138, read 99-138
+    # against the true 97-110). Off: to the later of the two ends
+    handover_giver: bool = flag(True)
     # ... and where the two hands stood still at most this many hand sides apart (the object goes
     # from hand to hand; a place on one table and a pick by someone else at another are not a
     # handover). The handovers of the 3-camera handshake takes (limbs3d hands, seeds 0-9): 0.1-1.7

@@ -883,7 +883,8 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     up to ``handover_gap`` frames *before* the giver's starts: its pick is read after it, where the
     hand moved on to take the object (limbs3d, handshake seed 3: the taker stood still over 59-67,
     took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
-    with the giver's still moment and ends with the later of the two, goes from the placing hand
+    with the giver's still moment and ends with the later of the two (the giver's where the
+    taker's began after it ended, ``handover_giver``), goes from the placing hand
     (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
     the two people overlapping it is dropped (the touch of the handover). The two hands must have
     stood still within ``handover_reach`` hand sides of each other (rows' ``at``, where known).
@@ -908,7 +909,10 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
             continue
         used |= {i, j}
         give, take = rows[i], rows[j]
-        exchanges.append(dict(start_frame=give["start_frame"], end_frame=max(give["end_frame"], take["end_frame"]),
+        end = max(give["end_frame"], take["end_frame"])
+        if d.handover_giver and take["start_frame"] > give["end_frame"]:
+            end = give["end_frame"]  # the taker stood still with the object after it was passed
+        exchanges.append(dict(start_frame=give["start_frame"], end_frame=end,
                               kind="exchange", track_id_a=give["track_id_a"], part_a=give["part_a"],
                               track_id_b=take["track_id_a"], part_b=take["part_a"], ended_by="still",
                               object_colour=give["object_colour"], hue=give.get("hue"),
