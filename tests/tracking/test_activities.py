@@ -376,6 +376,24 @@ def test_a_handover_lasts_while_the_giver_holds_the_object_out_not_while_the_tak
     assert [(r["start_frame"], r["end_frame"]) for r in handovers(both, P)] == [(99, 120)]
 
 
+def test_one_object_given_by_one_hand_is_one_exchange():
+    # limbs3d, 3-camera handshake seed 5: the giver's (person 1's left hand) place and the taker's
+    # pick 91-108 (truth 90-107) and a touch of the giver's hand with the taker's other hand read
+    # as an exchange 101-110: two exchanges of one object before ``one_exchange``
+    touch = dict(start_frame=101, end_frame=110, kind="exchange", track_id_a=1, part_a="left_hand", track_id_b=2,
+                 part_b="left_hand", ended_by="contact", object_colour="#cfdc1e", confidence=0.997)
+    rows = [_one_hand("pick", 91, 108, 2, 31, confidence=1.0), touch,
+            _one_hand("place", 91, 108, 1, 31, part="left_hand", confidence=1.0)]
+    out = handovers(rows, P)
+    assert [(r["kind"], r["start_frame"], r["end_frame"], r["part_b"]) for r in out] == [
+        ("exchange", 91, 108, "right_hand")]
+    off = handovers(rows, P.updated({"decision.one_exchange": False}))
+    assert sorted((r["start_frame"], r["end_frame"]) for r in off) == [(91, 108), (101, 110)]
+    # an exchange of other hands at another time stays
+    later = dict(touch, start_frame=120, end_frame=130)
+    assert len(handovers(rows[:1] + [later] + rows[2:], P)) == 2
+
+
 def test_temporal_matching():
     assert temporal_iou((10, 19), (15, 24)) == pytest.approx(5 / 15)
     truth = pd.DataFrame(dict(kind=["pick", "place"], start_frame=[10, 50], end_frame=[20, 60]))

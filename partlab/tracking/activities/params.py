@@ -228,6 +228,11 @@ class Decision:
     # holding it (limbs3d, 3-camera handshake seed 8: place 99-111, pick 118-138, read 99-138
     # against the true 97-110). Off: to the later of the two ends
     handover_giver: bool = flag(True)
+    # an exchange read from a handover and one read from a touch that share a hand and overlap by
+    # more than half of the shorter are one (the more confident kept), as activities of one kind
+    # read by several pairs of hands are (limbs3d, 3-camera handshake seed 5: the giver's place and
+    # the taker's pick 91-108 and a touch of the giver's hand with the taker's other hand 101-110)
+    one_exchange: bool = flag(True)
     # ... and where the two hands stood still at most this many hand sides apart (the object goes
     # from hand to hand; a place on one table and a pick by someone else at another are not a
     # handover). The handovers of the 3-camera handshake takes (limbs3d hands, seeds 0-9): 0.1-1.7

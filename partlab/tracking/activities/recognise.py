@@ -888,7 +888,9 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
     the two people overlapping it is dropped (the touch of the handover). The two hands must have
     stood still within ``handover_reach`` hand sides of each other (rows' ``at``, where known).
-    Each place and each pick gives at most one exchange, the nearest in time first."""
+    Each place and each pick gives at most one exchange, the nearest in time first; an exchange
+    that shares a hand with another and overlaps it by more than half of the shorter is the same
+    one, the more confident kept (``one_exchange``)."""
     d = params.decision
     reach = d.same_colour / DEGREES_PER_BIN
 
@@ -925,4 +927,7 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
                                                                      (e["start_frame"], e["end_frame"])) > 0
             for e in exchanges)
 
-    return [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
+    out = [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
+    # one object given by one hand is one exchange: a handover's and one read from a touch of the
+    # giver's hand with another of the taker's (``decision.one_exchange``; :func:`_distinct`)
+    return _distinct(out) if d.one_exchange else out
