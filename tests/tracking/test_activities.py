@@ -292,6 +292,37 @@ def test_a_3d_touch_carried_away_from_where_the_hands_met_ends_there():
     assert temporal_iou((96, 139), (93, 107)) < 0.5
 
 
+def test_a_hand_held_out_to_another_person_whose_hand_was_lost_is_a_touch():
+    from partlab.tracking.activities.recognise import held_out_joins
+
+    # limbs3d, 3-camera handshake seed 0 (mm): heads 600 mm apart; person 2's right hand held out
+    # half way (0, 10, 1140) over 35-62, person 1's right hand lost from 39 (truth 36-59)
+    def rows(lost_from=39, reach=0.0):
+        out = []
+        for f in range(20, 80):
+            out += [_3d_row(f, 1, "head", (-300.0, 0.0, 1500.0)), _3d_row(f, 2, "head", (300.0, 0.0, 1500.0)),
+                    _3d_row(f, 1, "left_hand", (-280.0, 250.0, 950.0)),
+                    _3d_row(f, 2, "left_hand", (270.0, -150.0, 970.0)),
+                    _3d_row(f, 2, "right_hand", (reach, 10.0, 1140.0) if 35 <= f <= 62 else (280.0, 260.0, 950.0))]
+            if f < lost_from:
+                out.append(_3d_row(f, 1, "right_hand", (-290.0, -250.0, 850.0)))
+        return pd.DataFrame(out)
+
+    none = pd.DataFrame(columns=["start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b"])
+    found = held_out_joins(rows(), none, P)
+    assert found[["start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]] \
+        .values.tolist() == [[35, 62, 2, "right_hand", 1, "right_hand", "held_out"]]
+    assert temporal_iou((35, 62), (36, 59)) >= 0.5
+    # the other person's hands seen all along (not lost: no touch), a hand only a quarter of the way
+    # (at rest by its person), a touch already read, or a hand not as far as ``held_out``: nothing
+    assert held_out_joins(rows(lost_from=80), none, P).empty
+    assert held_out_joins(rows(reach=150.0), none, P).empty
+    touch = pd.DataFrame([dict(start_frame=40, end_frame=45, track_id_a=1, part_a="left_hand", track_id_b=2,
+                               part_b="right_hand")])
+    assert held_out_joins(rows(), touch, P).empty
+    assert held_out_joins(rows(), none, P.updated({"decision.held_out": 0.6})).empty
+
+
 def test_two_3d_touches_at_different_places_are_two_activities():
     # limbs3d, 3-camera handshake seed 1 (mm): the handshake's touch 31-60 at (-3, -30, 1064);
     # person 1's hand then passes person 2's hand, left where a false split threw it, 245 mm away

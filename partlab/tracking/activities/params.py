@@ -160,6 +160,14 @@ class Decision:
     # (truth 30-57), now 31-60. One camera (no 3D): unchanged (in one view's boxes of 15-30 px hands
     # 1.5 split held-out handshake 18's touches). 0: off
     meeting_reach: float = number(1.5)
+    # with 3D positions, a person's hand held out at least this share of the way from their head to
+    # another person's (along the heads' line) over ``still_frames`` frames or more, with no touch
+    # read, while one of the other's hands is unseen over half of them, touches that hand: the
+    # tracker lost it at the meeting (limbs3d, 3-camera handshake seeds 0, 5-8: one hand lost or
+    # thrown for the whole handshake, the other held out at the meeting 0.49-0.56 of the way;
+    # hands at rest lie at 0.0-0.44). Seeds 0-9 handshake 0.30 -> 0.80 recall (0.40: 0.90, one
+    # false; 0.50: 0.70, one false). One camera: no 3D, off by construction. 0: off
+    held_out: float = number(0.45, FRACTION)
     # activities less sure than this are not reported (a hand unseen at a decision point: Table 1
     # needs both; colour around both hands that keeps a two-hand touch from being read)
     min_confidence: float = number(0.4, FRACTION)
