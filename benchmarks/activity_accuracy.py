@@ -12,17 +12,26 @@ seated with a clap, handshake with a handshake and an exchange), hands from ``--
 views, eq. 29) from the truth's first frame; the colour analysis reads each view's silhouettes
 against the take's empty-scene images, with tracked or true hands.
 
+``--cache DIR`` keeps each run's hands and the colour seen round them (the state of
+:class:`~partlab.tracking.activities.recognise.ActivityTracker` before the recognition) per
+scene, seed, cameras and hands, and later runs re-run only the recognition from it: changes of
+``decision.*`` parameters are then measured in seconds (a 3-camera take takes minutes to track).
+Other ``--set`` changes are part of the cache's key.
+
 ``--hands truth`` feeds the recognition the scene's true head and hand boxes instead of the limb
 tracker's (what the recognition gets right when the hands are right); ``--hands both`` runs both,
 which separates the recognition's errors from the hand tracker's.
 
     python benchmarks/activity_accuracy.py [--seeds 0-9] [--size 720x480] [--frames 150] [--hands tracked|truth|both]
                                            [--cameras 3] [--set GROUP.NAME=VALUE ...] [--dump DIR]
+                                           [--cache DIR]
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
+import pickle
 import sys
 import time
 from pathlib import Path
@@ -80,17 +89,70 @@ class TruthHands:
         return records_to_frame(records)
 
 
+STATE = ("_colours", "_centres", "_clothes", "_clothes_n", "_where")
+
+
+def cache_path(cache: Path | None, name: str, seed: int, cameras: int, hands: str, changes: dict | None) -> Path | None:
+    """Where a run's tracks and colours are kept (``--cache``): one file per scene, seed, cameras,
+    hands and the ``--set`` changes other than the recognition's decision parameters."""
+    if cache is None:
+        return None
+    kept = sorted(f"{k}={v}" for k, v in (changes or {}).items() if not k.startswith("decision."))
+    tag = hashlib.sha1(";".join(kept).encode()).hexdigest()[:8] if kept else "defaults"
+    return cache / f"{name}_{seed}_{cameras}cam_{hands}_{tag}.pkl"
+
+
+def run_cached(path: Path | None, run, activity_params,
+               frames: int) -> tuple[pd.DataFrame, pd.DataFrame, float]:
+    """The activities of one run: ``run()`` (which returns the ActivityTracker it ran, its tracks
+    and the scene's true events), its state kept at ``path``; or, where ``path`` holds one, the
+    recognition alone (with ``activity_params``) on the kept state. Returns the true events, the
+    activities found and seconds per frame."""
+    from partlab.tracking.activities.recognise import ActivityTracker
+
+    if path is not None and path.exists():
+        with path.open("rb") as fh:
+            kept = pickle.load(fh)
+        inner = SimpleNamespace(table=lambda records: kept["tracks"], events=kept["joins"], params=None)
+        tracker = ActivityTracker(inner, activity_params)
+        for k in STATE:
+            getattr(tracker, k).update(kept[k])
+        t0 = time.perf_counter()
+        tracker.table([])
+        return kept["truth"], tracker.events, (time.perf_counter() - t0) / frames
+    t0 = time.perf_counter()
+    tracker, tracks, truth = run()
+    spf = (time.perf_counter() - t0) / frames
+    if path is not None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        kept = {k: {key: (dict(v) if isinstance(v, dict) else v) for key, v in getattr(tracker, k).items()}
+                for k in STATE}
+        kept.update(tracks=tracks, joins=getattr(tracker.inner, "events", None), truth=truth)
+        with path.open("wb") as fh:
+            pickle.dump(kept, fh)
+    return truth, tracker.events, spf
+
+
 def run_take(name: str, seed: int, frames: int, cameras: int, hands: str,
-             changes: dict | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
+             changes: dict | None = None, cache: Path | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
     """One 3-camera take (640x480, in memory): activities from limbs3d's heads and hands (its
-    parameters with ``changes``, ``{"group.field": value}``), or the truth's."""
+    parameters with ``changes``, ``{"group.field": value}``; ``decision.*`` ones are the
+    recognition's), or the truth's."""
     from partlab.labelling.synth.multiview import make_multiview_scene
     from partlab.tracking.activities import with_activities
     from partlab.tracking.frame import Frame
 
+    changes = dict(changes or {})
+    params = model_params(None, "activities")
+    decision = {k: v for k, v in changes.items() if k.startswith("decision.")}
+    if decision:
+        params = params.updated({k: _value(params.get(k), v) for k, v in decision.items()})
+    changes = {k: v for k, v in changes.items() if k not in decision}
+    path = cache_path(cache, name, seed, cameras, hands, changes)
+    if path is not None and path.exists():
+        return run_cached(path, None, params, frames)
     scene = make_multiview_scene(name, cameras, seed, frames, 640, 480)
     cams = {c.name: c for c in scene.cameras}
-    params = model_params(None, "activities")
     if hands == "truth":
         tracker = with_activities(TruthHands(scene.truth), params, scene.backgrounds)
     else:
@@ -102,10 +164,8 @@ def run_take(name: str, seed: int, frames: int, cameras: int, hands: str,
         inner = Limbs3DTracker(limbs3d, np.random.default_rng(seed), cams, init=scene.init,
                                backgrounds=scene.backgrounds)
         tracker = with_activities(inner, params, scene.backgrounds)
-    t0 = time.perf_counter()
     sets = (FrameSet(i, {c: Frame(i, scene.frames[c][i], None, c, cams[c]) for c in cams}) for i in range(frames))
-    run_frames(tracker, sets, None)
-    return scene.events, tracker.events, (time.perf_counter() - t0) / frames
+    return run_cached(path, lambda: (tracker, run_frames(tracker, sets, None), scene.events), params, frames)
 
 
 def _value(default, text: str):
@@ -129,9 +189,12 @@ def one_camera_model(changes: dict | None) -> SimpleNamespace | None:
 
 def run_one(name: str, seed: int, frames: int, width: int, height: int,
             hands: str = "tracked", changes: dict | None = None,
-            dump: Path | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
-    scene = make_scene(name, seed=seed, n_frames=frames, width=width, height=height)
+            dump: Path | None = None, cache: Path | None = None) -> tuple[pd.DataFrame, pd.DataFrame, float]:
     model = one_camera_model(changes)
+    path = cache_path(cache, name, seed, 1, hands, changes)
+    if path is not None and path.exists() and dump is None:
+        return run_cached(path, None, model_params(model, "activities"), frames)
+    scene = make_scene(name, seed=seed, n_frames=frames, width=width, height=height)
     if hands == "truth":
         from partlab.tracking.activities import with_activities
 
@@ -144,6 +207,8 @@ def run_one(name: str, seed: int, frames: int, width: int, height: int,
     out = run_frames(tracker, (FrameSet.single(i, f) for i, f in enumerate(scene.frames)),
                      lambda s: BackgroundModel(body))
     spf = (time.perf_counter() - t0) / frames
+    if path is not None and not path.exists():
+        run_cached(path, lambda: (tracker, out, scene.events), None, frames)
     if dump is not None:  # tracks, truth and events of the scene, to trace an event by hand
         dump.mkdir(parents=True, exist_ok=True)
         out.to_csv(dump / f"{name}_{seed}_{hands}_tracks.csv", index=False)
@@ -197,6 +262,9 @@ def main() -> int:
                          "recognition's (e.g. skin.keep_min_side=12)")
     ap.add_argument("--dump", type=Path, default=None,
                     help="one camera: write each scene's tracks, truth and events here as CSV")
+    ap.add_argument("--cache", type=Path, default=None,
+                    help="keep each run's hands and colours here, and re-run only the recognition "
+                         "where they are kept (decision.* changes; other --set changes are in the key)")
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
     for hands in (("tracked", "truth") if args.hands == "both" else (args.hands,)):
@@ -211,10 +279,10 @@ def report(args, w: int, h: int, hands: str) -> None:
         for name in SCENES if args.cameras == 1 else SCENES_3D:
             if args.cameras == 1:
                 truth, pred, s = run_one(name, seed, args.frames, w, h, hands,
-                                         dict(a.split("=", 1) for a in args.set), args.dump)
+                                         dict(a.split("=", 1) for a in args.set), args.dump, args.cache)
             else:
                 truth, pred, s = run_take(name, seed, args.frames, args.cameras, hands,
-                                          dict(a.split("=", 1) for a in args.set))
+                                          dict(a.split("=", 1) for a in args.set), args.cache)
             spf.append(s)
             truth = truth.assign(clip=f"{name}/{seed}")
             pred = pred.assign(clip=f"{name}/{seed}")

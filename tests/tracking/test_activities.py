@@ -248,6 +248,101 @@ def test_a_3d_touch_is_read_from_the_hand_that_stayed_when_the_other_jumps_off_o
                                 replace(P, decision=replace(P.decision, stayed_hand=False))))
 
 
+def test_a_hand_that_drifts_slowly_while_it_takes_an_object_stands_still():
+    # one camera, pick_place seed 11 (28 px hand): the hand stops at the object over 25-53 but
+    # its estimate drifts about 1.5 px a frame for a few frames (0.054 hand sides); with a 0.05
+    # speed the stop broke in two (25-34 and 40-53) and the pick was read over 40-53 only (IoU
+    # 0.48 with the true 25-53)
+    def x(f):
+        return 250.0 - 12 * (f - 13) if f < 25 else 187.0 if f <= 33 else 187.0 - 1.5 * (f - 33) if f < 41 \
+            else 175.0 if f <= 53 else 175.0 + 8 * (f - 53)
+
+    centres = {f: (x(f), 280.0, 28.0) for f in range(13, 70)}
+    (s0, s1), = [r for r in still_moments(centres, P) if r[0] < 60]
+    assert s0 <= 26 and s1 >= 52
+    slower = P.updated({"decision.still_speed": 0.05})
+    halves = [r for r in still_moments(centres, slower) if r[0] < 60]
+    assert len(halves) == 2 and halves[1][0] >= 40
+
+
+def _3d_row(f, t, part, xyz):
+    return dict(frame=f, track_id=t, part=part, x=100 * t, y=100, w=10, h=10, camera="cam0",
+                X=xyz[0], Y=xyz[1], Z=xyz[2])
+
+
+def test_a_3d_touch_carried_away_from_where_the_hands_met_ends_there():
+    # limbs3d, 3-camera handshake seed 4 (mm): person 1's left and person 2's right hand join at
+    # (-36, -221, 1106) over 96-108 (truth: the exchange 93-107); the tracker then carries the one
+    # joined estimate to person 1's side (297, -312, 881) by 116 and throws person 2's hand off at
+    # 122, person 1's staying there: read 96-135 without ``meeting_reach``
+    meet, home = np.array([-36.0, -221.0, 1106.0]), np.array([297.0, -312.0, 881.0])
+    rows = []
+    for f in range(90, 140):
+        p1 = meet + (96 - f) * np.array([-70.0, 35.0, 0.0]) if f < 96 else meet if f <= 108 \
+            else meet + min(1.0, (f - 108) / 8) * (home - meet)
+        p2 = meet + (96 - f) * np.array([70.0, -35.0, 0.0]) if f < 96 else p1 if f <= 121 \
+            else np.array([-340.0, -200.0, 870.0])
+        rows += [_3d_row(f, 1, "left_hand", p1), _3d_row(f, 2, "right_hand", p2)]
+    tracks = pd.DataFrame(rows)
+    found = contacts(tracks, P)[["start_frame", "end_frame"]].values.tolist()
+    assert found == [[96, 111]]  # 202 mm (1.5 x 135) from the meeting at 112
+    assert temporal_iou((96, 111), (93, 107)) >= 0.5
+    off = contacts(tracks, P.updated({"decision.meeting_reach": 0.0}))[["start_frame", "end_frame"]]
+    assert off.values.tolist() == [[96, 139]]
+    assert temporal_iou((96, 139), (93, 107)) < 0.5
+
+
+def test_a_hand_held_out_to_another_person_whose_hand_was_lost_is_a_touch():
+    from partlab.tracking.activities.recognise import held_out_joins
+
+    # limbs3d, 3-camera handshake seed 0 (mm): heads 600 mm apart; person 2's right hand held out
+    # half way (0, 10, 1140) over 35-62, person 1's right hand lost from 39 (truth 36-59)
+    def rows(lost_from=39, reach=0.0):
+        out = []
+        for f in range(20, 80):
+            out += [_3d_row(f, 1, "head", (-300.0, 0.0, 1500.0)), _3d_row(f, 2, "head", (300.0, 0.0, 1500.0)),
+                    _3d_row(f, 1, "left_hand", (-280.0, 250.0, 950.0)),
+                    _3d_row(f, 2, "left_hand", (270.0, -150.0, 970.0)),
+                    _3d_row(f, 2, "right_hand", (reach, 10.0, 1140.0) if 35 <= f <= 62 else (280.0, 260.0, 950.0))]
+            if f < lost_from:
+                out.append(_3d_row(f, 1, "right_hand", (-290.0, -250.0, 850.0)))
+        return pd.DataFrame(out)
+
+    none = pd.DataFrame(columns=["start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b"])
+    found = held_out_joins(rows(), none, P)
+    assert found[["start_frame", "end_frame", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]] \
+        .values.tolist() == [[35, 62, 2, "right_hand", 1, "right_hand", "held_out"]]
+    assert temporal_iou((35, 62), (36, 59)) >= 0.5
+    # the other person's hands seen all along (not lost: no touch), a hand only a quarter of the way
+    # (at rest by its person), a touch already read, or a hand not as far as ``held_out``: nothing
+    assert held_out_joins(rows(lost_from=80), none, P).empty
+    assert held_out_joins(rows(reach=150.0), none, P).empty
+    touch = pd.DataFrame([dict(start_frame=40, end_frame=45, track_id_a=1, part_a="left_hand", track_id_b=2,
+                               part_b="right_hand")])
+    assert held_out_joins(rows(), touch, P).empty
+    assert held_out_joins(rows(), none, P.updated({"decision.held_out": 0.6})).empty
+
+
+def test_two_3d_touches_at_different_places_are_two_activities():
+    # limbs3d, 3-camera handshake seed 1 (mm): the handshake's touch 31-60 at (-3, -30, 1064);
+    # person 1's hand then passes person 2's hand, left where a false split threw it, 245 mm away
+    # (63-82), and again at 107-110, 140 mm from there: merged (``merge_gap``) into one handshake
+    # 31-110 (truth 30-57); now the handshake's touch stays apart from the two passes
+    def join(start, end, at):
+        return dict(start_frame=start, end_frame=end, kind="handshake", track_id_a=1, part_a="right_hand",
+                    track_id_b=2, part_b="right_hand", ended_by="contact", meet=(np.array(at), 135.0))
+
+    joins = pd.DataFrame([join(31, 60, (-3.0, -30.0, 1064.0)), join(63, 82, (-160.0, -205.0, 1027.0)),
+                          join(107, 110, (-45.0, -252.0, 963.0))])
+    spans = [(j["start_frame"], j["end_frame"]) for j in merged_joins(joins, P)]
+    assert spans == [(31, 60), (63, 110)]
+    # touches at one place (a handshake's several contacts) are one, and without the rule all are
+    assert [(j["start_frame"], j["end_frame"]) for j in merged_joins(
+        joins.assign(meet=[(np.array((-3.0, -30.0, 1064.0)), 135.0)] * 3), P)] == [(31, 110)]
+    off = P.updated({"decision.meeting_reach": 0.0})
+    assert [(j["start_frame"], j["end_frame"]) for j in merged_joins(joins, off)] == [(31, 110)]
+
+
 def test_what_one_view_shows_all_along_is_told_from_what_every_view_lost():
     from partlab.tracking.activities.recognise import _one_view_mass
 
@@ -276,7 +371,7 @@ def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
     out = handovers(rows, P)
     assert len(out) == 1  # the handshake over the handover is its touch, not an activity of its own
     ex = out[0]
-    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 125)
+    assert (ex["kind"], ex["start_frame"], ex["end_frame"]) == ("exchange", 90, 100)  # ``handover_giver``
     assert (ex["track_id_a"], ex["part_a"], ex["track_id_b"], ex["part_b"]) == (1, "right_hand", 2, "left_hand")
     assert ex["confidence"] == pytest.approx(0.7)
     # the taker may have stood still just before the giver did (its pick is read after it)
@@ -297,6 +392,37 @@ def test_a_place_then_another_persons_pick_of_that_colour_is_one_exchange():
     # two picks of the colour: the nearer in time takes it, the other stays a pick
     out = handovers([rows[0], _one_hand("pick", 112, 125, 3, green), _one_hand("pick", 103, 120, 2, green)], P)
     assert sorted((r["kind"], r["track_id_b"]) for r in out) == [("exchange", 2), ("pick", 0)]
+
+
+def test_a_handover_lasts_while_the_giver_holds_the_object_out_not_while_the_taker_stands_after():
+    # limbs3d, 3-camera handshake seed 8: the giver's place 99-111 (the true exchange 97-110), the
+    # taker's pick 118-138, where it stood still with the object after it had been passed: one
+    # exchange 99-138 before ``handover_giver`` (IoU 0.32), 99-111 now
+    rows = [_one_hand("place", 99, 111, 1, 89, part="left_hand"), _one_hand("pick", 118, 138, 2, 90)]
+    assert [(r["kind"], r["start_frame"], r["end_frame"]) for r in handovers(rows, P)] == [("exchange", 99, 111)]
+    off = P.updated({"decision.handover_giver": False})
+    assert [(r["start_frame"], r["end_frame"]) for r in handovers(rows, off)] == [(99, 138)]
+    # still moments that overlap: the exchange spans both
+    both = [rows[0], _one_hand("pick", 105, 120, 2, 90)]
+    assert [(r["start_frame"], r["end_frame"]) for r in handovers(both, P)] == [(99, 120)]
+
+
+def test_one_object_given_by_one_hand_is_one_exchange():
+    # limbs3d, 3-camera handshake seed 5: the giver's (person 1's left hand) place and the taker's
+    # pick 91-108 (truth 90-107) and a touch of the giver's hand with the taker's other hand read
+    # as an exchange 101-110: two exchanges of one object before ``one_exchange``
+    touch = dict(start_frame=101, end_frame=110, kind="exchange", track_id_a=1, part_a="left_hand", track_id_b=2,
+                 part_b="left_hand", ended_by="contact", object_colour="#cfdc1e", confidence=0.997)
+    rows = [_one_hand("pick", 91, 108, 2, 31, confidence=1.0), touch,
+            _one_hand("place", 91, 108, 1, 31, part="left_hand", confidence=1.0)]
+    out = handovers(rows, P)
+    assert [(r["kind"], r["start_frame"], r["end_frame"], r["part_b"]) for r in out] == [
+        ("exchange", 91, 108, "right_hand")]
+    off = handovers(rows, P.updated({"decision.one_exchange": False}))
+    assert sorted((r["start_frame"], r["end_frame"]) for r in off) == [(91, 108), (101, 110)]
+    # an exchange of other hands at another time stays
+    later = dict(touch, start_frame=120, end_frame=130)
+    assert len(handovers(rows[:1] + [later] + rows[2:], P)) == 2
 
 
 def test_temporal_matching():

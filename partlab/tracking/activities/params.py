@@ -151,6 +151,24 @@ class Decision:
     # joins of the same two hands this close in time are one activity (three claps, a shake with
     # a few contacts): frames between one separation and the next join
     merge_gap: int = number(30, POSITIVE_COUNT)
+    # with 3D positions (a multi-camera tracker), the touches of one activity of two people are at
+    # one place: a touch ends where both hands are farther than this many ``contact_mm`` from where
+    # they met, and joins of a pair that met farther apart than that are not merged (``merge_gap``).
+    # limbs3d, 3-camera handshake seed 4: the joined pair carried 340 mm back to one person's side,
+    # read 95-135 against the true exchange's 93-107, now 95-111; seed 1: the handshake's touch and
+    # a hand passing the other's estimate, left 245 mm away by a false split, merged into 31-110
+    # (truth 30-57), now 31-60. One camera (no 3D): unchanged (in one view's boxes of 15-30 px hands
+    # 1.5 split held-out handshake 18's touches). 0: off
+    meeting_reach: float = number(1.5)
+    # with 3D positions, a person's hand held out at least this share of the way from their head to
+    # another person's (along the heads' line) over ``still_frames`` frames or more, with no touch
+    # read, while one of the other's hands is unseen over half of them, touches that hand: the
+    # tracker lost it at the meeting (limbs3d, 3-camera handshake seeds 0, 5-8: one hand lost or
+    # thrown for the whole handshake, the other held out at the meeting 0.49-0.56 of the way;
+    # hands at rest lie at 0.0-0.44). Seeds 0-9 handshake 0.30 -> 0.80 recall (0.40: 0.90, one
+    # false; 0.50: 0.70, one false); held out 10-19 0.40 -> 0.60, and one exchange whose hands
+    # were both lost read as a handshake (seed 12). One camera: no 3D, off by construction. 0: off
+    held_out: float = number(0.45, FRACTION)
     # activities less sure than this are not reported (a hand unseen at a decision point: Table 1
     # needs both; colour around both hands that keeps a two-hand touch from being read)
     min_confidence: float = number(0.4, FRACTION)
@@ -174,9 +192,21 @@ class Decision:
     # the tracker split before the handover were read as handshakes, one as a clap
     object_at_touch: bool = flag(True)
     # a still moment (the climax of a pick or a place, "ballistic" movements): the hand moves less
-    # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames
-    still_speed: float = number(0.05, POSITIVE)
+    # than ``still_speed`` hand sizes per frame for at least ``still_frames`` frames. 0.06: a
+    # tracked hand's estimate drifts up to 1.5 px a frame on a 28 px hand while it stands at the
+    # object (one camera, pick_place seeds 11 and 4, held-out 13): at 0.05 the stop broke in two and
+    # the pick was read too short (40-53 against 25-53) or the place's after window fell on the
+    # hand still beside the object (seeds 0-19: pick 17 -> 18 of 20, place 18 -> 20 of 20). 3
+    # cameras, seeds 0-19: as many exchanges found (12 of 20), 3 false places fewer and a false
+    # pick more; held-out exchange 11 read from a still moment 40 frames too early (56-114
+    # against 93-111)
+    still_speed: float = number(0.06, POSITIVE)
     still_frames: int = number(8, POSITIVE_COUNT)
+    # two still stretches at most this many frames apart are one stop (a jittering hand). 6 also
+    # joins pick_place seed 8's stop broken by a 35 px jump onto the forearm (24-32, 38-54), but the
+    # scenes' hands come back to rest 7-8 frames after a place, so 7 joins every place to the rest
+    # that follows it (no after window: places 20 -> 9 of 20): 4 keeps the margin on both sides
+    still_gap: int = number(4, COUNT)
     # a still moment the decision points far from it (``apart_size``) read as neither pick nor place
     # is read again for a pick with the window right after the hand left (the ``gap`` window), where
     # the colour is also seen to leave with the hand (``stays_behind`` False). A hand carrying the
@@ -210,6 +240,16 @@ class Decision:
     # handover). The handovers of the 3-camera handshake takes (limbs3d hands, seeds 0-9): 0.1-1.7
     # hand sides apart. 0: any distance
     handover_reach: float = number(4.0)
+    # a handover whose taker stood still only after the giver's still moment ended lasts as the
+    # giver's: the object was passed while the giver held it out, and the taker's stop after is
+    # holding it (limbs3d, 3-camera handshake seed 8: place 99-111, pick 118-138, read 99-138
+    # against the true 97-110). Off: to the later of the two ends
+    handover_giver: bool = flag(True)
+    # an exchange read from a handover and one read from a touch that share a hand and overlap by
+    # more than half of the shorter are one (the more confident kept), as activities of one kind
+    # read by several pairs of hands are (limbs3d, 3-camera handshake seed 5: the giver's place and
+    # the taker's pick 91-108 and a touch of the giver's hand with the taker's other hand 101-110)
+    one_exchange: bool = flag(True)
 
 
 @dataclass(frozen=True)

@@ -104,7 +104,11 @@ class ActivityTracker:
         joins = getattr(self.inner, "events", None)
         seen = out[out["state"] != LOST] if "state" in out.columns else out
         found = contacts(seen, self.activity_params)
+        if self.activity_params.decision.held_out > 0:
+            found = pd.concat([found, held_out_joins(seen, found, self.activity_params)], ignore_index=True)
         joins = found if joins is None or not len(joins) else pd.concat([joins, found], ignore_index=True)
+        if self.activity_params.decision.meeting_reach > 0:
+            joins = meeting_points(joins, seen, self.activity_params)
         clothes = {t: clothes_hues(self._clothes[t] / max(n, 1), self.activity_params)
                    for t, n in self._clothes_n.items()}
         centres = {k: bridge_gaps(c, self.activity_params) for k, c in self._centres.items()}
@@ -191,7 +195,7 @@ def still_moments(centres: dict[int, tuple[float, float, float]], params: Activi
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)  # a run of k steps spans k + 1 frames
     runs: list[list[int]] = []
     for a, b in zip(starts, stops):  # stops a jittering hand makes are merged, as joins are
-        if runs and frames[a] - runs[-1][1] <= params.decision.still_frames // 2:
+        if runs and frames[a] - runs[-1][1] <= params.decision.still_gap:
             runs[-1][1] = int(frames[b])
         else:
             runs.append([int(frames[a]), int(frames[b])])
@@ -251,17 +255,44 @@ def touch_runs(ratio: Mapping[int, float], params: ActivityParams) -> list[tuple
     return runs
 
 
-def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
-    """Touches of two hands (:func:`touch_runs`), as join rows: one per touch of a pair."""
-    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
+def _contact_hands(tracks: pd.DataFrame) -> tuple[pd.DataFrame, bool]:
+    """The hand rows touches are read from, and whether they carry 3D positions: with 3D, one row
+    per hand and frame (a hand is where it is, whichever view saw it; one view may not see it),
+    else the first view's rows."""
     hands = tracks[tracks["part"].isin(HAND_PARTS)]
     in_3d = {"X", "Y", "Z"} <= set(hands.columns) and bool(hands[["X", "Y", "Z"]].notna().all(axis=None))
     if "camera" in hands.columns and (hands["camera"] != "").any():
         if in_3d:
-            # a 3D tracker: a hand is where it is, whichever view saw it (one view may not see it)
             hands = hands.drop_duplicates(["frame", "track_id", "part"])
         else:
             hands = hands[hands["camera"] == sorted(set(hands["camera"]) - {""})[0]]
+    return hands, in_3d
+
+
+def meeting_points(joins: pd.DataFrame | None, tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame | None:
+    """``joins`` with where each join of two hands met (``meet``: the midpoint of the two hands' 3D
+    positions at its first frame both are seen, with the sum of their touching reaches,
+    :func:`_near`; None where they are never both seen). Tracks without 3D positions: ``joins``
+    as they are (one view's boxes of 15-30 px hands place a meeting too loosely: one camera,
+    ``meeting_reach`` 1.5 split a handshake's touches 57-73 and 74-106, held-out seed 18)."""
+    if joins is None or not len(joins):
+        return joins
+    hands, in_3d = _contact_hands(tracks)
+    if not in_3d or hands.empty:
+        return joins
+    pos = _hand_positions(hands, params)
+    meets = []
+    for j in joins.itertuples(index=False):
+        pa, pb = pos.get((int(j.track_id_a), str(j.part_a)), {}), pos.get((int(j.track_id_b), str(j.part_b)), {})
+        f = next((f for f in range(int(j.start_frame), int(j.end_frame) + 1) if f in pa and f in pb), None)
+        meets.append(None if f is None else ((pa[f][0] + pb[f][0]) / 2, pa[f][1] + pb[f][1]))
+    return joins.assign(meet=meets)
+
+
+def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
+    """Touches of two hands (:func:`touch_runs`), as join rows: one per touch of a pair."""
+    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
+    hands, in_3d = _contact_hands(tracks)
     if hands.empty:
         return pd.DataFrame(columns=cols)
     ratios = _pair_distances(hands, params)
@@ -270,6 +301,10 @@ def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
         runs = {pair: stayed_touch_runs(alone[pair[0]], alone[pair[1]], params) for pair in ratios}
     else:
         runs = {pair: touch_runs(ratio, params) for pair, ratio in ratios.items()}
+    if in_3d and params.decision.meeting_reach > 0:
+        alone = _hand_positions(hands, params)
+        runs = {(a, b): [at_the_meeting(run, alone[a], alone[b], params) for run in spans] if a[0] != b[0] else spans
+                for (a, b), spans in runs.items()}
     rows = [(start, end, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact")
             for (a, b), spans in runs.items() for start, end in spans]
     return pd.DataFrame(rows, columns=cols)
@@ -339,6 +374,81 @@ def stayed_touch_runs(pa: Mapping[int, tuple[np.ndarray, float]], pb: Mapping[in
     return runs
 
 
+def held_out_joins(tracks: pd.DataFrame, touches: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
+    """Touches a multi-camera tracker lost one hand of (3D positions; ``decision.held_out``): a
+    person's hand held out towards another person, at least ``held_out`` of the way from their
+    head to the other's (their heads' line), over at least ``still_frames`` frames with no touch
+    read, while one of the other person's hands is unseen over at least half of them, is a touch
+    of the two (``ended_by`` "held_out"): the hand reached for the other, and the tracker lost
+    that one at the meeting (limbs3d, 3-camera handshake seed 0: person 2's right hand held out at
+    (0, 10, 1140) mm, 0.49-0.56 of the way, over 35-62, person 1's right hand lost from 39; truth
+    36-59). What Table 1 reads there is unsure (a hand unseen at both decision points: a handshake
+    only where the hand seen holds no colour, ``unseen_confidence``)."""
+    cols = ["start_frame", "end_frame", "kind", "track_id_a", "part_a", "track_id_b", "part_b", "ended_by"]
+    hands, in_3d = _contact_hands(tracks)
+    heads = tracks[tracks["part"] == "head"].drop_duplicates(["frame", "track_id"])
+    if not in_3d or hands.empty or heads[["X", "Y", "Z"]].isna().any(axis=None):
+        return pd.DataFrame(columns=cols)
+    d = params.decision
+    head = {(int(f), int(t)): np.array(xyz, float)
+            for f, t, *xyz in heads[["frame", "track_id", "X", "Y", "Z"]].itertuples(index=False)}
+    pos = {(int(t), str(p), int(f)): np.array(xyz, float)
+           for f, t, p, *xyz in hands[["frame", "track_id", "part", "X", "Y", "Z"]].itertuples(index=False)}
+    people = sorted({t for _, t in head})
+    frames = sorted({f for f, _ in head})
+    touched = defaultdict(list)
+    for j in touches.itertuples(index=False):
+        for k in ((int(j.track_id_a), str(j.part_a)), (int(j.track_id_b), str(j.part_b))):
+            touched[k].append((int(j.start_frame), int(j.end_frame)))
+    rows = []
+    for p in people:
+        for q in (q for q in people if q != p):
+            for part in HAND_PARTS:
+                out = []
+                for f in frames:
+                    hp, hq, at = head.get((f, p)), head.get((f, q)), pos.get((p, part, f))
+                    if hp is None or hq is None or at is None or not np.any(hq != hp):
+                        continue
+                    if np.dot(at - hp, hq - hp) / np.dot(hq - hp, hq - hp) >= d.held_out:
+                        out.append(f)
+                runs, cur = [], None
+                for f in out:
+                    if cur is not None and f - cur[1] <= 2:
+                        cur[1] = f
+                    else:
+                        cur = [f, f]
+                        runs.append(cur)
+                for a, b in runs:
+                    if b - a + 1 < d.still_frames or any(s <= b and e >= a for s, e in touched[(p, part)]):
+                        continue
+                    unseen = {other: sum((q, other, f) not in pos for f in range(a, b + 1)) for other in HAND_PARTS}
+                    other, n = max(unseen.items(), key=lambda kv: kv[1])
+                    if n >= 0.5 * (b - a + 1):
+                        rows.append((a, b, "handshake", p, part, q, other, "held_out"))
+    return pd.DataFrame(rows, columns=cols)
+
+
+def at_the_meeting(run: tuple[int, int], pa: Mapping[int, tuple[np.ndarray, float]],
+                   pb: Mapping[int, tuple[np.ndarray, float]], params: ActivityParams) -> tuple[int, int]:
+    """A touch of two people's hands (3D positions, :func:`_hand_positions`) ended at the last
+    frame before both hands seen are farther than ``decision.meeting_reach`` touching distances
+    from where they met (their midpoint at the touch's first frame): people who shake hands or
+    pass an object meet between them, and a multi-camera tracker that carries the two joined
+    estimates back to one person's side has lost the touch (limbs3d, 3-camera handshake seed 4:
+    the pair joined at (-36, -221, 1106) mm over 96-108 and carried 340 mm to person 1's side by
+    116, read 95-135 against the true exchange's 93-107). A hand the other's estimate was thrown
+    from stays at the meeting, so the touch goes on (``stayed_hand``)."""
+    start, end = run
+    if start not in pa or start not in pb:
+        return run
+    meet = (pa[start][0] + pb[start][0]) / 2
+    for f in range(start + 1, end + 1):
+        seen = [p[f] for p in (pa, pb) if f in p]
+        if seen and all(np.linalg.norm(c - meet) > params.decision.meeting_reach * 2 * r for c, r in seen):
+            return (start, f - 1)
+    return run
+
+
 def _ratio(a: tuple[np.ndarray, float], b: tuple[np.ndarray, float]) -> float:
     return float(np.linalg.norm(a[0] - b[0]) / max(a[1] + b[1], 1e-9))
 
@@ -346,24 +456,38 @@ def _ratio(a: tuple[np.ndarray, float], b: tuple[np.ndarray, float]) -> float:
 def merged_joins(joins: pd.DataFrame | None, params: ActivityParams) -> list[dict]:
     """The joins of each pair of targets, those less than ``merge_gap`` frames apart merged into one
     (claps come in bursts, a handshake touches a few times): ``start_frame`` of the first,
-    ``end_frame`` of the last."""
+    ``end_frame`` of the last. Joins
+    that met (``meet``, :func:`meeting_points`) farther apart than ``decision.meeting_reach``
+    touching distances are two activities too: a handshake's or a clap's touches are at one
+    place, and a hand that later passes the other's estimate elsewhere is not one of them."""
     if joins is None or not len(joins):
         return []
     groups: dict[tuple, list] = defaultdict(list)
     for j in joins.itertuples(index=False):
         a, b = (int(j.track_id_a), str(j.part_a)), (int(j.track_id_b), str(j.part_b))
-        groups[tuple(sorted((a, b)))].append((int(j.start_frame), int(j.end_frame), str(j.kind), str(j.ended_by)))
+        groups[tuple(sorted((a, b)))].append((int(j.start_frame), int(j.end_frame), str(j.kind), str(j.ended_by),
+                                              getattr(j, "meet", None)))
     out = []
     for (a, b), items in groups.items():
-        items.sort()
+        items.sort(key=lambda i: i[:4])
         cur = None
-        for start, end, kind, ended in items:
-            if cur is not None and start - cur["end_frame"] <= params.decision.merge_gap:
+        for start, end, kind, ended, meet in items:
+            if (cur is not None and start - cur["end_frame"] <= params.decision.merge_gap
+                    and _met_near(cur["meet"], meet, params)):
                 cur.update(end_frame=max(cur["end_frame"], end), ended_by=ended)
                 continue
-            cur = dict(start_frame=start, end_frame=end, kind=kind, a=a, b=b, ended_by=ended)
+            cur = dict(start_frame=start, end_frame=end, kind=kind, a=a, b=b, ended_by=ended, meet=meet)
             out.append(cur)
     return out
+
+
+def _met_near(m1, m2, params: ActivityParams) -> bool:
+    """Whether two joins' meeting points (:func:`meeting_points`) are within ``meeting_reach``
+    touching distances (True where either is unknown or the rule is off)."""
+    k = params.decision.meeting_reach
+    if k <= 0 or not isinstance(m1, tuple) or not isinstance(m2, tuple):
+        return True
+    return float(np.linalg.norm(np.asarray(m1[0]) - np.asarray(m2[0]))) <= k * 0.5 * (m1[1] + m2[1])
 
 
 def apart_windows(ca: Mapping[int, tuple], cb: Mapping[int, tuple], start: int, end: int,
@@ -815,11 +939,14 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
     up to ``handover_gap`` frames *before* the giver's starts: its pick is read after it, where the
     hand moved on to take the object (limbs3d, handshake seed 3: the taker stood still over 59-67,
     took the object at 71-78 and was lost; the giver stood still over 77-87). The exchange starts
-    with the giver's still moment and ends with the later of the two, goes from the placing hand
+    with the giver's still moment and ends with the later of the two (the giver's where the
+    taker's began after it ended, ``handover_giver``), goes from the placing hand
     (``a``) to the picking one (``b``), with the less sure of the two confidences; a handshake of
     the two people overlapping it is dropped (the touch of the handover). The two hands must have
     stood still within ``handover_reach`` hand sides of each other (rows' ``at``, where known).
-    Each place and each pick gives at most one exchange, the nearest in time first."""
+    Each place and each pick gives at most one exchange, the nearest in time first; an exchange
+    that shares a hand with another and overlaps it by more than half of the shorter is the same
+    one, the more confident kept (``one_exchange``)."""
     d = params.decision
     reach = d.same_colour / DEGREES_PER_BIN
 
@@ -840,7 +967,10 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
             continue
         used |= {i, j}
         give, take = rows[i], rows[j]
-        exchanges.append(dict(start_frame=give["start_frame"], end_frame=max(give["end_frame"], take["end_frame"]),
+        end = max(give["end_frame"], take["end_frame"])
+        if d.handover_giver and take["start_frame"] > give["end_frame"]:
+            end = give["end_frame"]  # the taker stood still with the object after it was passed
+        exchanges.append(dict(start_frame=give["start_frame"], end_frame=end,
                               kind="exchange", track_id_a=give["track_id_a"], part_a=give["part_a"],
                               track_id_b=take["track_id_a"], part_b=take["part_a"], ended_by="still",
                               object_colour=give["object_colour"], hue=give.get("hue"),
@@ -853,4 +983,7 @@ def handovers(rows: list[dict], params: ActivityParams) -> list[dict]:
                                                                      (e["start_frame"], e["end_frame"])) > 0
             for e in exchanges)
 
-    return [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
+    out = [r for k, r in enumerate(rows) if k not in used and not covered(r)] + exchanges
+    # one object given by one hand is one exchange: a handover's and one read from a touch of the
+    # giver's hand with another of the taker's (``decision.one_exchange``; :func:`_distinct`)
+    return _distinct(out) if d.one_exchange else out
