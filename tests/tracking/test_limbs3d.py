@@ -666,17 +666,23 @@ def test_a_hand_reaching_for_an_exchange_keeps_its_home_when_the_other_head_is_o
     little nearer that head estimate than its own. With ``states.foreign_pair_frames`` and no
     margin its home is not taken from those frames, and when the pair of the exchange splits
     (frame 95) it is sent back to the stale one (frames 97-109: 272-293 mm off, lost). With
-    ``states.foreign_home_margin`` 150 mm the home follows the reach: 3-118 mm."""
+    ``states.foreign_home_margin`` 150 mm the home follows the reach: 3-118 mm. Both with distances to
+    the heads in 3D; measured horizontally (``states.foreign_horizontal``, on since session hs3d5) the
+    home follows the reach even with no margin (3-118 mm)."""
     scene = make_multiview_scene("handshake", 4, seed=16, n_frames=150)
     frames = range(97, 110)
-    on = {"states.foreign_pair_frames": 5}
+    on = {"states.foreign_pair_frames": 5, "states.foreign_horizontal": False}
     stale = _part_error(scene, Limbs3DParams().updated({**on, "states.foreign_home_margin": 0.0}), 4, 2,
                         "right_hand", frames, seed=16)
     kept = _part_error(scene, Limbs3DParams().updated({**on, "states.foreign_home_margin": 150.0}), 4, 2,
                        "right_hand", frames, seed=16)
-    assert len(stale) == len(kept) == 13
+    across = _part_error(scene, Limbs3DParams().updated({**on, "states.foreign_horizontal": True,
+                                                         "states.foreign_home_margin": 0.0}), 4, 2,
+                         "right_hand", frames, seed=16)
+    assert len(stale) == len(kept) == len(across) == 13
     assert stale.min() > 250
     assert kept.max() < 130
+    assert across.max() < 130
 
 
 def test_a_lost_hand_takes_the_strong_candidate_on_its_side_that_nobody_tracks():
