@@ -370,7 +370,8 @@ class Limbs3DStates:
     # a hand past that by this much is the other person's. Tried 2026-12-06 at 150: held-out
     # handshake 3 cameras 60.8 -> 61.8 mm (seeds 15 and 18 fixed, seed 16 +54 with a hand on another
     # hand: a head estimate ~300 mm off makes a hand's own candidates "foreign"), 4 cameras 45.3 ->
-    # 44.2 (seed 10 -39, 13 +24, 17 +7). 0 = off
+    # 44.2 (seed 10 -39, 13 +24, 17 +7); at 300, 3 cameras 60.8 -> 59.3 but seed 16 +35.5 with a hand
+    # on another hand. 0 = off
     foreign_use: float = number(0.0)
     # a lost hand takes, once one has been there this many frames in a row, a candidate of prior >=
     # start_prior spanning lost_claim_views views or more, within dynamics.hand_reach of its head,
