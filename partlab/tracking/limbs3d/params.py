@@ -230,6 +230,22 @@ class Limbs3DDynamics:
     # 4 cameras 69.9 -> 69.4 mm (0.34 -> 0.46); standing and seated unchanged. False = main before
     line_of_sight: bool = flag(True)
     single_view_depth: float = number(600.0, POSITIVE)
+    # (line_of_sight) a hand seen by one view takes no candidate where two other tracked hands
+    # already are, both estimates within states.split_distance of it (our addition): two hands
+    # meeting make one blob, and a third hand's line of sight through that blob in one view is not
+    # where the third hand is. Held-out 3-camera handshake seed 14: person 2's left hand, hidden,
+    # was put on the exchange of person 1's left and person 2's right hand 540 mm from its own, and
+    # two hands ended on another hand (107.8 -> 35.6 mm, none with it). 2026-12-06
+    # (docs/measurements/limbs3d.md, session hs3d5): handshake seeds 0-9 at 2-4 cameras the same to
+    # 0.1 mm, held-out 10-19 only seed 14 at 3 cameras changes; one person: never applies (one other
+    # hand). False = main before
+    sight_meeting: bool = flag(True)
+    # a hand uses no candidate lying more than this many mm on the other side of its head (along its
+    # person's left-right axis at the init frame, the horizontal line from its other hand to it;
+    # our addition): a person's two hands keep their sides but for a reach across the body. Tried
+    # 2026-12-06 at 150 (held-out handshake 3 cameras 60.8 -> 63.1 mm: seed 16 +35, hands on another
+    # hand 2 -> 2); 0 = off
+    hand_side: float = number(0.0)
     # a head uses no candidate that shares a blob with the candidate of more views another person's
     # tracked target claims (the one nearest its prediction within candidate_gate; our addition,
     # sec. 6.4's ghosts for heads): in a view where two heads lie on one line of sight the nearer
@@ -340,6 +356,23 @@ class Limbs3DStates:
     # and was sent back there when the pair split (frame 97: 284 mm off, lost); 150: 72.7, and seed 7
     # (4 cameras) still leaves person 1's hand (106.6 -> 94.4 mm; 92.8 with 0; with 300 it stays on it)
     foreign_home_margin: float = number(150.0)
+    # with foreign_pair_frames: the distances from a hand to the heads are measured horizontally (our
+    # addition): a hand hanging at the hip is ~700-800 mm below either head, which hides how far it is
+    # to the side of each. Held-out 3-camera handshake seed 15: both right hands combined at person
+    # 1's hip, 780 / 910 mm from the heads in 3D (within foreign_margin), ~330 / ~700 across; person
+    # 2's hand stayed on person 1's for 70 frames (86.4 -> 67.0 mm, no longer on it). 2026-12-06
+    # (docs/measurements/limbs3d.md, session hs3d5): handshake seeds 0-9 at 2-4 cameras the same to
+    # 0.1 mm, held-out 10-19 seed 15 at 3 cameras and seed 16 at 4 (72.7 -> 72.4) only; one person:
+    # never applies. False = in 3D (main before)
+    foreign_horizontal: bool = flag(True)
+    # a hand uses no candidate nearer another person's head than its own by more than this (mm,
+    # measured as foreign_horizontal says; our addition): two people's hands meet between them, and
+    # a hand past that by this much is the other person's. Tried 2026-12-06 at 150: held-out
+    # handshake 3 cameras 60.8 -> 61.8 mm (seeds 15 and 18 fixed, seed 16 +54 with a hand on another
+    # hand: a head estimate ~300 mm off makes a hand's own candidates "foreign"), 4 cameras 45.3 ->
+    # 44.2 (seed 10 -39, 13 +24, 17 +7); at 300, 3 cameras 60.8 -> 59.3 but seed 16 +35.5 with a hand
+    # on another hand. 0 = off
+    foreign_use: float = number(0.0)
     # a lost hand takes, once one has been there this many frames in a row, a candidate of prior >=
     # start_prior spanning lost_claim_views views or more, within dynamics.hand_reach of its head,
     # nearer it than every other person's head by lost_claim_margin mm, at least lost_claim_side mm on

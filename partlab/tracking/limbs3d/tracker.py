@@ -357,8 +357,26 @@ class Limbs3DTracker:
                 or own is None):
             return False
         others = [h for tid, h in heads.items() if tid != t.track_id]
-        return bool(others) and min(np.linalg.norm(np.subtract(h, est)) for h in others) < (
-            np.linalg.norm(est - own) - self.params.states.foreign_home_margin)
+        return bool(others) and min(self._to_head(est, h) for h in others) < (
+            self._to_head(est, own) - self.params.states.foreign_home_margin)
+
+    def _foreign_points(self, t: _Target, points: np.ndarray, head) -> np.ndarray:
+        """``(K,)`` whether each of ``points`` is nearer another person's head than hand ``t``'s own
+        (``head``) by more than ``states.foreign_use`` mm (:meth:`_to_head`)."""
+        out = np.zeros(len(points), bool)
+        own = self._to_head(points, head)
+        for o in self.targets.values():
+            if o.part == "head" and o.track_id != t.track_id and o.position is not None:
+                out |= self._to_head(points, o.position) < own - self.params.states.foreign_use
+        return out
+
+    def _to_head(self, point, head):
+        """The distance (or ``(K,)`` distances of ``(K, 3)`` points) from ``point`` to ``head`` the
+        rules on two people's hands read: in 3D, or horizontally with ``states.foreign_horizontal`` (a
+        hand at the hip is 700-800 mm below either head, which hides how far it is to either side)."""
+        d = np.subtract(point, head)
+        d = d[..., :2] if self.params.states.foreign_horizontal else d
+        return np.linalg.norm(d, axis=-1) if d.ndim > 1 else float(np.linalg.norm(d))
 
     def _foreign_pair(self, t: _Target, k: int, est: np.ndarray, heads: dict, modes: tuple) -> tuple:
         """The modes of combined pair ``k`` (leader ``t``) of two people's hands, or, once its estimate
@@ -369,7 +387,10 @@ class Limbs3DTracker:
         right hand took person 1's when the hands parted (person 1's tracker lagged 230-360 mm off),
         followed it to person 1 and was combined with it 930-1040 mm from person 2's head, 230 mm
         nearer person 1's, for 56 frames. A home is not taken from a frame in which the hand is
-        nearer another person's head than its own (:meth:`_foreign`): it had been, from there."""
+        nearer another person's head than its own (:meth:`_foreign`): it had been, from there. With
+        ``states.foreign_horizontal`` the distances to the heads are horizontal (:meth:`_to_head`):
+        held-out 3-camera seed 15's pair of both right hands sat at person 1's hip, 780 mm from its
+        head and 910 from person 2's in 3D (within the margin) but ~330 and ~700 mm across."""
         st = self.params.states
         partner = self.machine.partner(k)
         o = self.targets[partner] if partner is not None else None
@@ -377,8 +398,8 @@ class Limbs3DTracker:
                 or t.track_id not in heads or o.track_id not in heads):
             t.foreign_pair = 0
             return modes
-        d_t = float(np.linalg.norm(est - heads[t.track_id]))
-        d_o = float(np.linalg.norm(est - heads[o.track_id]))
+        d_t = self._to_head(est, heads[t.track_id])
+        d_o = self._to_head(est, heads[o.track_id])
         t.foreign_pair = t.foreign_pair + 1 if abs(d_t - d_o) > st.foreign_margin else 0
         far = t if d_t > d_o else o
         if t.foreign_pair < st.foreign_pair_frames or far.home is None:
@@ -624,7 +645,10 @@ class Limbs3DTracker:
         ``states.start_prior`` made from one of those and a blob of another view, within
         ``hand_reach`` of its person's head for a hand, none of whose blobs is another target's
         image (:meth:`_explained`; for a lost one, ``share`` False, none shared with anybody), the
-        strongest."""
+        strongest. With ``dynamics.sight_meeting``, none where two other tracked hands already are
+        (both estimates within ``split_distance``): held-out 3-camera handshake seed 14, person 2's
+        left hand (hidden, 75 mm off) was put on the exchange of person 1's left and person 2's right
+        hand, 540 mm from its own, and took part in it from there."""
         d = self.params.dynamics
         members = self.last.get("members")
         if not self._line_of_sight or members is None or not len(points):
@@ -641,8 +665,21 @@ class Limbs3DTracker:
         ok = np.array([bool(mine & ms) for ms in members]) & (weights >= self.params.states.start_prior)
         if d.hand_reach > 0 and t.part != "head" and head is not None:
             ok &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        if self.params.states.foreign_use > 0 and t.part != "head" and head is not None:
+            ok &= ~self._foreign_points(t, points, head)
+        side = self._side(t) if d.hand_side > 0 and t.part != "head" and head is not None else None
+        if side is not None:
+            ok &= (points - head) @ side >= -d.hand_side
         for i in np.flatnonzero(ok):
             ok[i] = not self._explained(t, points[i], members[i], share)
+        if d.sight_meeting and ok.any():
+            hands = [o.position for k, o in self.targets.items() if o is not t and o.part != "head"
+                     and o.position is not None and o.filter is not None
+                     and self.machine.state(k) in (LimbState.NORMAL, LimbState.COMBINED)]
+            if len(hands) >= 2:
+                near = np.linalg.norm(points[:, None] - np.array(hands)[None], axis=-1) < (
+                    self.params.states.split_distance)
+                ok &= near.sum(axis=1) < 2  # two other hands meet there
         if not ok.any():
             return -1
         return int(np.flatnonzero(ok)[np.argmax(weights[ok])])
@@ -713,6 +750,12 @@ class Limbs3DTracker:
         use = (mine <= d.exclusive_ratio * others.min(axis=1)) if mine is not None else np.ones(len(points), bool)
         if d.hand_reach > 0 and t.part != "head" and head is not None and len(points):
             use &= np.linalg.norm(points - head, axis=1) <= d.hand_reach
+        if self.params.states.foreign_use > 0 and t.part != "head" and head is not None and len(points):
+            use &= ~self._foreign_points(t, points, head)
+        if d.hand_side > 0 and t.part != "head" and head is not None and len(points):
+            side = self._side(t)
+            if side is not None:
+                use &= (points - head) @ side >= -d.hand_side
         if d.head_own_blobs and t.part == "head" and len(points):
             use &= ~self._borrowed(t, len(points))
         if (d.hand_own_blobs > 0 and len(self.cameras) <= d.hand_own_blobs_cameras and t.part != "head"
