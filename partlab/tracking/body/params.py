@@ -464,6 +464,22 @@ class BodyDetector:
     # seeds 1-4 rate 0.514 -> 0.649, edits/100 53.0 -> 42.5 (seed 3 worse: 36.2 -> 44.7)
     # (docs/measurements/annotation_effort.md).
     reacquire_against: float = number(0.5)
+    # Which of two touching tracks (two tracks on one walker) due for re-acquisition takes a
+    # detection near them: not the one placed on that walker more recently (its box given there,
+    # ``--init`` or a keyframe, or its last measurement clear of every other track; a given box
+    # before a measurement of the same frame), while the other is due too and the detection lies
+    # within its ``reacquire_distance``: that one reached the shared walker later, from the walker
+    # the detection now shows. Without it the first in id order takes the detection (PETS09 seed 2
+    # with ``released_behind``, frame 540: track 3, given on person 3 at frame 528 where track 4
+    # had run ahead onto him, took person 4's detection behind the pair and the two swapped
+    # walkers). False: off.
+    reacquire_owner: bool = flag(False)
+    # A track re-acquired onto a detection forgets its clean centres from before the jump
+    # (``Person.velocity``, the median motion of the person box): kept, they mix the positions on
+    # the walker it left with those on the one it jumped to, and the jump reads as motion (PETS09
+    # seed 8: track 4, re-acquired at frame 552 and put behind at 556, coasted at -13.6 px a frame
+    # while its walker walked at -4). False: off.
+    reacquire_forgets: bool = flag(False)
     # Re-identification of tracks given by the user (``--init``) that ended (lost and withdrawn, or
     # walked out): a free detection (no track takes it, none covers it) where such a track's person
     # could be by now (its height within ``reid_size`` times the track's last box's, its centre
