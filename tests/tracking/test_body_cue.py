@@ -421,3 +421,90 @@ def test_a_track_measured_on_its_walker_is_not_re_acquired_by_the_one_following_
         assert own < 0.4 and other > 0.6, (seed, own, other)
         own, other = out[0.5, seed]
         assert own >= 0.95 and other < 0.1, (seed, own, other)  # measured 1.0 and 0.0
+
+
+def test_of_two_tracks_on_one_walker_the_one_placed_there_later_leaves_the_detection_to_the_other():
+    """``reacquire_owner``: two walkers in the same coats, A and B 60 px to its right. Track 2 was
+    given on B and ran ahead onto A (last measured clear of everyone at frame 6); track 1 is given
+    on A at frame 6 (PETS09 seed 2, frame 528: track 3 given on person 3 where track 4 sat). Both
+    sit on A, touching, and no detection has matched either for ``reacquire_after`` frames when the
+    detector sees B alone. Without the option the first in id order (track 1) jumps onto B and the
+    two swap walkers; with it track 1, placed on A later (a given box ranks before a measurement of
+    the same frame), stays and track 2 takes B's detection."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    def two_in_one_coat(xa: float, xb: float) -> np.ndarray:
+        f = np.full((240, 360, 3), 150, np.uint8)
+        for x in (int(xa), int(xb)):
+            f[60:78, x + 8:x + 22] = (90, 140, 200)  # head
+            f[78:112, x:x + 30] = (35, 35, 40)  # coat
+            f[112:160, x + 2:x + 28] = (170, 100, 40)  # jeans
+        return f
+
+    frame = two_in_one_coat(100, 160)
+    ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    on_a, on_b = Box(100, 60, 30, 100), Box(160, 60, 30, 100)
+    out = {}
+    for owner in (False, True):
+        params = BodyParams().updated({"detector.reacquire_owner": owner})
+        t = BodyTracker(params, np.random.default_rng(0), init=[])
+        t.frame_size = (360, 240)
+        b = t.start_track(2, {"person": on_b}, ycc, None, 0)
+        b.given = {"person": on_b}
+        for f in b.filters.values():  # ran ahead onto A, 2 px to the right of A's own track
+            f.shift(np.array([-58.0, 0.0]))
+        b.seen = (6, *t._reported_person_box(b).centre)
+        a = t.start_track(1, {"person": on_a}, ycc, None, 6)
+        a.given = {"person": on_a}
+        assert t._touching(a.part_boxes(), b.part_boxes())[0]
+        det = np.array([[on_b.x, on_b.y, on_b.w, on_b.h, 1.0]])
+        t.cue.detector.detect = lambda frame, regions, det=det: det
+        index = 6 + params.detector.reacquire_after
+        index += -index % params.detector.every  # a frame the cue scans
+        t.cue.step(index, frame, ycc, None)
+        out[owner] = (t._reported_person_box(a).centre[0] - on_a.centre[0],
+                      t._reported_person_box(b).centre[0] - on_b.centre[0])
+    a_off, b_off = out[False]
+    assert abs(a_off - 60) < 3 and b_off < -50  # track 1 on B, track 2 left on A: swapped
+    a_off, b_off = out[True]
+    assert abs(a_off) < 3 and abs(b_off) < 3  # each on its own walker
+
+
+def test_a_track_re_acquired_onto_another_place_forgets_the_motion_it_had_before_the_jump():
+    """``reacquire_forgets``: a track whose clean centres say it walked right at 4 px a frame, due for
+    re-acquisition, jumps 60 px left onto a detection. Kept, those centres and the first ones
+    after the jump make the jump read as motion (PETS09 seed 8: a track re-acquired, then put
+    behind someone, coasted at -13.6 px a frame while its walker walked at -4); with the option its
+    person-box velocity starts again from the frames after the jump."""
+    import cv2
+
+    from partlab.tracking.core.box import Box
+
+    frame = np.full((240, 360, 3), 150, np.uint8)
+    frame[60:78, 108:122] = (90, 140, 200)
+    frame[78:112, 100:130] = (35, 35, 40)
+    frame[112:160, 102:128] = (170, 100, 40)
+    ycc = cv2.cvtColor(frame, cv2.COLOR_BGR2YCrCb)
+    out = {}
+    for forgets in (False, True):
+        params = BodyParams().updated({"detector.reacquire_forgets": forgets})
+        t = BodyTracker(params, np.random.default_rng(0), init=[])
+        t.frame_size = (360, 240)
+        a = t.start_track(1, {"person": Box(100, 60, 30, 100)}, ycc, None, 0)
+        for f in a.filters.values():  # it walked right to 160 (its walker is back at 100)
+            f.shift(np.array([60.0, 0.0]))
+        a.centres.extend((k, 135.0 + 4 * k, 110.0) for k in range(6))
+        det = np.array([[100.0, 60.0, 30.0, 100.0, 1.0]])
+        t.cue.detector.detect = lambda frame, regions, det=det: det
+        index = params.detector.reacquire_after
+        index += -index % params.detector.every
+        t.cue.step(index, frame, ycc, None)
+        assert abs(t._reported_person_box(a).centre[0] - 115) < 3  # jumped onto the detection
+        a.centres.append((index + 1, 115.0, 110.0))  # the first clean frame after the jump
+        out[forgets] = (len(a.centres), a.velocity())
+    n, v = out[False]
+    assert n == 7 and v[0] > 3.5  # the walk before the jump, 4 px a frame
+    n, v = out[True]
+    assert n == 1 and v is None  # starts again: no velocity until three clean frames after the jump

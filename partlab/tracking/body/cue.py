@@ -288,12 +288,13 @@ class DetectionCue:
         ``duplicate_margin`` (that track goes lost). The free rest."""
         t, p = self.tracker, self.p
         held = dict(held or {}) if p.reacquire_claims and p.duplicate_margin > 0 else {}
+        left = self._left_to_others(index, unmatched, dets) if p.reacquire_owner else {}
         for person in unmatched:
             if not free and not held:
                 break
-            lost = person.lost_since is not None
-            if not lost and index - self.last_match.get(person.track_id, index) < p.reacquire_after:
+            if not self._due(index, person):
                 continue
+            tid = person.track_id
             reported = t._reported_person_box(person)
             cx, cy = reported.centre
             heading = self._heading(person, reported)
@@ -304,8 +305,10 @@ class DetectionCue:
                 dx, dy = det.centre[0] - cx, det.centre[1] - cy
                 if np.hypot(dx, dy) > p.reacquire_distance * det.h:
                     continue
-                if heading is not None and self._on_its_path(heading, dx, dy, det):
-                    continue  # behind a walker its track was measured on: the one following it
+                if (heading is not None and self._on_its_path(heading, dx, dy, det)) or j in left.get(tid, ()):
+                    # behind a walker its track was measured on (the one following it), or left to a
+                    # track placed on its walker earlier (``reacquire_owner``)
+                    continue
                 holder = held.get(j)
                 if any(det.iou(t._reported_person_box(q)) >= p.match_iou for q in t.people.values()
                        if q is not person and q is not holder):
@@ -323,11 +326,7 @@ class DetectionCue:
             if holder is not None:  # it was on someone else's person: it coasts, lost, and yields
                 if holder.lost_since is None:
                     holder.lost_since = holder.yields_from = index
-            for g in person.filters.values():
-                g.set_velocity(np.zeros(2))
-            if t.params.dynamics.relearn_velocity:  # standing there: learns its walker's speed as a new track
-                person.learns_from = index
-                person.steps.clear()
+            self._stand(person, index)
             self._steer(person, reported, Box(*dets[best, :4]), 1.0)
             person.lost_since = None
             person.unsupported = 0
@@ -335,6 +334,55 @@ class DetectionCue:
             self.last_match[person.track_id] = index
             free = [j for j in free if j != best]
         return free
+
+    def _stand(self, person, index: int) -> None:
+        """A re-acquired track stands where it jumps: it learns its walker's speed again as a new
+        track (``dynamics.relearn_velocity``) and, with ``reacquire_forgets``, forgets the clean
+        centres of the walker it left (its motion there is not its walker's)."""
+        for g in person.filters.values():
+            g.set_velocity(np.zeros(2))
+        if self.tracker.params.dynamics.relearn_velocity:
+            person.learns_from = index
+            person.steps.clear()
+        if self.p.reacquire_forgets:
+            person.centres.clear()
+
+    def _due(self, index: int, person) -> bool:
+        """Lost, or unmatched for ``reacquire_after`` frames: re-acquired by a detection near it."""
+        return (person.lost_since is not None
+                or index - self.last_match.get(person.track_id, index) >= self.p.reacquire_after)
+
+    @staticmethod
+    def _placed(person) -> tuple[int, int]:
+        """``reacquire_owner``: the last frame a track was placed on its walker: its start from given
+        boxes, or its last measurement clear of every other track (``Person.seen``); a given box
+        ranks before a measurement of the same frame (what was drawn is the person, a measurement
+        may already sit on a neighbour)."""
+        given = (person.started, 1) if person.given else (-1, 1)
+        seen = (person.seen[0], 0) if person.seen is not None else (-1, 0)
+        return max(given, seen)
+
+    def _left_to_others(self, index: int, unmatched: list, dets: np.ndarray) -> dict[int, set[int]]:
+        """``reacquire_owner``: track id -> the detections it leaves to a track it touches (two tracks
+        on one walker, both unmatched and due) that was placed on that walker earlier
+        (:meth:`_placed`), within that track's ``reacquire_distance``. The one placed later stays:
+        the other came onto the shared walker from elsewhere, and a detection near the pair is
+        more likely that other walker's."""
+        t, p = self.tracker, self.p
+        due = [q for q in unmatched if self._due(index, q) and q.lost_since is None and q.occluded_by is None]
+        out: dict[int, set[int]] = {}
+        for a in due:
+            for b in due:
+                if a is b or self._placed(b) >= self._placed(a):
+                    continue
+                if not t._touching(a.part_boxes(), b.part_boxes())[0]:
+                    continue
+                cx, cy = t._reported_person_box(b).centre
+                near = {j for j in range(len(dets))
+                        if np.hypot(dets[j, 0] + dets[j, 2] / 2 - cx, dets[j, 1] + dets[j, 3] / 2 - cy)
+                        <= p.reacquire_distance * dets[j, 3]}
+                out.setdefault(a.track_id, set()).update(near)
+        return out
 
     def _heading(self, person, reported: Box) -> np.ndarray | None:
         """``reacquire_against``: the velocity of a track measured up to now on its walker alone (not

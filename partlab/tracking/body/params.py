@@ -473,6 +473,26 @@ class BodyDetector:
     # seeds 1-4 rate 0.514 -> 0.649, edits/100 53.0 -> 42.5 (seed 3 worse: 36.2 -> 44.7)
     # (docs/measurements/annotation_effort.md).
     reacquire_against: float = number(0.5)
+    # Which of two touching tracks (two tracks on one walker) due for re-acquisition takes a
+    # detection near them: not the one placed on that walker more recently (its box given there,
+    # ``--init`` or a keyframe, or its last measurement clear of every other track; a given box
+    # before a measurement of the same frame), while the other is due too and the detection lies
+    # within its ``reacquire_distance``: that one reached the shared walker later, from the walker
+    # the detection now shows. Without it the first in id order takes the detection (PETS09 seed 2
+    # with ``released_behind``, frame 540: track 3, given on person 3 at frame 528 where track 4
+    # had run ahead onto him, took person 4's detection behind the pair and the two swapped
+    # walkers). False: off.
+    reacquire_owner: bool = flag(False)
+    # A track re-acquired onto a detection forgets its clean centres from before the jump
+    # (``Person.velocity``, the median motion of the person box): kept, they mix the positions on
+    # the walker it left with those on the one it jumped to, and the jump reads as motion (PETS09
+    # seed 8: track 4, re-acquired at frame 552 and put behind at 556, coasted at -13.6 px a frame
+    # while its walker walked at -4). Off: alone not measured; with ``released_behind`` (see there)
+    # PETS09 seeds 1-8 rate 0.922 -> 0.919, MOTA 0.766 -> 0.771, edits/100 13.88 -> 13.40 (with
+    # ``released_behind`` alone 0.912 / 0.759 / 13.97), held-out seeds 9-14 0.858 -> 0.902, but the
+    # bundle retrained on frames 0-199 does worse on the rest (seeds 1-4: 9.12 -> 11.13 edits/100)
+    # and automatic mode's IDF1 0.824 -> 0.816 (seed 4). True: on.
+    reacquire_forgets: bool = flag(False)
     # Re-identification of tracks given by the user (``--init``) that ended (lost and withdrawn, or
     # walked out): a free detection (no track takes it, none covers it) where such a track's person
     # could be by now (its height within ``reid_size`` times the track's last box's, its centre
@@ -532,12 +552,14 @@ class BodyDetector:
     # not measured, its scores are those of its last measured frame, on the person it was sent
     # off. Without it those stale scores, higher than those of the track that has just claimed its
     # person back, put that one behind: it coasts off its person on its old velocity and the
-    # released track keeps that person (PETS09 seed 1, frames 42-43). Off by default: PETS09 from
-    # the first boxes, seeds 1-8, it raises seed 1 (0.826 -> 0.919) but not the mean (0.911 ->
-    # 0.898, the 3 <-> 4 coin moving onto seeds 2 and 8; seeds 1-14: 0.893 -> 0.901, MOTA -0.015,
-    # edits/100 +0.90), and retraining on frames 0-199 then no longer lowers the edits on 200-794
-    # (paired +0.13 ± 1.44 against -3.28 ± 2.13 off, seeds 1-8). Putting a yielding track behind
-    # for all of its loss gave 0.901, hiding nobody in that frame seed 3 0.755. True: on.
+    # released track keeps that person (PETS09 seed 1, frames 42-43). Off by default: alone it
+    # raised seed 1 (0.826 -> 0.919) but not the 8-seed mean (0.911 -> 0.898: the 3 <-> 4 coin
+    # moved onto other seeds); with ``reacquire_forgets`` (2026-12-06) PETS09 from the first boxes
+    # seeds 1-8 rate 0.922 -> 0.919 with every seed >= 0.85 (seed 1 0.825 -> 0.918), edits/100
+    # 13.88 -> 13.40, held-out seeds 9-14 rate 0.858 -> 0.902, but retraining on frames 0-199
+    # then lowers the edits on 200-794 less (trained bundle seeds 1-4: 9.12 -> 11.13 edits/100).
+    # Putting a yielding track behind for all of its loss gave 0.901, hiding nobody in that frame
+    # seed 3 0.755. True: on.
     released_behind: bool = flag(False)
     # Automatic mode: a track no detection has matched for ``undetected_frames`` frames ends (a ghost
     # of the background model, a shadow). 0: never for this reason (foreground support still ends
