@@ -51,7 +51,7 @@ if TYPE_CHECKING:
 
 #: a person moving less than this share of its box height a frame stands still (at a border: leaving)
 STILL = 0.01
-#: frames of camera shifts kept (``BodyTracker.scene_velocity`` reads those of a person's last clean frames)
+#: frames of camera travel kept (``BodyTracker.scene_velocity`` reads those of a person's last clean frames)
 SHIFTS = 64
 
 
@@ -277,7 +277,8 @@ class BodyTracker:
                                                    residual=bg.camera_residual))
                        if bg.camera_motion > 0 else None)
         self.moving_mask: np.ndarray | None = None  # while the camera moves: what moves in the scene
-        self.shifts: dict[int, np.ndarray] = {}  # frame -> the camera's shift (zero while not moving), recent
+        self._travelled = np.zeros(2)  # the camera's summed shifts while moving, up to the last frame
+        self.travel: dict[int, np.ndarray] = {}  # frame -> _travelled at it, the last SHIFTS frames
 
     # -- starting tracks --------------------------------------------------------------
     def _part_boxes_for_start(self, boxes: dict[str, Box], ycc, mask) -> dict[str, Box]:
@@ -418,10 +419,7 @@ class BodyTracker:
         self.frame_size = (W, H)
         self.frames_seen += 1
         mask = self._follow_camera(frame, foreground)
-        if self.camera is not None:  # the last SHIFTS frames' shifts, for motion in the scene
-            self.shifts[index] = self.camera.shift.copy() if self.camera.moving else np.zeros(2)
-            for k in [k for k in self.shifts if k <= index - SHIFTS]:
-                del self.shifts[k]
+        self._note_travel(index)
         support = mask if mask is not None else self.moving_mask  # foreground support of tracks
         moving = self.camera is not None and self.camera.moving
         new_ids = set()
@@ -922,21 +920,24 @@ class BodyTracker:
         """``background.camera_rewind`` applies: the support is the moving camera's scene motion."""
         return self.params.background.camera_rewind and mask is not None and mask is self.moving_mask
 
+    def _note_travel(self, index: int) -> None:
+        """Keeps the camera's travel up to frame ``index`` (:attr:`travel`, the last SHIFTS frames),
+        for :meth:`scene_velocity`."""
+        if self.camera is None:
+            return
+        if self.camera.moving:
+            self._travelled = self._travelled + self.camera.shift
+        self.travel[index] = self._travelled
+        for k in [k for k in self.travel if k <= index - SHIFTS]:
+            del self.travel[k]
+
     def scene_velocity(self, centres) -> np.ndarray | None:
-        """Median per-frame motion in the scene of ``(frame, cx, cy)`` entries: each step's image
-        motion less the camera's shifts over it (:attr:`shifts`); None if fewer than three or a
-        step's shifts are no longer known."""
-        if len(centres) < 3:
+        """Median per-frame motion in the scene of ``(frame, cx, cy)`` entries (:func:`median_velocity`
+        of the centres less the camera's travel up to their frames, :attr:`travel`); None if fewer
+        than three or a frame's travel is no longer known."""
+        if len(centres) < 3 or any(int(f) not in self.travel for f, _, _ in centres):
             return None
-        c = np.asarray(centres, dtype=np.float64)
-        steps = []
-        for (f0, x0, y0), (f1, x1, y1) in zip(c[:-1], c[1:]):
-            frames = range(int(f0) + 1, int(f1) + 1)
-            if any(k not in self.shifts for k in frames):
-                return None
-            carried = np.sum([self.shifts[k] for k in frames], axis=0)
-            steps.append((np.array([x1 - x0, y1 - y0]) - carried) / (f1 - f0))
-        return np.median(np.asarray(steps), axis=0)
+        return median_velocity([(f, x - self.travel[int(f)][0], y - self.travel[int(f)][1]) for f, x, y in centres])
 
     def _rewind(self, person: Person, index: int) -> np.ndarray:
         """``background.camera_rewind``: a person that just went lost coasts on from where it was
