@@ -296,13 +296,12 @@ def contacts(tracks: pd.DataFrame, params: ActivityParams) -> pd.DataFrame:
     if hands.empty:
         return pd.DataFrame(columns=cols)
     ratios = _pair_distances(hands, params)
+    alone = _hand_positions(hands, params) if in_3d else None
     if params.decision.stayed_hand and in_3d:
-        alone = _hand_positions(hands, params)
         runs = {pair: stayed_touch_runs(alone[pair[0]], alone[pair[1]], params) for pair in ratios}
     else:
         runs = {pair: touch_runs(ratio, params) for pair, ratio in ratios.items()}
     if in_3d and params.decision.meeting_reach > 0:
-        alone = _hand_positions(hands, params)
         runs = {(a, b): [at_the_meeting(run, alone[a], alone[b], params) for run in spans] if a[0] != b[0] else spans
                 for (a, b), spans in runs.items()}
     rows = [(start, end, "clap" if a[0] == b[0] else "handshake", a[0], a[1], b[0], b[1], "contact")
