@@ -16,7 +16,8 @@ against the take's empty-scene images, with tracked or true hands.
 :class:`~partlab.tracking.activities.recognise.ActivityTracker` before the recognition) per
 scene, seed, cameras and hands, and later runs re-run only the recognition from it: changes of
 ``decision.*`` parameters are then measured in seconds (a 3-camera take takes minutes to track).
-Other ``--set`` changes are part of the cache's key.
+Other ``--set`` changes are part of the cache's key; the code is not: after changing a tracker
+(or the colour analysis), use a new directory.
 
 ``--hands truth`` feeds the recognition the scene's true head and hand boxes instead of the limb
 tracker's (what the recognition gets right when the hands are right); ``--hands both`` runs both,
